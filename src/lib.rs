@@ -1,0 +1,2 @@
+//! stirling facade
+pub use stirling_dsl as dsl;

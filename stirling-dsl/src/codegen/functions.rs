@@ -1,0 +1,59 @@
+//! The generated functions of one closure (`__rhs_full`, `__jac_full`, ...).
+
+use proc_macro2::{Ident, TokenStream};
+use quote::{format_ident, quote};
+
+use super::layout::Layout;
+use super::rows::{rows_body, Output};
+use super::terms;
+use crate::expr::Arena;
+
+/// Wrap `body` into a method with the standard prologue (`n`, parameters, offsets).
+fn method(name: &Ident, args: TokenStream, ret: TokenStream, lay: &Layout, body: TokenStream) -> TokenStream {
+    let (params, offsets) = (lay.params(), lay.offsets());
+    quote! {
+        #[allow(non_snake_case, unused_variables, unused_parens, clippy::all)]
+        #[inline(never)]
+        fn #name(&self, #args) #ret {
+            let n: usize = self.n;
+            let nf = n as f64;
+            #params
+            #offsets
+            #body
+        }
+    }
+}
+
+/// All methods for the closure `tag` (`full` or `frozen`).
+pub fn closure_methods(arena: &mut Arena, lay: &Layout, tag: &str, private: &TokenStream, krate: &TokenStream) -> TokenStream {
+    let f = |what: &str| format_ident!("__{}_{}", what, tag);
+    let sink = quote!(sink: &mut #krate::JacSink);
+    let xp = quote!(p: &[f64], x: &[f64]);
+    let rhs = rows_body(arena, lay, &lay.sys.rows, Output::Value, private);
+    let jac = rows_body(arena, lay, &lay.sys.rows, Output::StateJacobian, private);
+    let pjac = rows_body(arena, lay, &lay.sys.rows, Output::ParamJacobian, private);
+    let forces = terms::forces(arena, lay, private);
+    let grads = terms::force_gradients(arena, lay, private);
+    let init = terms::init(arena, lay, private);
+    let vessels = terms::vessels(arena, lay, private);
+    let mech = terms::mech(arena, lay, private);
+    let n_states = n_states(lay);
+    let items = [
+        method(&f("rhs"), quote!(#xp, t: f64, out: &mut [f64]), quote!(), lay, rhs),
+        method(&f("jac"), quote!(#xp, t: f64, #sink), quote!(), lay, jac),
+        method(&f("pjac"), quote!(#xp, t: f64, #sink), quote!(), lay, pjac),
+        method(&f("forces"), quote!(#xp, out: &mut [f64]), quote!(), lay, forces),
+        method(&f("force_grad"), quote!(k: usize, #xp, out: &mut [f64]), quote!(), lay, grads),
+        method(&f("init"), quote!(p: &[f64], out: &mut [f64]), quote!(), lay, init),
+        method(&f("vessels"), quote!(#xp, f: &mut dyn FnMut(usize, [f64; 7])), quote!(), lay, vessels),
+        method(&f("mech"), quote!(#xp), quote!(-> [f64; 2]), lay, mech),
+        method(&f("n_states"), quote!(), quote!(-> usize), lay, n_states),
+    ];
+    quote! { #(#items)* }
+}
+
+fn n_states(lay: &Layout) -> TokenStream {
+    let s = lay.sys.blocks.iter().filter(|b| !b.array).count();
+    let a = lay.sys.blocks.iter().filter(|b| b.array).count();
+    quote!(#s + #a * n)
+}

@@ -1,0 +1,145 @@
+//! Static descriptions emitted with a model: parameters, bodies, states, topology.
+
+use proc_macro2::TokenStream;
+use quote::quote;
+
+use super::layout::Layout;
+use crate::expr::{Printer, Style};
+use crate::topology::{BlockKind, Topology, Vessel};
+
+/// `&[ParamInfo { .. }, ..]`.
+pub fn params(topo: &Topology, krate: &TokenStream) -> TokenStream {
+    let items = topo.params.iter().map(|p| {
+        let (name, default, unit, doc) = (&p.name, p.default, &p.unit, &p.doc);
+        quote! { #krate::ParamInfo { name: #name, default: #default, unit: #unit, doc: #doc } }
+    });
+    quote! { &[#(#items),*] }
+}
+
+/// `&[BodyInfo { .. }, ..]`.
+pub fn bodies(topo: &Topology, krate: &TokenStream) -> TokenStream {
+    let items = topo.bodies.iter().map(|b| {
+        let (name, pos, vel) = (&b.name, &b.pos, &b.vel);
+        quote! { #krate::BodyInfo { name: #name, pos: #pos, vel: #vel } }
+    });
+    quote! { &[#(#items),*] }
+}
+
+/// Vessel-element offset of CV `i`: `(scalars before, arrays before)`.
+fn cv_element_offset(topo: &Topology, i: usize) -> (usize, usize) {
+    let before = &topo.cvs[..i];
+    (before.iter().filter(|c| !c.array).count(), before.iter().filter(|c| c.array).count())
+}
+
+/// Body of `fn states(&self) -> Vec<StateInfo>` for one closure.
+pub fn states(lay: &Layout, krate: &TokenStream) -> TokenStream {
+    let topo = lay.topo;
+    let pushes = lay.sys.blocks.iter().map(|b| {
+        let (kind, unit, what, elem) = match b.kind {
+            BlockKind::Position(k) => (quote!(Position), "m", format!("position of the {}", topo.bodies[k].name), Some(k)),
+            BlockKind::Velocity(k) => (quote!(Velocity), "m/s", format!("velocity of the {}", topo.bodies[k].name), Some(k)),
+            BlockKind::Pressure(i) => (quote!(Pressure), "Pa", format!("gas pressure in {}", topo.cvs[i].name), None),
+            BlockKind::Mass(i) => (quote!(Mass), "kg", format!("gas mass in {}", topo.cvs[i].name), None),
+        };
+        let cv = match b.kind {
+            BlockKind::Pressure(i) | BlockKind::Mass(i) => i,
+            _ => 0,
+        };
+        let (s, a) = cv_element_offset(topo, cv);
+        let index = match elem {
+            Some(k) => quote!(#k),
+            None => quote!(#s + #a * n + j),
+        };
+        let name = &b.name;
+        let (name_expr, meaning_expr, range) = if b.array {
+            (quote!(format!("{}[{}]", #name, j)), quote!(format!("{} section {}", #what, j + 1)), quote!(0..n))
+        } else {
+            (quote!(#name.to_string()), quote!(#what.to_string()), quote!(0..1usize))
+        };
+        quote! {
+            for j in #range {
+                v.push(#krate::StateInfo { name: #name_expr, kind: #krate::StateKind::#kind(#index), unit: #unit, meaning: #meaning_expr });
+            }
+        }
+    });
+    quote! {
+        let n = self.n;
+        let mut v = Vec::new();
+        #(#pushes)*
+        v
+    }
+}
+
+/// Names of the vessel elements (CV elements, then spaces).
+pub fn vessel_names(topo: &Topology) -> TokenStream {
+    let cvs = topo.cvs.iter().map(|c| {
+        let name = &c.name;
+        if c.array {
+            quote! { for j in 0..self.n { v.push(format!("{}[{}]", #name, j)); } }
+        } else {
+            quote! { v.push(#name.to_string()); }
+        }
+    });
+    let spaces = topo.spaces.iter().map(|s| &s.name);
+    quote! {
+        let mut v = Vec::new();
+        #(#cvs)*
+        #(v.push(#spaces.to_string());)*
+        v
+    }
+}
+
+/// The static `TopologyInfo`.
+pub fn topology(topo: &Topology, lay: &Layout, krate: &TokenStream) -> TokenStream {
+    let namer = |s| lay.name(s);
+    let p = Printer::new(&topo.arena, Style::Text, &namer);
+    let body_name = |k: usize| topo.bodies[k].name.clone();
+    let face = |f: &crate::topology::FaceDecl| {
+        let (b, c) = (body_name(f.body), p.expr(f.coeff));
+        quote! { #krate::FaceInfo { body: #b, coeff: #c } }
+    };
+    let mut vessels = Vec::new();
+    for c in &topo.cvs {
+        let faces = c.faces.iter().map(face);
+        let ports = c.ports.iter().map(|pt| {
+            let (n, w) = (&pt.name, p.expr(pt.wall));
+            quote! { #krate::PortInfo { name: #n, wall: #w } }
+        });
+        let (name, array) = (&c.name, c.array);
+        vessels.push(quote! { #krate::VesselInfo { name: #name, is_cv: true, array: #array, faces: &[#(#faces),*], ports: &[#(#ports),*] } });
+    }
+    for s in &topo.spaces {
+        let faces = s.faces.iter().map(face);
+        let name = &s.name;
+        vessels.push(quote! { #krate::VesselInfo { name: #name, is_cv: false, array: false, faces: &[#(#faces),*], ports: &[] } });
+    }
+    let links = topo.links.iter().map(|l| {
+        let end = |e: &crate::topology::End| match e.vessel {
+            Vessel::Cv(i) => crate::topology::frame::rename(&format!("{}{}", topo.cvs[i].name, at_text(e.at)), crate::topology::frame::Place::Own),
+            Vessel::Space(s) => topo.spaces[s].name.clone(),
+        };
+        let (f, t, r, chain) = (end(&l.from), end(&l.to), p.expr(l.resistance), l.is_chain());
+        quote! { #krate::LinkInfo { from: #f, to: #t, resistance: #r, chain: #chain } }
+    });
+    let bodies = topo.bodies.iter().map(|b| &b.name);
+    let couplings = topo.couplings.iter().map(|c| {
+        let (a, b) = (body_name(c.a), body_name(c.b));
+        quote! { (#a, #b) }
+    });
+    let (name, doc) = (&topo.name, &topo.doc);
+    quote! {
+        #krate::TopologyInfo {
+            name: #name, doc: #doc, bodies: &[#(#bodies),*], couplings: &[#(#couplings),*],
+            vessels: &[#(#vessels),*], links: &[#(#links),*],
+        }
+    }
+}
+
+fn at_text(at: crate::expr::At) -> String {
+    match at {
+        crate::expr::At::Scalar => String::new(),
+        crate::expr::At::Rel(r) => format!("[{}]", crate::topology::frame::index_text(r)),
+        crate::expr::At::First => "[0]".into(),
+        crate::expr::At::Last => "[n-1]".into(),
+    }
+}

@@ -1,0 +1,114 @@
+//! State layout in generated code: block offsets as functions of `n`, and how
+//! symbols read the state vector, the parameters and the section index.
+
+use proc_macro2::{Ident, Literal, Span, TokenStream};
+use quote::{format_ident, quote};
+
+use crate::expr::{At, Sym};
+use crate::topology::{System, Topology};
+
+/// Turns symbols into Rust for one system.
+pub struct Layout<'a> {
+    pub sys: &'a System,
+    pub topo: &'a Topology,
+}
+
+impl Layout<'_> {
+    /// The identifier holding a block's offset, e.g. `o_P_regen`.
+    pub fn offset_ident(&self, sym: u32) -> Ident {
+        let i = self.block(sym);
+        format_ident!("o_{}", self.sys.blocks[i].name)
+    }
+
+    fn block(&self, sym: u32) -> usize {
+        self.sys.block_index(sym).unwrap_or_else(|| panic!("internal: state block {sym} has no state in this closure"))
+    }
+
+    /// `let o_x: usize = 0; ...` for every block, as `scalars + arrays * n`.
+    pub fn offsets(&self) -> TokenStream {
+        let (mut s, mut a) = (0usize, 0usize);
+        let mut out = TokenStream::new();
+        for b in &self.sys.blocks {
+            let id = format_ident!("o_{}", b.name);
+            let (sl, al) = (Literal::usize_unsuffixed(s), Literal::usize_unsuffixed(a));
+            out.extend(match a {
+                0 => quote! { let #id: usize = #sl; },
+                1 => quote! { let #id: usize = #sl + n; },
+                _ => quote! { let #id: usize = #sl + #al * n; },
+            });
+            if b.array {
+                a += 1;
+            } else {
+                s += 1;
+            }
+        }
+        out
+    }
+
+    /// `let R = p[0]; ...` for every parameter.
+    pub fn params(&self) -> TokenStream {
+        let mut out = TokenStream::new();
+        for (i, p) in self.topo.params.iter().enumerate() {
+            let (id, k) = (Ident::new(&p.name, Span::call_site()), Literal::usize_unsuffixed(i));
+            out.extend(quote! { let #id: f64 = p[#k]; });
+        }
+        out
+    }
+
+    /// Index expression of a state element.
+    pub fn index(&self, block: u32, at: At) -> TokenStream {
+        let o = self.offset_ident(block);
+        match at {
+            At::Scalar | At::First => quote!(#o),
+            At::Rel(0) => quote!(#o + j),
+            At::Rel(k) if k > 0 => {
+                let k = Literal::usize_unsuffixed(k as usize);
+                quote!(#o + j + #k)
+            }
+            At::Rel(k) => {
+                let k = Literal::usize_unsuffixed((-k) as usize);
+                quote!(#o + j - #k)
+            }
+            At::Last => quote!(#o + n - 1),
+        }
+    }
+
+    /// The Rust for a symbol inside a generated function.
+    pub fn leaf(&self, s: Sym) -> TokenStream {
+        match s {
+            Sym::Param(i) => {
+                let id = Ident::new(&self.topo.params[i as usize].name, Span::call_site());
+                quote!(#id)
+            }
+            Sym::State(b, at) => {
+                let idx = self.index(b, at);
+                quote!(x[#idx])
+            }
+            Sym::Index => quote!(jf),
+            Sym::Count => quote!(nf),
+            Sym::Input(i) => {
+                let i = Literal::u32_unsuffixed(i);
+                quote!(u[#i])
+            }
+        }
+    }
+
+    /// Display name of a symbol for the printers.
+    pub fn name(&self, s: Sym) -> String {
+        match s {
+            Sym::Param(i) => self.topo.params[i as usize].name.clone(),
+            Sym::State(b, at) => {
+                let name = self.sys.block_index(b).map(|i| self.sys.blocks[i].name.clone()).unwrap_or_else(|| format!("s{b}"));
+                match at {
+                    At::Scalar => name,
+                    At::Rel(r) => format!("{name}[{}]", crate::topology::frame::index_text(r)),
+                    At::First => format!("{name}[0]"),
+                    At::Last => format!("{name}[n-1]"),
+                }
+            }
+            Sym::Index => "j".into(),
+            Sym::Count => "n".into(),
+            Sym::Input(i) => format!("u{i}"),
+        }
+    }
+}

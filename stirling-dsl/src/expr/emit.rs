@@ -1,0 +1,172 @@
+//! Rust code emission with common-subexpression elimination.
+//!
+//! The arena already shares structurally equal nodes; the emitter names every
+//! node that has more than one parent among the requested outputs (and every
+//! named quantity) with a `let`, in arena (topological) order, and prints each
+//! output as an expression over those temporaries.
+
+use proc_macro2::{Ident, Literal, Span, TokenStream};
+use quote::{format_ident, quote};
+
+use super::arena::Arena;
+use super::node::{Func, Id, Node, Sym};
+
+const P_ADD: u8 = 1;
+const P_MUL: u8 = 2;
+const P_UNARY: u8 = 3;
+const P_ATOM: u8 = 4;
+
+/// The statements and output expressions of one straight-line block.
+pub struct Block {
+    /// `let` statements, in dependency order.
+    pub lets: Vec<TokenStream>,
+    /// One expression per requested output.
+    pub outputs: Vec<TokenStream>,
+}
+
+/// Emit `roots` as one block; `leaf` prints each symbol. `private` is the path of the
+/// runtime helpers (`::stirling_dsl::__private`).
+pub fn emit_block(arena: &Arena, roots: &[Id], leaf: &dyn Fn(Sym) -> TokenStream, private: &TokenStream) -> Block {
+    let uses = count_uses(arena, roots);
+    let mut names: Vec<Option<Ident>> = vec![None; arena.len()];
+    let mut taken = std::collections::HashSet::new();
+    let mut lets = Vec::new();
+    let em = Emitter { arena, leaf, private };
+    for i in 0..arena.len() {
+        let id = Id(i as u32);
+        if uses[i] == 0 || !needs_let(arena, id, uses[i]) {
+            continue;
+        }
+        let name = fresh(temp_name(arena, id, lets.len()), &mut taken);
+        let value = em.go(inner(arena, id), &names).0;
+        lets.push(quote! { let #name = #value; });
+        names[i] = Some(name);
+    }
+    let outputs = roots.iter().map(|&r| em.go(r, &names).0).collect();
+    Block { lets, outputs }
+}
+
+fn inner(arena: &Arena, id: Id) -> Id {
+    match *arena.node(id) {
+        Node::Named(_, a) => a,
+        _ => id,
+    }
+}
+
+/// Number of parents of each node among the nodes reachable from `roots`
+/// (roots count once more, so a root that is also shared gets a name).
+fn count_uses(arena: &Arena, roots: &[Id]) -> Vec<u32> {
+    let mask = arena.reachable(roots);
+    let mut uses = vec![0u32; arena.len()];
+    for (i, &m) in mask.iter().enumerate() {
+        if m {
+            for c in arena.node(Id(i as u32)).children() {
+                uses[c.index()] += 1;
+            }
+        }
+    }
+    for r in roots {
+        uses[r.index()] += 1;
+    }
+    uses
+}
+
+fn needs_let(arena: &Arena, id: Id, uses: u32) -> bool {
+    match arena.node(id) {
+        Node::Const(_) | Node::Sym(_) => false,
+        Node::Named(..) => true,
+        Node::Neg(a) => uses > 1 && !matches!(arena.node(*a), Node::Const(_) | Node::Sym(_)),
+        _ => uses > 1,
+    }
+}
+
+fn temp_name(arena: &Arena, id: Id, k: usize) -> String {
+    match *arena.node(id) {
+        Node::Named(n, _) => sanitize(arena.name(n)),
+        _ => format!("t{k}"),
+    }
+}
+
+fn sanitize(name: &str) -> String {
+    name.chars().map(|c| if c.is_ascii_alphanumeric() { c } else { '_' }).collect()
+}
+
+fn fresh(base: String, taken: &mut std::collections::HashSet<String>) -> Ident {
+    let mut name = base.clone();
+    let mut k = 2;
+    while !taken.insert(name.clone()) {
+        name = format!("{base}_{k}");
+        k += 1;
+    }
+    Ident::new(&name, Span::call_site())
+}
+
+struct Emitter<'a> {
+    arena: &'a Arena,
+    leaf: &'a dyn Fn(Sym) -> TokenStream,
+    private: &'a TokenStream,
+}
+
+impl Emitter<'_> {
+    fn go(&self, id: Id, names: &[Option<Ident>]) -> (TokenStream, u8) {
+        if let Some(n) = &names[id.index()] {
+            return (quote!(#n), P_ATOM);
+        }
+        let w = |c: Id, min: u8| self.wrap(c, min, names);
+        match *self.arena.node(id) {
+            Node::Const(bits) => number(f64::from_bits(bits)),
+            Node::Sym(s) => ((self.leaf)(s), P_ATOM),
+            Node::Named(_, a) => self.go(a, names),
+            Node::Add(a, b) => binary(w(a, P_ADD), quote!(+), w(b, P_ADD), P_ADD),
+            Node::Sub(a, b) => binary(w(a, P_ADD), quote!(-), w(b, P_MUL), P_ADD),
+            Node::Mul(a, b) => binary(w(a, P_MUL), quote!(*), w(b, P_UNARY), P_MUL),
+            Node::Div(a, b) => binary(w(a, P_MUL), quote!(/), w(b, P_UNARY), P_MUL),
+            Node::Neg(a) => {
+                let a = w(a, P_UNARY);
+                (quote!(-#a), P_UNARY)
+            }
+            Node::Powi(a, k) => {
+                let a = w(a, P_ATOM);
+                let k = Literal::i32_unsuffixed(k);
+                (quote!(#a.powi(#k)), P_ATOM)
+            }
+            Node::Powf(a, b) => {
+                let (a, b) = (w(a, P_ATOM), self.go(b, names).0);
+                (quote!(#a.powf(#b)), P_ATOM)
+            }
+            Node::Func(f, a) => self.call(f, a, names),
+        }
+    }
+
+    fn call(&self, f: Func, a: Id, names: &[Option<Ident>]) -> (TokenStream, u8) {
+        if f == Func::Sign {
+            let (arg, private) = (self.go(a, names).0, self.private);
+            return (quote!(#private::sign(#arg)), P_ATOM);
+        }
+        let arg = self.wrap(a, P_ATOM, names);
+        let m = format_ident!("{}", f.name());
+        (quote!(#arg.#m()), P_ATOM)
+    }
+
+    fn wrap(&self, id: Id, min: u8, names: &[Option<Ident>]) -> TokenStream {
+        let (t, p) = self.go(id, names);
+        if p < min {
+            quote!((#t))
+        } else {
+            t
+        }
+    }
+}
+
+fn binary(a: TokenStream, op: TokenStream, b: TokenStream, p: u8) -> (TokenStream, u8) {
+    (quote!(#a #op #b), p)
+}
+
+fn number(v: f64) -> (TokenStream, u8) {
+    let lit = Literal::f64_unsuffixed(v.abs());
+    if v < 0.0 {
+        (quote!(-#lit), P_UNARY)
+    } else {
+        (quote!(#lit), P_ATOM)
+    }
+}

@@ -1,0 +1,14 @@
+//! The symbolic core: a hash-consed expression arena with folding constructors,
+//! differentiation, substitution, evaluation, printers and Rust emission.
+
+mod arena;
+mod diff;
+pub mod emit;
+mod eval;
+mod node;
+pub mod print;
+mod subst;
+
+pub use arena::Arena;
+pub use node::{sign, At, Func, Id, Node, Sym};
+pub use print::{Printer, Style};

@@ -1,0 +1,166 @@
+//! The interface every generated model implements; the analyses are generic over it.
+
+use crate::expr::Style;
+use crate::Closure;
+
+/// A model parameter as declared.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ParamInfo {
+    pub name: &'static str,
+    pub default: f64,
+    pub unit: &'static str,
+    pub doc: &'static str,
+}
+
+/// What a state is.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum StateKind {
+    /// Position of body `k`.
+    Position(usize),
+    /// Velocity of body `k`.
+    Velocity(usize),
+    /// Pressure of CV element `k` (vessel order, arrays expanded).
+    Pressure(usize),
+    /// Gas mass of CV element `k`.
+    Mass(usize),
+}
+
+/// One state with its meaning.
+#[derive(Clone, Debug, PartialEq)]
+pub struct StateInfo {
+    pub name: String,
+    pub kind: StateKind,
+    pub unit: &'static str,
+    pub meaning: String,
+}
+
+/// A body of the topology.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct BodyInfo {
+    pub name: &'static str,
+    pub pos: &'static str,
+    pub vel: &'static str,
+}
+
+/// Energy-rate terms of the budget (PHYSICS.md section 10):
+/// `dE/dt = heat + boundary + mechanical`.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct PowerTerms {
+    /// Heat into the gas through all ports.
+    pub heat: f64,
+    /// Work and enthalpy from given-pressure spaces (`Pb dVb/dt`).
+    pub boundary: f64,
+    /// Power of dampers and extra forces (negative: dissipation).
+    pub mechanical: f64,
+}
+
+/// Where the Jacobian entries go; `add` accumulates.
+pub enum JacSink<'a> {
+    /// Column-major dense storage with `nrows` rows (zero it first).
+    Dense { data: &'a mut [f64], nrows: usize },
+    /// Coordinate triplets `(row, col, value)`.
+    Triplets(&'a mut Vec<(usize, usize, f64)>),
+}
+
+impl JacSink<'_> {
+    /// Add `v` at `(r, c)`.
+    #[inline(always)]
+    pub fn add(&mut self, r: usize, c: usize, v: f64) {
+        match self {
+            JacSink::Dense { data, nrows } => data[r + *nrows * c] += v,
+            JacSink::Triplets(t) => t.push((r, c, v)),
+        }
+    }
+}
+
+/// A generated model at a given `n` and closure.
+///
+/// Callback shape: `(p, x, t, out)`, parameters as a slice in [`Model::params`] order.
+pub trait Model: Send + Sync {
+    /// The declared model name.
+    fn name(&self) -> &'static str;
+    /// Number of array sections (1 when the topology has no array).
+    fn n(&self) -> usize;
+    /// The inventory closure.
+    fn closure(&self) -> Closure;
+    /// Whether the topology has an array of CVs (so `n` matters).
+    fn has_array(&self) -> bool;
+    /// Declared parameters, in slice order.
+    fn params(&self) -> &'static [ParamInfo];
+    /// The bodies, in state order.
+    fn bodies(&self) -> &'static [BodyInfo];
+    /// Number of states.
+    fn n_states(&self) -> usize;
+    /// The states, in order.
+    fn states(&self) -> Vec<StateInfo>;
+    /// Names of the gas vessels (CV elements, then spaces) used by [`Model::pv`].
+    fn vessel_names(&self) -> Vec<String>;
+    /// `out = f(x, p, t)`.
+    fn rhs(&self, p: &[f64], x: &[f64], t: f64, out: &mut [f64]);
+    /// The analytic Jacobian `df/dx`.
+    fn jacobian(&self, p: &[f64], x: &[f64], t: f64, sink: &mut JacSink);
+    /// The analytic parameter Jacobian `df/dp` (columns in parameter order).
+    fn param_jacobian(&self, p: &[f64], x: &[f64], t: f64, sink: &mut JacSink);
+    /// Pressure force on each body.
+    fn pressure_forces(&self, p: &[f64], x: &[f64], out: &mut [f64]);
+    /// Gradient of body `k`'s pressure force with respect to the states.
+    fn pressure_force_gradient(&self, k: usize, p: &[f64], x: &[f64], out: &mut [f64]);
+    /// The equilibrium of PHYSICS.md section 6 (exact for the declared charge at rest).
+    fn equilibrium_guess(&self, p: &[f64], out: &mut [f64]);
+    /// Pressure and volume of every vessel (CV elements, then spaces).
+    fn pv(&self, p: &[f64], x: &[f64], pressure: &mut [f64], volume: &mut [f64]);
+    /// Gas temperature of every CV element.
+    fn temperatures(&self, p: &[f64], x: &[f64], out: &mut [f64]);
+    /// Total gas mass in the CVs.
+    fn gas_mass(&self, p: &[f64], x: &[f64]) -> f64;
+    /// Stored energy `sum P V/(gamma-1) + sum m v^2/2 + k q^2/2`.
+    fn energy(&self, p: &[f64], x: &[f64]) -> f64;
+    /// The terms of `dE/dt`.
+    fn power(&self, p: &[f64], x: &[f64]) -> PowerTerms;
+    /// The generated equations, as text or LaTeX.
+    fn equations(&self, style: Style) -> String;
+    /// The topology, for the bond-graph view.
+    fn topology(&self) -> &'static crate::runtime::TopologyInfo;
+
+    /// Default parameter values.
+    fn default_params(&self) -> Vec<f64> {
+        self.params().iter().map(|p| p.default).collect()
+    }
+    /// Index of a parameter by name.
+    fn param_index(&self, name: &str) -> Option<usize> {
+        self.params().iter().position(|p| p.name == name)
+    }
+    /// Names of the states.
+    fn state_names(&self) -> Vec<String> {
+        self.states().into_iter().map(|s| s.name).collect()
+    }
+    /// Dense column-major Jacobian.
+    fn jacobian_dense(&self, p: &[f64], x: &[f64], t: f64) -> Vec<f64> {
+        let n = self.n_states();
+        let mut data = vec![0.0; n * n];
+        self.jacobian(p, x, t, &mut JacSink::Dense { data: &mut data, nrows: n });
+        data
+    }
+    /// Jacobian as coordinate triplets (entries at one position are to be summed).
+    fn jacobian_triplets(&self, p: &[f64], x: &[f64], t: f64) -> Vec<(usize, usize, f64)> {
+        let mut out = Vec::new();
+        self.jacobian(p, x, t, &mut JacSink::Triplets(&mut out));
+        out
+    }
+    /// The structural sparsity pattern of the Jacobian: sorted, unique `(row, col)`.
+    fn sparsity(&self, p: &[f64]) -> Vec<(usize, usize)> {
+        let mut x = vec![0.0; self.n_states()];
+        self.equilibrium_guess(p, &mut x);
+        let mut rc: Vec<(usize, usize)> = self.jacobian_triplets(p, &x, 0.0).into_iter().map(|(r, c, _)| (r, c)).collect();
+        rc.sort_unstable();
+        rc.dedup();
+        rc
+    }
+    /// Dense column-major parameter Jacobian (`n_states` rows).
+    fn param_jacobian_dense(&self, p: &[f64], x: &[f64], t: f64) -> Vec<f64> {
+        let n = self.n_states();
+        let mut data = vec![0.0; n * self.params().len()];
+        self.param_jacobian(p, x, t, &mut JacSink::Dense { data: &mut data, nrows: n });
+        data
+    }
+}

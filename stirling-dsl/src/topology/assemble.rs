@@ -1,0 +1,577 @@
+//! The energetic assembly rules (PHYSICS.md sections 1, 2, 4 and 6).
+//!
+//! Per control volume `i` (ideal gas, `cv = R/(gamma-1)`):
+//!
+//! ```text
+//! V_i  = V_i0 + sum_k a_ik q_k            T_i = P_i V_i / (m_i R)
+//! Q_i  = sum_ports h Aw (Tw - T_i)        mdot = (P_from - P_to) / R_link
+//! H    = cp mdot (s T_from + (1-s) T_to),  s = (1 + tanh(mdot / mdot_eps)) / 2
+//! P_i' = ((gamma-1)(Q_i + H_in - H_out) - gamma P_i V_i') / V_i
+//! m_i' = mdot_in - mdot_out
+//! ```
+//! and per body `m q'' = sum_i a_ik P_i + F - k q - c q' - cq q'|q'| - couplings`.
+
+use super::decl::{LinkDecl, Topology, Vessel};
+use super::frame::{place, Place};
+use super::system::{BlockInfo, BlockKind, Row, System, Variant, VesselTerms, VARIANTS};
+use crate::expr::{At, Func, Id, Sym};
+use crate::Closure;
+
+/// Where a row is assembled: a scalar block, or a section variant of an array CV.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum RowAt {
+    Scalar,
+    Array(usize, Variant),
+}
+
+/// Quantities of a CV in its own frame.
+#[derive(Clone, Copy, Debug)]
+struct CvTemplate {
+    p: Id,
+    m: Id,
+    v: Id,
+    vdot: Id,
+    t: Id,
+    q: Id,
+    m0: Id,
+}
+
+/// Assemble the equations of `topo` under `closure`.
+pub fn assemble(topo: &mut Topology, closure: Closure) -> System {
+    Assembler::new(topo, closure).run()
+}
+
+struct Assembler<'t> {
+    t: &'t mut Topology,
+    closure: Closure,
+    array_blocks: Vec<bool>,
+    cv: Vec<CvTemplate>,
+}
+
+impl<'t> Assembler<'t> {
+    fn new(t: &'t mut Topology, closure: Closure) -> Self {
+        let (nb, ncv) = (t.bodies.len(), t.cvs.len());
+        let mut array_blocks = vec![false; 2 * nb + 2 * ncv];
+        for (i, c) in t.cvs.iter().enumerate() {
+            array_blocks[2 * nb + i] = c.array;
+            array_blocks[2 * nb + ncv + i] = c.array;
+        }
+        Self { t, closure, array_blocks, cv: Vec::new() }
+    }
+
+    fn p_block(&self, i: usize) -> u32 {
+        (2 * self.t.bodies.len() + i) as u32
+    }
+
+    fn m_block(&self, i: usize) -> u32 {
+        (2 * self.t.bodies.len() + self.t.cvs.len() + i) as u32
+    }
+
+    fn has_mass_state(&self, i: usize) -> bool {
+        self.closure == Closure::Full && self.t.cv_is_linked(i)
+    }
+
+    fn own(&self, i: usize) -> At {
+        if self.t.cvs[i].array {
+            At::Rel(0)
+        } else {
+            At::Scalar
+        }
+    }
+
+    fn label(&self, i: usize, what: &str) -> String {
+        let c = &self.t.cvs[i];
+        if c.array {
+            format!("{what}_{}[j]", c.name)
+        } else {
+            format!("{what}_{}", c.name)
+        }
+    }
+
+    fn run(mut self) -> System {
+        for i in 0..self.t.cvs.len() {
+            let tpl = self.cv_template(i);
+            self.cv.push(tpl);
+        }
+        let blocks = self.blocks();
+        let rows = blocks.iter().map(|b| self.row(b)).collect();
+        let init = blocks.iter().map(|b| self.init_row(b)).collect();
+        let forces = (0..self.t.bodies.len()).map(|k| self.force(k)).collect();
+        let mut vessels: Vec<VesselTerms> = (0..self.t.cvs.len()).map(|i| self.cv_terms(i)).collect();
+        vessels.extend((0..self.t.spaces.len()).map(|s| self.space_terms(s)));
+        let (mech_energy, mech_power) = (self.mech_energy(), self.mech_power());
+        let array_blocks = self.array_blocks.clone();
+        System { closure: self.closure, blocks, rows, init, forces, vessels, mech_energy, mech_power, array_blocks }
+    }
+
+    fn blocks(&self) -> Vec<BlockInfo> {
+        let mut out = Vec::new();
+        for (k, b) in self.t.bodies.iter().enumerate() {
+            out.push(BlockInfo { sym: Topology::pos_block(k), name: b.pos.clone(), array: false, kind: BlockKind::Position(k) });
+            out.push(BlockInfo { sym: Topology::vel_block(k), name: b.vel.clone(), array: false, kind: BlockKind::Velocity(k) });
+        }
+        for (i, c) in self.t.cvs.iter().enumerate() {
+            let name = format!("P_{}", c.name);
+            out.push(BlockInfo { sym: self.p_block(i), name, array: c.array, kind: BlockKind::Pressure(i) });
+        }
+        for (i, c) in self.t.cvs.iter().enumerate() {
+            if self.has_mass_state(i) {
+                let name = format!("m_{}", c.name);
+                out.push(BlockInfo { sym: self.m_block(i), name, array: c.array, kind: BlockKind::Mass(i) });
+            }
+        }
+        out
+    }
+
+    /// Position and velocity symbols of body `k`.
+    fn body_syms(&mut self, k: usize) -> (Id, Id) {
+        let a = &mut self.t.arena;
+        (a.sym(Sym::State(Topology::pos_block(k), At::Scalar)), a.sym(Sym::State(Topology::vel_block(k), At::Scalar)))
+    }
+
+    /// `sum coeff * q` and `sum coeff * v` over faces.
+    fn face_sums(&mut self, faces: &[super::decl::FaceDecl]) -> (Id, Id) {
+        let (mut dv, mut vdot) = (self.t.arena.num(0.0), self.t.arena.num(0.0));
+        for f in faces.to_vec() {
+            let (q, v) = self.body_syms(f.body);
+            let a = &mut self.t.arena;
+            let (cq, cv) = (a.mul(f.coeff, q), a.mul(f.coeff, v));
+            dv = a.add(dv, cq);
+            vdot = a.add(vdot, cv);
+        }
+        (dv, vdot)
+    }
+
+    /// Every state symbol set to zero: the rest position of section 6.
+    fn at_rest(&mut self, id: Id) -> Id {
+        self.t.arena.subst(id, &mut |a, s| matches!(s, Sym::State(..)).then(|| a.num(0.0)))
+    }
+
+    fn cv_template(&mut self, i: usize) -> CvTemplate {
+        let c = self.t.cvs[i].clone();
+        let own = self.own(i);
+        let (dv, vdot_raw) = self.face_sums(&c.faces);
+        let v_raw = self.t.arena.add(c.volume, dv);
+        let (vl, vdl, tl, ql, m0l) =
+            (self.label(i, "V"), self.label(i, "Vdot"), self.label(i, "T"), self.label(i, "Q"), self.label(i, "m0"));
+        let m0_raw = self.rest_mass(i, v_raw);
+        let (pb, mb) = (self.p_block(i), self.m_block(i));
+        let has_m = self.has_mass_state(i);
+        let gas = self.t.gas.clone().expect("checked: a model with CVs declares its gas");
+        let a = &mut self.t.arena;
+        let v = a.named(&vl, v_raw);
+        let vdot = a.named(&vdl, vdot_raw);
+        let m0 = a.named(&m0l, m0_raw);
+        let p = a.sym(Sym::State(pb, own));
+        let m = if has_m { a.sym(Sym::State(mb, own)) } else { m0 };
+        let pv = a.mul(p, v);
+        let mr = a.mul(m, gas.r);
+        let t_raw = a.div(pv, mr);
+        let t = a.named(&tl, t_raw);
+        let q_raw = self.heat(&c.ports, t);
+        let q = self.t.arena.named(&ql, q_raw);
+        CvTemplate { p, m, v, vdot, t, q, m0 }
+    }
+
+    /// `sum h A (Tw - T)`.
+    fn heat(&mut self, ports: &[super::decl::PortDecl], t: Id) -> Id {
+        let a = &mut self.t.arena;
+        let mut q = a.num(0.0);
+        for port in ports {
+            let ha = a.mul(port.h, port.area);
+            let dt = a.sub(port.wall, t);
+            let term = a.mul(ha, dt);
+            q = a.add(q, term);
+        }
+        q
+    }
+
+    /// `m_i0 = Pcharge V_i0 / (R T_i0)`, `T_i0 = sum h Aw Tw / sum h Aw` at rest.
+    fn rest_mass(&mut self, i: usize, volume: Id) -> Id {
+        let ports = self.t.cvs[i].ports.clone();
+        let gas = self.t.gas.clone().expect("checked: a model with CVs declares its gas");
+        let (mut num, mut den) = (self.t.arena.num(0.0), self.t.arena.num(0.0));
+        for port in &ports {
+            let a = &mut self.t.arena;
+            let ha = a.mul(port.h, port.area);
+            let haw = a.mul(ha, port.wall);
+            num = a.add(num, haw);
+            den = a.add(den, ha);
+        }
+        let (num, den, v0) = (self.at_rest(num), self.at_rest(den), self.at_rest(volume));
+        let a = &mut self.t.arena;
+        let t0 = a.div(num, den);
+        let pv = a.mul(gas.charge, v0);
+        let rt = a.mul(gas.r, t0);
+        a.div(pv, rt)
+    }
+
+    fn placed(&mut self, id: Id, at: Place) -> Id {
+        place(&mut self.t.arena, id, at, &self.array_blocks)
+    }
+
+    fn row(&mut self, b: &BlockInfo) -> Row {
+        match b.kind {
+            BlockKind::Position(k) => Row::Scalar(self.body_syms(k).1),
+            BlockKind::Velocity(k) => Row::Scalar(self.acceleration(k)),
+            BlockKind::Pressure(i) | BlockKind::Mass(i) => {
+                let want_p = matches!(b.kind, BlockKind::Pressure(_));
+                if b.array {
+                    Row::Array(VARIANTS.map(|v| self.balance(i, RowAt::Array(i, v), want_p)))
+                } else {
+                    Row::Scalar(self.balance(i, RowAt::Scalar, want_p))
+                }
+            }
+        }
+    }
+
+    fn init_row(&mut self, b: &BlockInfo) -> Row {
+        let id = match b.kind {
+            BlockKind::Position(_) | BlockKind::Velocity(_) => self.t.arena.num(0.0),
+            BlockKind::Pressure(_) => self.t.gas.as_ref().expect("checked").charge,
+            BlockKind::Mass(i) => self.cv[i].m0,
+        };
+        if b.array {
+            Row::Array([id; 4])
+        } else {
+            Row::Scalar(id)
+        }
+    }
+
+    /// Pressure force on body `k`: `sum_i a_ik P_i` over CV and space faces.
+    fn force(&mut self, k: usize) -> Id {
+        let mut terms = Vec::new();
+        for (i, c) in self.t.cvs.iter().enumerate() {
+            for f in c.faces.iter().filter(|f| f.body == k) {
+                terms.push((f.coeff, self.cv[i].p));
+            }
+        }
+        for s in &self.t.spaces {
+            for f in s.faces.iter().filter(|f| f.body == k) {
+                terms.push((f.coeff, s.pressure));
+            }
+        }
+        let name = format!("F_{}", self.t.bodies[k].name);
+        let a = &mut self.t.arena;
+        let products: Vec<Id> = terms.into_iter().map(|(c, p)| a.mul(c, p)).collect();
+        let sum = a.sum(products);
+        a.named(&name, sum)
+    }
+
+    /// `(F_pressure + F - k q - c v - cq v|v| - couplings) / m`.
+    fn acceleration(&mut self, k: usize) -> Id {
+        let fp = self.force(k);
+        let b = self.t.bodies[k].clone();
+        let (q, v) = self.body_syms(k);
+        let coupling = self.coupling_force(k);
+        let a = &mut self.t.arena;
+        let kq = a.mul(b.spring, q);
+        let cv = a.mul(b.damper, v);
+        let av = a.func(Func::Abs, v);
+        let vav = a.mul(v, av);
+        let qv = a.mul(b.quad_damper, vav);
+        let f = a.add(fp, b.force);
+        let f = a.sub(f, kq);
+        let f = a.sub(f, cv);
+        let f = a.sub(f, qv);
+        let f = a.add(f, coupling);
+        a.div(f, b.mass)
+    }
+
+    /// Force of the coupling dampers on body `k`: `c (v_other - v_k)` each.
+    fn coupling_force(&mut self, k: usize) -> Id {
+        let mut total = self.t.arena.num(0.0);
+        for c in self.t.couplings.clone() {
+            let other = match (c.a == k, c.b == k) {
+                (true, _) => c.b,
+                (_, true) => c.a,
+                _ => continue,
+            };
+            let (vk, vo) = (self.body_syms(k).1, self.body_syms(other).1);
+            let a = &mut self.t.arena;
+            let dv = a.sub(vo, vk);
+            let f = a.mul(c.damper, dv);
+            total = a.add(total, f);
+        }
+        total
+    }
+
+    /// `P'` (`want_p`) or `m'` of CV `i` at `row`.
+    fn balance(&mut self, i: usize, row: RowAt, want_p: bool) -> Id {
+        let flows = self.flows_of(i, row);
+        let tpl = self.cv[i];
+        let gas = self.t.gas.clone().expect("checked");
+        let a = &mut self.t.arena;
+        if !want_p {
+            let terms: Vec<Id> = flows.iter().map(|f| if f.into { f.mdot } else { a.neg(f.mdot) }).collect();
+            return a.sum(terms);
+        }
+        let terms: Vec<Id> = flows.iter().map(|f| if f.into { f.h } else { a.neg(f.h) }).collect();
+        let hnet = a.sum(terms);
+        let one = a.num(1.0);
+        let gm1 = a.sub(gas.gamma, one);
+        let qh = a.add(tpl.q, hnet);
+        let e = a.mul(gm1, qh);
+        let gp = a.mul(gas.gamma, tpl.p);
+        let w = a.mul(gp, tpl.vdot);
+        let num = a.sub(e, w);
+        a.div(num, tpl.v)
+    }
+
+    /// The links touching CV `i` at `row`, with their flows in the row's frame.
+    fn flows_of(&mut self, i: usize, row: RowAt) -> Vec<Flow> {
+        let links = self.t.links.clone();
+        let mut out = Vec::new();
+        for l in &links {
+            for (end, into) in [(&l.from, false), (&l.to, true)] {
+                if end.vessel != Vessel::Cv(i) {
+                    continue;
+                }
+                if let Some(base) = touches(end.at, row, l) {
+                    out.push(self.flow(l, row, base, into));
+                }
+            }
+        }
+        out
+    }
+
+    /// The flow of link `l` seen from `row`, whose own section is `base` in the link's frame.
+    fn flow(&mut self, l: &LinkDecl, row: RowAt, base: i32, into: bool) -> Flow {
+        let (p_from, t_from, from_name) = self.end_state(l.from.vessel, l.from.at, row, base);
+        let (p_to, t_to, to_name) = self.end_state(l.to.vessel, l.to.at, row, base);
+        let shift = if l.is_chain() { Place::Shift(-base) } else { Place::Own };
+        let r = self.placed(l.resistance, shift);
+        let rq = l.quadratic.map(|q| self.placed(q, shift));
+        let name = if l.is_chain() { chain_name(&from_name, base) } else { format!("{from_name}_{to_name}") };
+        let gas = self.t.gas.clone().expect("checked");
+        let a = &mut self.t.arena;
+        let dp = a.sub(p_from, p_to);
+        let mdot_raw = match rq {
+            None => a.div(dp, r),
+            Some(rq) => quadratic_flow(a, dp, r, rq),
+        };
+        let mdot = a.named(&format!("mdot_{name}"), mdot_raw);
+        let h_raw = enthalpy(a, mdot, t_from, t_to, &gas);
+        let h = a.named(&format!("H_{name}"), h_raw);
+        Flow { mdot, h, into }
+    }
+
+    /// Pressure, temperature and display name of a link end seen from `row`.
+    fn end_state(&mut self, vessel: Vessel, at: At, row: RowAt, base: i32) -> (Id, Id, String) {
+        match vessel {
+            Vessel::Space(s) => {
+                let sp = &self.t.spaces[s];
+                (sp.pressure, sp.temperature.expect("checked: a linked space has a temperature"), sp.name.clone())
+            }
+            Vessel::Cv(c) => {
+                let pl = end_place(c, at, row, base);
+                let tpl = self.cv[c];
+                let (p, t) = (self.placed(tpl.p, pl), self.placed(tpl.t, pl));
+                (p, t, end_name(&self.t.cvs[c].name, self.t.cvs[c].array, at))
+            }
+        }
+    }
+
+    fn cv_terms(&mut self, i: usize) -> VesselTerms {
+        let tpl = self.cv[i];
+        let gas = self.t.gas.clone().expect("checked");
+        let a = &mut self.t.arena;
+        let one = a.num(1.0);
+        let gm1 = a.sub(gas.gamma, one);
+        let pv = a.mul(tpl.p, tpl.v);
+        let energy = a.div(pv, gm1);
+        let zero = a.num(0.0);
+        let c = &self.t.cvs[i];
+        VesselTerms {
+            name: c.name.clone(),
+            array: c.array,
+            is_cv: true,
+            pressure: tpl.p,
+            volume: tpl.v,
+            energy,
+            heat: tpl.q,
+            boundary: zero,
+            mass: tpl.m,
+            temperature: tpl.t,
+        }
+    }
+
+    fn space_terms(&mut self, s: usize) -> VesselTerms {
+        let sp = self.t.spaces[s].clone();
+        let (dv, vdot) = self.face_sums(&sp.faces);
+        let outflow = self.space_enthalpy_out(s);
+        let a = &mut self.t.arena;
+        let volume = a.add(sp.volume, dv);
+        let work = a.mul(sp.pressure, vdot);
+        let boundary = a.sub(work, outflow);
+        let zero = a.num(0.0);
+        let temperature = sp.temperature.unwrap_or_else(|| a.num(f64::NAN));
+        VesselTerms {
+            name: sp.name.clone(),
+            array: false,
+            is_cv: false,
+            pressure: sp.pressure,
+            volume,
+            energy: zero,
+            heat: zero,
+            boundary,
+            mass: zero,
+            temperature,
+        }
+    }
+
+    /// Enthalpy flowing from the CVs into space `s` (scalar CV ends only; checked).
+    fn space_enthalpy_out(&mut self, s: usize) -> Id {
+        let links = self.t.links.clone();
+        let mut terms = Vec::new();
+        for l in &links {
+            let into_space = l.to.vessel == Vessel::Space(s);
+            if !into_space && l.from.vessel != Vessel::Space(s) {
+                continue;
+            }
+            let f = self.flow(l, RowAt::Scalar, 0, true);
+            let a = &mut self.t.arena;
+            terms.push(if into_space { f.h } else { a.neg(f.h) });
+        }
+        self.t.arena.sum(terms)
+    }
+
+    fn mech_energy(&mut self) -> Id {
+        let mut total = self.t.arena.num(0.0);
+        for k in 0..self.t.bodies.len() {
+            let b = self.t.bodies[k].clone();
+            let (q, v) = self.body_syms(k);
+            let a = &mut self.t.arena;
+            let half = a.num(0.5);
+            let (v2, q2) = (a.powi(v, 2), a.powi(q, 2));
+            let (mv, kq) = (a.mul(b.mass, v2), a.mul(b.spring, q2));
+            let s = a.add(mv, kq);
+            let e = a.mul(half, s);
+            total = a.add(total, e);
+        }
+        total
+    }
+
+    /// `sum v (F - c v - cq v|v|) - sum c (v_a - v_b)^2`.
+    fn mech_power(&mut self) -> Id {
+        let mut total = self.t.arena.num(0.0);
+        for k in 0..self.t.bodies.len() {
+            let b = self.t.bodies[k].clone();
+            let v = self.body_syms(k).1;
+            let a = &mut self.t.arena;
+            let cv = a.mul(b.damper, v);
+            let av = a.func(Func::Abs, v);
+            let vav = a.mul(v, av);
+            let qv = a.mul(b.quad_damper, vav);
+            let f = a.sub(b.force, cv);
+            let f = a.sub(f, qv);
+            let p = a.mul(v, f);
+            total = a.add(total, p);
+        }
+        for c in self.t.couplings.clone() {
+            let (va, vb) = (self.body_syms(c.a).1, self.body_syms(c.b).1);
+            let a = &mut self.t.arena;
+            let dv = a.sub(va, vb);
+            let d2 = a.powi(dv, 2);
+            let p = a.mul(c.damper, d2);
+            total = a.sub(total, p);
+        }
+        total
+    }
+}
+
+/// One link's flow as seen by a CV balance.
+struct Flow {
+    mdot: Id,
+    h: Id,
+    into: bool,
+}
+
+/// Whether a link end at `at` touches the row's section; returns the row's offset in the
+/// link's frame (`0`, or `1` for the upper end of a chain link).
+fn touches(at: At, row: RowAt, l: &LinkDecl) -> Option<i32> {
+    match (at, row) {
+        (At::Scalar, RowAt::Scalar) => Some(0),
+        (At::First, RowAt::Array(_, v)) => matches!(v, Variant::Single | Variant::First).then_some(0),
+        (At::Last, RowAt::Array(_, v)) => matches!(v, Variant::Single | Variant::Last).then_some(0),
+        (At::Rel(r), RowAt::Array(_, v)) => {
+            let upper = r > rel_min(l);
+            let ok = if upper {
+                matches!(v, Variant::Interior | Variant::Last)
+            } else {
+                matches!(v, Variant::First | Variant::Interior)
+            };
+            ok.then_some(r)
+        }
+        _ => None,
+    }
+}
+
+fn rel_min(l: &LinkDecl) -> i32 {
+    let r = |a: At| if let At::Rel(r) = a { r } else { 0 };
+    r(l.from.at).min(r(l.to.at))
+}
+
+/// Where a link end sits relative to the row's own section.
+fn end_place(cv: usize, at: At, row: RowAt, base: i32) -> Place {
+    let own_array = matches!(row, RowAt::Array(c, _) if c == cv);
+    match at {
+        At::Scalar => Place::Own,
+        At::Rel(r) => Place::Shift(r - base),
+        At::First => match row {
+            RowAt::Array(_, Variant::Single | Variant::First) if own_array => Place::Own,
+            _ => Place::First,
+        },
+        At::Last => match row {
+            RowAt::Array(_, Variant::Single | Variant::Last) if own_array => Place::Own,
+            _ => Place::Last,
+        },
+    }
+}
+
+fn end_name(name: &str, array: bool, at: At) -> String {
+    if !array {
+        return name.to_string();
+    }
+    match at {
+        At::First => format!("{name}[0]"),
+        At::Last => format!("{name}[n-1]"),
+        _ => name.to_string(),
+    }
+}
+
+/// `mdot_regen[j]` is the chain flow from section `j` to `j+1`; seen from the upper section it is `[j-1]`.
+fn chain_name(array: &str, base: i32) -> String {
+    format!("{array}[{}]", super::frame::index_text(-base))
+}
+
+/// `dP = R mdot + Rq mdot |mdot|` solved for `mdot`: `2 dP / (R + sqrt(R^2 + 4 Rq |dP|))`.
+fn quadratic_flow(a: &mut crate::expr::Arena, dp: Id, r: Id, rq: Id) -> Id {
+    let (two, four) = (a.num(2.0), a.num(4.0));
+    let r2 = a.powi(r, 2);
+    let adp = a.func(Func::Abs, dp);
+    let t = a.mul(four, rq);
+    let t = a.mul(t, adp);
+    let s = a.add(r2, t);
+    let root = a.func(Func::Sqrt, s);
+    let den = a.add(r, root);
+    let num = a.mul(two, dp);
+    a.div(num, den)
+}
+
+/// `H = cp mdot (s T_from + (1 - s) T_to)`, `s = (1 + tanh(mdot/eps))/2`, `cp = gamma R/(gamma-1)`.
+fn enthalpy(a: &mut crate::expr::Arena, mdot: Id, t_from: Id, t_to: Id, gas: &super::decl::GasDecl) -> Id {
+    let (one, half) = (a.num(1.0), a.num(0.5));
+    let ratio = a.div(mdot, gas.mdot_eps);
+    let th = a.func(Func::Tanh, ratio);
+    let opt = a.add(one, th);
+    let s = a.mul(half, opt);
+    let dt = a.sub(t_from, t_to);
+    let sdt = a.mul(s, dt);
+    let t_up = a.add(t_to, sdt);
+    let gm1 = a.sub(gas.gamma, one);
+    let gr = a.mul(gas.gamma, gas.r);
+    let cp = a.div(gr, gm1);
+    let cm = a.mul(cp, mdot);
+    a.mul(cm, t_up)
+}

@@ -1,0 +1,161 @@
+//! The topology description: what a `stirling_model!` declares, with every
+//! coefficient already an expression in one shared [`Arena`].
+//!
+//! Symbols used by the expressions: [`Sym::Param`] for parameters, the body
+//! position and velocity blocks (`Sym::State(block, At::Scalar)`, numbered as
+//! [`Topology::pos_block`] and [`Topology::vel_block`] give), [`Sym::Index`] and
+//! [`Sym::Count`] inside arrays.
+
+use crate::expr::{Arena, At, Id};
+
+/// One model parameter.
+#[derive(Clone, Debug)]
+pub struct ParamDecl {
+    pub name: String,
+    pub default: f64,
+    pub unit: String,
+    pub doc: String,
+}
+
+/// Gas properties shared by all control volumes.
+#[derive(Clone, Debug)]
+pub struct GasDecl {
+    /// Specific gas constant `R`.
+    pub r: Id,
+    /// Heat-capacity ratio `gamma`.
+    pub gamma: Id,
+    /// Charge (mean) pressure: every CV's pressure at rest.
+    pub charge: Id,
+    /// Smoothing scale of the upwind switch `mdot_eps`.
+    pub mdot_eps: Id,
+}
+
+/// A rigid body on one axis: `m q'' = F_faces + force - k q - c q' - cq q'|q'| - couplings`.
+#[derive(Clone, Debug)]
+pub struct BodyDecl {
+    pub name: String,
+    pub pos: String,
+    pub vel: String,
+    pub mass: Id,
+    pub spring: Id,
+    pub damper: Id,
+    pub quad_damper: Id,
+    /// Any further force (a load, friction, an end stop), an expression of states and parameters.
+    pub force: Id,
+}
+
+/// A damper between two bodies: force `c (v_b - v_a)` on `a` and the opposite on `b`.
+#[derive(Clone, Debug)]
+pub struct CouplingDecl {
+    pub a: usize,
+    pub b: usize,
+    pub damper: Id,
+}
+
+/// A piston face: the volume changes by `coeff * q_body`, the body feels `coeff * P`.
+#[derive(Clone, Debug)]
+pub struct FaceDecl {
+    pub body: usize,
+    pub coeff: Id,
+}
+
+/// A heat port: `Q = h area (wall - T)`.
+#[derive(Clone, Debug)]
+pub struct PortDecl {
+    pub name: String,
+    pub h: Id,
+    pub area: Id,
+    pub wall: Id,
+}
+
+/// A space whose pressure is given (a fixed bounce space, or an algebraic pressure such as
+/// Schmidt's). It contributes forces through its faces and boundary work `P dV/dt`.
+#[derive(Clone, Debug)]
+pub struct SpaceDecl {
+    pub name: String,
+    pub pressure: Id,
+    pub volume: Id,
+    /// Gas temperature, required only if a mass-flow link touches the space.
+    pub temperature: Option<Id>,
+    pub faces: Vec<FaceDecl>,
+}
+
+/// A gas control volume, or an array of `n` of them (`array`).
+#[derive(Clone, Debug)]
+pub struct CvDecl {
+    pub name: String,
+    pub array: bool,
+    /// Volume at rest, `V_0` (may use `Index`/`Count` in an array).
+    pub volume: Id,
+    pub faces: Vec<FaceDecl>,
+    pub ports: Vec<PortDecl>,
+}
+
+/// What a link end names.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Vessel {
+    Cv(usize),
+    Space(usize),
+}
+
+/// A link end: the vessel and, for arrays, which element.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct End {
+    pub vessel: Vessel,
+    pub at: At,
+}
+
+/// A mass-flow link `from -> to`: `dP = R mdot + Rq mdot |mdot|`, carrying upwind enthalpy.
+/// A chain link (`from`/`to` at `Rel` offsets) repeats for `j in 0..n-1`.
+#[derive(Clone, Debug)]
+pub struct LinkDecl {
+    pub from: End,
+    pub to: End,
+    pub resistance: Id,
+    /// Quadratic (turbulent) coefficient `Rq`, if declared.
+    pub quadratic: Option<Id>,
+}
+
+impl LinkDecl {
+    /// Whether the link repeats along an array.
+    pub fn is_chain(&self) -> bool {
+        matches!(self.from.at, At::Rel(_)) || matches!(self.to.at, At::Rel(_))
+    }
+}
+
+/// A whole declared model.
+#[derive(Clone, Debug, Default)]
+pub struct Topology {
+    pub name: String,
+    pub doc: String,
+    pub arena: Arena,
+    pub params: Vec<ParamDecl>,
+    pub gas: Option<GasDecl>,
+    pub bodies: Vec<BodyDecl>,
+    pub couplings: Vec<CouplingDecl>,
+    pub spaces: Vec<SpaceDecl>,
+    pub cvs: Vec<CvDecl>,
+    pub links: Vec<LinkDecl>,
+}
+
+impl Topology {
+    /// Block number of body `k`'s position.
+    pub fn pos_block(k: usize) -> u32 {
+        2 * k as u32
+    }
+
+    /// Block number of body `k`'s velocity.
+    pub fn vel_block(k: usize) -> u32 {
+        2 * k as u32 + 1
+    }
+
+    /// Whether CV `i` takes part in a mass-flow link.
+    pub fn cv_is_linked(&self, i: usize) -> bool {
+        self.links.iter().any(|l| l.from.vessel == Vessel::Cv(i) || l.to.vessel == Vessel::Cv(i))
+    }
+
+    /// Whether any CV is an array.
+    pub fn has_array(&self) -> bool {
+        self.cvs.iter().any(|c| c.array)
+    }
+}
