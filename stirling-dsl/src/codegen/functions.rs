@@ -47,9 +47,17 @@ pub fn closure_methods(arena: &mut Arena, lay: &Layout, tag: &str, private: &Tok
         method(&f("init"), quote!(p: &[f64], out: &mut [f64]), quote!(), lay, init),
         method(&f("vessels"), quote!(#xp, f: &mut dyn FnMut(usize, [f64; 7])), quote!(), lay, vessels),
         method(&f("mech"), quote!(#xp), quote!(-> [f64; 2]), lay, mech),
-        method(&f("n_states"), quote!(), quote!(-> usize), lay, n_states),
     ];
-    quote! { #(#items)* }
+    let ns = f("n_states");
+    let items = quote! {
+        #(#items)*
+        #[allow(clippy::all)]
+        fn #ns(&self) -> usize {
+            let n: usize = self.n;
+            #n_states
+        }
+    };
+    items
 }
 
 fn n_states(lay: &Layout) -> TokenStream {

@@ -163,6 +163,12 @@ fn binary(a: TokenStream, op: TokenStream, b: TokenStream, p: u8) -> (TokenStrea
 }
 
 fn number(v: f64) -> (TokenStream, u8) {
+    if v.is_nan() {
+        return (quote!(f64::NAN), P_ATOM);
+    }
+    if v.is_infinite() {
+        return if v > 0.0 { (quote!(f64::INFINITY), P_ATOM) } else { (quote!(f64::NEG_INFINITY), P_ATOM) };
+    }
     let lit = Literal::f64_unsuffixed(v.abs());
     if v < 0.0 {
         (quote!(-#lit), P_UNARY)

@@ -1,0 +1,289 @@
+//! Parsing: the token syntax of `stirling_model!` into a spanned AST.
+//!
+//! ```text
+//! /// docs
+//! pub model Name {
+//!     name "name";                                   // optional display name
+//!     params { /// doc
+//!              p: 1.0 "unit", ... }
+//!     let D = sqrt(4.0 * A / pi);
+//!     gas { R: R, gamma: gamma, charge: Pmean, mdot_eps: mdot_eps }
+//!     body displacer(x, v) { mass: md, spring: kd, damper: bd, quad_damper: bqd, force: .. }
+//!     coupling displacer, piston { damper: b }
+//!     space bounce { pressure: Pb, volume: Vb0, temperature: Tk, faces { displacer: Ar } }
+//!     cv hot { volume: Vh0, faces { displacer: -A }, port hot { h: hh, area: Awh, wall: Th } }
+//!     cv regen[n] { volume: Vr / n, port wall { h: hr, area: Awr / n, wall: Th - (j + 0.5) * (Th - Tk) / n } }
+//!     link hot -> regen[0] { resistance: Rf / (2.0 * n) }
+//!     link regen[j] -> regen[j + 1] for j in 0..n - 1 { resistance: Rf / n }
+//! }
+//! ```
+
+use proc_macro2::Span;
+use syn::parse::{Parse, ParseStream};
+use syn::punctuated::Punctuated;
+use syn::{braced, bracketed, parenthesized, Attribute, Expr, Ident, LitStr, Token, Visibility};
+
+/// `name: expr`.
+pub struct Field {
+    pub name: Ident,
+    pub value: Expr,
+}
+
+impl Parse for Field {
+    fn parse(input: ParseStream) -> syn::Result<Self> {
+        let name = input.parse()?;
+        input.parse::<Token![:]>()?;
+        let value = input.parse()?;
+        Ok(Field { name, value })
+    }
+}
+
+fn fields(input: ParseStream) -> syn::Result<Vec<Field>> {
+    let content;
+    braced!(content in input);
+    let list = Punctuated::<Field, Token![,]>::parse_terminated(&content)?;
+    Ok(list.into_iter().collect())
+}
+
+/// One parameter: `/// doc` then `name: default "unit"`.
+pub struct ParamAst {
+    pub doc: String,
+    pub name: Ident,
+    pub default: Expr,
+    pub unit: String,
+}
+
+impl Parse for ParamAst {
+    fn parse(input: ParseStream) -> syn::Result<Self> {
+        let doc = docs(&input.call(Attribute::parse_outer)?);
+        let name = input.parse()?;
+        input.parse::<Token![:]>()?;
+        let default = input.parse()?;
+        let unit = if input.peek(LitStr) { input.parse::<LitStr>()?.value() } else { "-".to_string() };
+        Ok(ParamAst { doc, name, default, unit })
+    }
+}
+
+/// Concatenated `///` lines.
+pub fn docs(attrs: &[Attribute]) -> String {
+    let mut lines = Vec::new();
+    for a in attrs {
+        if let syn::Meta::NameValue(nv) = &a.meta {
+            if let Expr::Lit(syn::ExprLit { lit: syn::Lit::Str(s), .. }) = &nv.value {
+                lines.push(s.value().trim().to_string());
+            }
+        }
+    }
+    lines.join(" ")
+}
+
+pub struct BodyAst {
+    pub name: Ident,
+    pub pos: Ident,
+    pub vel: Ident,
+    pub fields: Vec<Field>,
+}
+
+pub struct CouplingAst {
+    pub a: Ident,
+    pub b: Ident,
+    pub fields: Vec<Field>,
+}
+
+/// A space or a CV: fields, faces and ports.
+pub struct VesselAst {
+    pub name: Ident,
+    /// `[n]` for an array of CVs.
+    pub array: Option<Ident>,
+    pub fields: Vec<Field>,
+    pub faces: Vec<Field>,
+    pub ports: Vec<PortAst>,
+}
+
+pub struct PortAst {
+    pub name: Ident,
+    pub fields: Vec<Field>,
+}
+
+/// `name` or `name[index]`.
+pub struct EndAst {
+    pub name: Ident,
+    pub index: Option<Expr>,
+}
+
+impl Parse for EndAst {
+    fn parse(input: ParseStream) -> syn::Result<Self> {
+        let name = input.parse()?;
+        let index = if input.peek(syn::token::Bracket) {
+            let content;
+            bracketed!(content in input);
+            Some(content.parse()?)
+        } else {
+            None
+        };
+        Ok(EndAst { name, index })
+    }
+}
+
+pub struct RangeAst {
+    pub var: Ident,
+    pub start: Expr,
+    pub end: Expr,
+    pub span: Span,
+}
+
+pub struct LinkAst {
+    pub span: Span,
+    pub from: EndAst,
+    pub to: EndAst,
+    pub range: Option<RangeAst>,
+    pub fields: Vec<Field>,
+}
+
+pub enum Item {
+    Name(LitStr),
+    Params(Vec<ParamAst>),
+    Let(Ident, Expr),
+    Gas(Span, Vec<Field>),
+    Body(BodyAst),
+    Coupling(CouplingAst),
+    Space(VesselAst),
+    Cv(VesselAst),
+    Link(LinkAst),
+}
+
+pub struct ModelAst {
+    pub doc: String,
+    pub vis: Visibility,
+    pub ident: Ident,
+    pub items: Vec<Item>,
+}
+
+impl Parse for ModelAst {
+    fn parse(input: ParseStream) -> syn::Result<Self> {
+        let doc = docs(&input.call(Attribute::parse_outer)?);
+        let vis = input.parse()?;
+        let kw: Ident = input.parse()?;
+        if kw != "model" {
+            return Err(syn::Error::new(kw.span(), format!("expected `model Name {{ .. }}`, found `{kw}`")));
+        }
+        let ident = input.parse()?;
+        let content;
+        braced!(content in input);
+        let mut items = Vec::new();
+        while !content.is_empty() {
+            items.push(item(&content)?);
+        }
+        Ok(ModelAst { doc, vis, ident, items })
+    }
+}
+
+fn item(input: ParseStream) -> syn::Result<Item> {
+    if input.peek(Token![let]) {
+        input.parse::<Token![let]>()?;
+        let name = input.parse()?;
+        input.parse::<Token![=]>()?;
+        let value = input.parse()?;
+        input.parse::<Token![;]>()?;
+        return Ok(Item::Let(name, value));
+    }
+    let kw: Ident = input.parse()?;
+    let item = match kw.to_string().as_str() {
+        "name" => {
+            let s = input.parse()?;
+            input.parse::<Token![;]>()?;
+            Item::Name(s)
+        }
+        "params" => {
+            let content;
+            braced!(content in input);
+            Item::Params(Punctuated::<ParamAst, Token![,]>::parse_terminated(&content)?.into_iter().collect())
+        }
+        "gas" => Item::Gas(kw.span(), fields(input)?),
+        "body" => body(input)?,
+        "coupling" => {
+            let a = input.parse()?;
+            input.parse::<Token![,]>()?;
+            let b = input.parse()?;
+            Item::Coupling(CouplingAst { a, b, fields: fields(input)? })
+        }
+        "space" => Item::Space(vessel(input)?),
+        "cv" => Item::Cv(vessel(input)?),
+        "link" => link(input, kw.span())?,
+        other => {
+            return Err(syn::Error::new(
+                kw.span(),
+                format!("unknown item `{other}`: expected one of name, params, let, gas, body, coupling, space, cv, link"),
+            ))
+        }
+    };
+    Ok(item)
+}
+
+fn body(input: ParseStream) -> syn::Result<Item> {
+    let name = input.parse()?;
+    let content;
+    parenthesized!(content in input);
+    let pos = content.parse()?;
+    content.parse::<Token![,]>()?;
+    let vel = content.parse()?;
+    Ok(Item::Body(BodyAst { name, pos, vel, fields: fields(input)? }))
+}
+
+fn vessel(input: ParseStream) -> syn::Result<VesselAst> {
+    let name = input.parse()?;
+    let array = if input.peek(syn::token::Bracket) {
+        let content;
+        bracketed!(content in input);
+        Some(content.parse()?)
+    } else {
+        None
+    };
+    let content;
+    braced!(content in input);
+    let mut v = VesselAst { name, array, fields: Vec::new(), faces: Vec::new(), ports: Vec::new() };
+    while !content.is_empty() {
+        let key: Ident = content.fork().parse()?;
+        if key == "faces" && content.peek2(syn::token::Brace) {
+            content.parse::<Ident>()?;
+            v.faces.extend(fields(&content)?);
+        } else if key == "port" && !content.peek2(Token![:]) {
+            content.parse::<Ident>()?;
+            let name = content.parse()?;
+            v.ports.push(PortAst { name, fields: fields(&content)? });
+        } else {
+            v.fields.push(content.parse()?);
+        }
+        if !content.is_empty() {
+            content.parse::<Token![,]>()?;
+        }
+    }
+    Ok(v)
+}
+
+fn link(input: ParseStream, span: Span) -> syn::Result<Item> {
+    let from = input.parse()?;
+    input.parse::<Token![->]>()?;
+    let to = input.parse()?;
+    let range = if input.peek(Token![for]) {
+        let kw = input.parse::<Token![for]>()?;
+        let var = input.parse()?;
+        input.parse::<Token![in]>()?;
+        let Expr::Range(r) = Expr::parse_without_eager_brace(input)? else {
+            return Err(syn::Error::new(kw.span, "expected a range after `in`, e.g. `for j in 0..n - 1`"));
+        };
+        let span = kw.span.join(var_span(&r)).unwrap_or(kw.span);
+        let (Some(start), Some(end)) = (r.start, r.end) else {
+            return Err(syn::Error::new(span, "expected a range `a..b`"));
+        };
+        Some(RangeAst { var, start: *start, end: *end, span })
+    } else {
+        None
+    };
+    Ok(Item::Link(LinkAst { span, from, to, range, fields: fields(input)? }))
+}
+
+fn var_span(r: &syn::ExprRange) -> Span {
+    use syn::spanned::Spanned;
+    r.span()
+}

@@ -1,0 +1,95 @@
+//! Checks of link ends and chain links: which section an index names, and that a
+//! chain link stays inside its array.
+
+use stirling_dsl::expr::{At, Sym};
+use stirling_dsl::topology::{LinkDecl, Vessel};
+use syn::spanned::Spanned;
+
+use crate::ast::LinkAst;
+use crate::check::Lower;
+
+/// `index(j, n)` evaluated at a sample point.
+fn sample(l: &Lower, id: stirling_dsl::Id, j: f64, n: f64) -> f64 {
+    l.topo.arena.eval(id, &mut |s| match s {
+        Sym::Index => j,
+        Sym::Count => n,
+        _ => f64::NAN,
+    })
+}
+
+impl Lower {
+    /// Classify a section index: `0`, `n - 1`, or `j + k` with the link's range variable.
+    pub(crate) fn index(&mut self, ix: &syn::Expr, var: Option<&str>) -> Option<At> {
+        let id = self.expr(ix, var);
+        let syms = self.topo.arena.symbols(id);
+        if syms.iter().any(|s| !matches!(s, Sym::Index | Sym::Count)) {
+            self.cx.error(ix.span(), "a section index may use only `n`, the range variable and integers");
+            return None;
+        }
+        let (f00, f10, f01) = (sample(self, id, 0.0, 10.0), sample(self, id, 1.0, 10.0), sample(self, id, 0.0, 11.0));
+        let (dj, dn) = (f10 - f00, f01 - f00);
+        let at = match (dj, dn) {
+            (0.0, 0.0) if f00 == 0.0 => Some(At::First),
+            (0.0, 1.0) if f00 == 9.0 => Some(At::Last),
+            (1.0, 0.0) if f00.fract() == 0.0 => Some(At::Rel(f00 as i32)),
+            _ => None,
+        };
+        if at.is_none() {
+            self.cx.error(ix.span(), "unsupported section index: expected `0`, `n - 1`, or `j + k` with the link's range variable `j`");
+        }
+        at
+    }
+
+    /// A chain link (`a[j] -> a[j + 1] for j in 0..n - 1`) must stay inside its array;
+    /// a link without `for` must name fixed sections.
+    pub(crate) fn link_shape_ok(&mut self, l: &LinkAst, link: &LinkDecl) -> bool {
+        let rel = |at: At| if let At::Rel(r) = at { Some(r) } else { None };
+        let (rf, rt) = (rel(link.from.at), rel(link.to.at));
+        let Some(range) = &l.range else {
+            if rf.is_some() || rt.is_some() {
+                self.cx.error(l.span, "a link with a section variable needs a range: `for j in 0..n - 1`");
+                return false;
+            }
+            return true;
+        };
+        let (Some(rf), Some(rt)) = (rf, rt) else {
+            self.cx.error(range.span, "a `for` link must index both ends with the range variable, e.g. `a[j] -> a[j + 1]`");
+            return false;
+        };
+        if link.from.vessel != link.to.vessel {
+            self.cx.error(l.span, "a chain link must join sections of one array");
+            return false;
+        }
+        let start = self.expr(&range.start, None);
+        let end = self.expr(&range.end, None);
+        let s = sample(self, start, 0.0, 10.0);
+        let e_off = sample(self, end, 0.0, 10.0) - 10.0;
+        let (lo, hi) = (rf.min(rt), rf.max(rt));
+        if s + lo as f64 != 0.0 && s + (lo as f64) < 0.0 {
+            self.cx.error(range.start.span(), format!("the link runs before the start of the array: the index reaches {}", s as i32 + lo));
+            return false;
+        }
+        if e_off + hi as f64 > 0.0 {
+            let name = self.vessel_name(link.from.vessel);
+            let reach = e_off as i32 + hi - 1;
+            let reach = if reach == 0 { "n".to_string() } else { format!("n {} {}", if reach > 0 { "+" } else { "-" }, reach.abs()) };
+            self.cx.error(
+                range.end.span(),
+                format!(
+                    "the link runs past the end of `{name}`: its last section is n - 1, but with this range the index reaches {reach}; expected `for j in 0..n - {}`",
+                    hi - lo
+                ),
+            );
+            return false;
+        }
+        if s != 0.0 || lo != 0 || hi != 1 || e_off != -1.0 {
+            self.cx.error(range.span, "unsupported chain: expected `a[j] -> a[j + 1] for j in 0..n - 1` (or the reverse direction)");
+            return false;
+        }
+        true
+    }
+
+    fn vessel_name(&self, v: Vessel) -> String {
+        self.vessels.iter().find(|(_, &x)| x == v).map(|(k, _)| k.clone()).unwrap_or_default()
+    }
+}

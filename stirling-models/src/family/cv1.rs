@@ -1,0 +1,17 @@
+//! `cv1`: one gas control volume with three heat ports (5th order).
+
+use super::engine::engine_model;
+
+engine_model! {
+    /// One control volume for all the gas; hot, cold and regenerator heat ports.
+    model Cv1 {
+        name "cv1";
+        cv gas {
+            volume: Vh0 + Vc0 + Vr,
+            faces { displacer: -A + (A - Ar), piston: -(A - Ar) },
+            port hot { h: hh, area: Awh0 - pi * D * x, wall: Th },
+            port cold { h: hk, area: Awc0 + pi * D * (x - y), wall: Tk },
+            port regen { h: hr, area: Awr, wall: (Th + Tk) / 2.0 },
+        }
+    }
+}

@@ -1,0 +1,12 @@
+//! The seed's model family (PHYSICS.md sections 3-5), declared with `stirling_model!`.
+
+mod cv1;
+mod cv2;
+mod engine;
+mod nsection;
+mod schmidt;
+
+pub use cv1::{Cv1, Cv1Params};
+pub use cv2::{Cv2, Cv2Params};
+pub use nsection::{NSection, NSectionParams};
+pub use schmidt::{Schmidt, SchmidtParams};

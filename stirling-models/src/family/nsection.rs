@@ -1,0 +1,27 @@
+//! `nsection`: hot space, `n` regenerator sections, cold space (n+6 frozen, 2n+8 full).
+
+use super::engine::engine_model;
+
+engine_model! {
+    /// Hot space, `n` regenerator sections with a linear wall profile, cold space.
+    model NSection {
+        name "nsection";
+        cv hot {
+            volume: Vh0,
+            faces { displacer: -A },
+            port hot { h: hh, area: Awh0 - pi * D * x, wall: Th },
+        }
+        cv regen[n] {
+            volume: Vr / n,
+            port wall { h: hr, area: Awr / n, wall: Th - (j + 0.5) * (Th - Tk) / n },
+        }
+        cv cold {
+            volume: Vc0,
+            faces { displacer: A - Ar, piston: -(A - Ar) },
+            port cold { h: hk, area: Awc0 + pi * D * (x - y), wall: Tk },
+        }
+        link hot -> regen[0] { resistance: Rf / (2.0 * n) }
+        link regen[j] -> regen[j + 1] for j in 0..n - 1 { resistance: Rf / n }
+        link regen[n - 1] -> cold { resistance: Rf / (2.0 * n) }
+    }
+}
