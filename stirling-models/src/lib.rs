@@ -1,3 +1,11 @@
 //! # stirling-models: the seed family and the analyses
+//!
+//! - [`family`]: `schmidt`, `cv1`, `cv2`, `nsection` declared with `stirling_model!`
+//!   on the default engine of PHYSICS.md section 8.
+//! - [`registry`]: the family by name, as the command line uses it.
+
 pub mod family;
+pub mod registry;
+
+pub use registry::{build, RegistryError, FAMILY};
 pub use stirling_dsl as dsl;

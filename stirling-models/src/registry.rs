@@ -1,0 +1,82 @@
+//! The family by name: `schmidt`, `cv1`, `cv2`, `nsection`, and the seed's order aliases.
+
+use stirling_dsl::{Closure, Model};
+
+use crate::family::{Cv1, Cv2, NSection, Schmidt};
+
+/// A family member as the command line names it.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct ModelEntry {
+    pub name: &'static str,
+    pub aliases: &'static [&'static str],
+    pub summary: &'static str,
+}
+
+/// The family with its aliases (`order4`..`order8` as the seed counts orders, i.e. frozen).
+pub const FAMILY: &[ModelEntry] = &[
+    ModelEntry { name: "schmidt", aliases: &["order4"], summary: "isothermal spaces at one algebraic pressure (4 states)" },
+    ModelEntry { name: "cv1", aliases: &["order5"], summary: "one gas control volume, three heat ports (5 states)" },
+    ModelEntry { name: "cv2", aliases: &["order6"], summary: "two CVs joined by the regenerator resistance (6 frozen / 8 full)" },
+    ModelEntry {
+        name: "nsection",
+        aliases: &["order7", "order8"],
+        summary: "hot space, n regenerator sections, cold space (n+6 frozen / 2n+8 full); order7 = n 1, order8 = n 2",
+    },
+];
+
+/// Why a model request cannot be served.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+pub enum RegistryError {
+    #[error("unknown model `{0}`: expected one of schmidt, cv1, cv2, nsection (aliases order4..order8)")]
+    UnknownModel(String),
+    #[error("model `{model}` has no regenerator sections: --n {n} does not apply (omit --n)")]
+    NotAnArray { model: String, n: usize },
+    #[error("--n must be at least 1, found {0}")]
+    ZeroSections(usize),
+    #[error("alias `{alias}` fixes n = {fixed}; --n {n} contradicts it")]
+    AliasFixesN { alias: String, fixed: usize, n: usize },
+}
+
+/// Build a family member; `n` is `None` when not given (default 1 section for `nsection`).
+pub fn build(name: &str, n: Option<usize>, closure: Closure) -> Result<Box<dyn Model>, RegistryError> {
+    let (canonical, fixed_n) = match name {
+        "order4" => ("schmidt", None),
+        "order5" => ("cv1", None),
+        "order6" => ("cv2", None),
+        "order7" => ("nsection", Some(1)),
+        "order8" => ("nsection", Some(2)),
+        other => (other, None),
+    };
+    if let (Some(f), Some(n)) = (fixed_n, n) {
+        if f != n {
+            return Err(RegistryError::AliasFixesN { alias: name.to_string(), fixed: f, n });
+        }
+    }
+    if n == Some(0) {
+        return Err(RegistryError::ZeroSections(0));
+    }
+    let scalar = |m: &str| match n {
+        Some(k) if k != 1 => Err(RegistryError::NotAnArray { model: m.to_string(), n: k }),
+        _ => Ok(()),
+    };
+    let boxed: Box<dyn Model> = match canonical {
+        "schmidt" => {
+            scalar("schmidt")?;
+            Box::new(Schmidt::new(1, closure).expect("n = 1 is valid"))
+        }
+        "cv1" => {
+            scalar("cv1")?;
+            Box::new(Cv1::new(1, closure).expect("n = 1 is valid"))
+        }
+        "cv2" => {
+            scalar("cv2")?;
+            Box::new(Cv2::new(1, closure).expect("n = 1 is valid"))
+        }
+        "nsection" => {
+            let n = n.or(fixed_n).unwrap_or(1);
+            Box::new(NSection::new(n, closure).map_err(|_| RegistryError::ZeroSections(n))?)
+        }
+        _ => return Err(RegistryError::UnknownModel(name.to_string())),
+    };
+    Ok(boxed)
+}
