@@ -1,1 +1,38 @@
-fn main() {}
+//! `stirling`: the command line of the framework.
+
+mod common;
+mod cmd_models;
+// <mods>
+
+use clap::{Parser, Subcommand};
+
+/// Energetic, symbolic modeling of free-piston Stirling engines.
+#[derive(Parser, Debug)]
+#[command(name = "stirling", version, about, long_about = None)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand, Debug)]
+enum Command {
+    /// List the model family and its aliases
+    Models {
+        /// Machine-readable output
+        #[arg(long)]
+        json: bool,
+    },
+    // <commands>
+}
+
+fn main() {
+    let cli = Cli::parse();
+    let result = match cli.command {
+        Command::Models { json } => cmd_models::run(json),
+        // <dispatch>
+    };
+    if let Err(e) = result {
+        eprintln!("error: {e:#}");
+        std::process::exit(2);
+    }
+}

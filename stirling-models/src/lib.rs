@@ -2,9 +2,11 @@
 //!
 //! - [`family`]: `schmidt`, `cv1`, `cv2`, `nsection` declared with `stirling_model!`
 //!   on the default engine of PHYSICS.md section 8.
+//! - [`params`]: parameter files, overrides and validation.
 //! - [`registry`]: the family by name, as the command line uses it.
 
 pub mod family;
+pub mod params;
 pub mod registry;
 
 pub use registry::{build, RegistryError, FAMILY};
