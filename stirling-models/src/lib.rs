@@ -7,6 +7,8 @@
 
 pub mod family;
 pub mod params;
+pub mod plot;
+// <analysis mods>
 pub mod registry;
 
 pub use registry::{build, RegistryError, FAMILY};

@@ -1,0 +1,2 @@
+//! SVG plots (plotters): one file per kind of figure.
+// <plot mods>
