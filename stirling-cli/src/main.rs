@@ -3,6 +3,7 @@
 mod common;
 mod cmd_models;
 // <mods>
+mod cmd_info;
 
 use clap::{Parser, Subcommand};
 
@@ -23,6 +24,8 @@ enum Command {
         json: bool,
     },
     // <commands>
+    /// States, parameters and generated equations of a model, or its bond graph (--graph)
+    Info(cmd_info::InfoArgs),
 }
 
 fn main() {
@@ -30,6 +33,7 @@ fn main() {
     let result = match cli.command {
         Command::Models { json } => cmd_models::run(json),
         // <dispatch>
+        Command::Info(a) => cmd_info::run(&a),
     };
     if let Err(e) = result {
         eprintln!("error: {e:#}");

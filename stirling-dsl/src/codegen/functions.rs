@@ -37,6 +37,7 @@ pub fn closure_methods(arena: &mut Arena, lay: &Layout, tag: &str, private: &Tok
     let init = terms::init(arena, lay, private);
     let vessels = terms::vessels(arena, lay, private);
     let mech = terms::mech(arena, lay, private);
+    let masses = terms::masses(arena, lay, private);
     let n_states = n_states(lay);
     let items = [
         method(&f("rhs"), quote!(#xp, t: f64, out: &mut [f64]), quote!(), lay, rhs),
@@ -47,6 +48,7 @@ pub fn closure_methods(arena: &mut Arena, lay: &Layout, tag: &str, private: &Tok
         method(&f("init"), quote!(p: &[f64], out: &mut [f64]), quote!(), lay, init),
         method(&f("vessels"), quote!(#xp, f: &mut dyn FnMut(usize, [f64; 7])), quote!(), lay, vessels),
         method(&f("mech"), quote!(#xp), quote!(-> [f64; 2]), lay, mech),
+        method(&f("masses"), quote!(p: &[f64], out: &mut [f64]), quote!(), lay, masses),
     ];
     let ns = f("n_states");
     let items = quote! {

@@ -180,6 +180,7 @@ fn model_impl(topo: &Topology, spec: &ModelSpec, st: &Statics) -> TokenStream {
     let init = call("init", quote!(p, out));
     let vessels = call("vessels", quote!(p, x, f));
     let mech = call("mech", quote!(p, x));
+    let masses = call("masses", quote!(p, out));
     let n_states = call("n_states", quote!());
     quote! {
         impl #krate::Model for #ident {
@@ -206,6 +207,7 @@ fn model_impl(topo: &Topology, spec: &ModelSpec, st: &Statics) -> TokenStream {
                 #grad
             }
             fn equilibrium_guess(&self, p: &[f64], out: &mut [f64]) { #init }
+            fn body_masses(&self, p: &[f64], out: &mut [f64]) { #masses }
             fn pv(&self, p: &[f64], x: &[f64], pressure: &mut [f64], volume: &mut [f64]) {
                 let f = &mut |k: usize, v: [f64; 7]| { pressure[k] = v[0]; volume[k] = v[1]; };
                 #vessels

@@ -96,3 +96,16 @@ pub fn mech(arena: &Arena, lay: &Layout, private: &TokenStream) -> TokenStream {
     let (lets, outs) = (b.lets, b.outputs);
     quote! { #(#lets)* [#(#outs),*] }
 }
+
+/// `out[k] = m_k`, the declared mass of every body (parameters only).
+pub fn masses(arena: &Arena, lay: &Layout, private: &TokenStream) -> TokenStream {
+    let leaf = |s: Sym| lay.leaf(s);
+    let roots: Vec<Id> = lay.topo.bodies.iter().map(|b| b.mass).collect();
+    let b = emit_block(arena, &roots, &leaf, private);
+    let lets = b.lets;
+    let stores = b.outputs.iter().enumerate().map(|(k, v)| {
+        let k = Literal::usize_unsuffixed(k);
+        quote! { out[#k] = #v; }
+    });
+    quote! { #(#lets)* #(#stores)* }
+}

@@ -105,6 +105,9 @@ pub trait Model: Send + Sync {
     fn pressure_forces(&self, p: &[f64], x: &[f64], out: &mut [f64]);
     /// Gradient of body `k`'s pressure force with respect to the states.
     fn pressure_force_gradient(&self, k: usize, p: &[f64], x: &[f64], out: &mut [f64]);
+    /// The declared mass of every body, in body order: `out[k] = m_k`, so that an extra
+    /// force `u` on body `k` enters the velocity row as `u / m_k`.
+    fn body_masses(&self, p: &[f64], out: &mut [f64]);
     /// The equilibrium of PHYSICS.md section 6 (exact for the declared charge at rest).
     fn equilibrium_guess(&self, p: &[f64], out: &mut [f64]);
     /// Pressure and volume of every vessel (CV elements, then spaces).
@@ -129,6 +132,12 @@ pub trait Model: Send + Sync {
     /// Index of a parameter by name.
     fn param_index(&self, name: &str) -> Option<usize> {
         self.params().iter().position(|p| p.name == name)
+    }
+    /// The declared mass of body `k` (see [`Model::body_masses`]).
+    fn body_mass(&self, k: usize, p: &[f64]) -> f64 {
+        let mut m = vec![0.0; self.bodies().len()];
+        self.body_masses(p, &mut m);
+        m[k]
     }
     /// Names of the states.
     fn state_names(&self) -> Vec<String> {

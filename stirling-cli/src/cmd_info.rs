@@ -1,0 +1,166 @@
+//! `stirling info`: what a model is made of. States with their meaning and unit,
+//! parameters with unit, value and doc, the generated equations (text or LaTeX),
+//! or the energetic (bond-graph) view as Graphviz DOT.
+
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+use anyhow::{bail, Context};
+use clap::Args;
+use stirling_dsl::{Model, Style};
+
+use crate::common::ModelArgs;
+
+/// Arguments of `stirling info`.
+#[derive(Args, Debug, Clone)]
+pub struct InfoArgs {
+    #[command(flatten)]
+    pub model: ModelArgs,
+    /// Print the equations as LaTeX (an `aligned` block) instead of text
+    #[arg(long)]
+    pub latex: bool,
+    /// Write the bond-graph view of the topology as Graphviz DOT instead of the listing
+    #[arg(long, conflicts_with = "json")]
+    pub graph: bool,
+    /// With --graph: write the DOT to this file instead of stdout
+    #[arg(long, requires = "graph", value_name = "FILE")]
+    pub out: Option<PathBuf>,
+    /// With --out: overwrite an existing file
+    #[arg(long, requires = "out")]
+    pub force: bool,
+    /// Machine-readable output
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// Run `stirling info`.
+pub fn run(args: &InfoArgs) -> anyhow::Result<()> {
+    let (model, p) = args.model.load()?;
+    let model = model.as_ref();
+    if args.graph {
+        let dot = stirling_dsl::to_dot(model.topology());
+        return match &args.out {
+            Some(path) => write_new(path, &dot, args.force),
+            None => Ok(print!("{dot}")),
+        };
+    }
+    let style = if args.latex { Style::Latex } else { Style::Text };
+    if args.json {
+        println!("{}", serde_json::to_string_pretty(&json(model, &p, style))?);
+    } else {
+        print!("{}", listing(model, &p, style));
+    }
+    Ok(())
+}
+
+/// Write `text` to a new file; an existing file is kept unless `force`.
+fn write_new(path: &Path, text: &str, force: bool) -> anyhow::Result<()> {
+    let mut opts = std::fs::OpenOptions::new();
+    opts.write(true);
+    if force {
+        opts.create(true).truncate(true);
+    } else {
+        opts.create_new(true);
+    }
+    let mut f = match opts.open(path) {
+        Ok(f) => f,
+        Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => {
+            bail!("{} exists; pass --force to overwrite it", path.display())
+        }
+        Err(e) => return Err(e).with_context(|| format!("cannot create {}", path.display())),
+    };
+    f.write_all(text.as_bytes()).with_context(|| format!("cannot write {}", path.display()))?;
+    eprintln!("wrote {}", path.display());
+    Ok(())
+}
+
+/// The title line: name, sections, closure, state count and the declaration's doc.
+fn title(model: &dyn Model) -> String {
+    let n = if model.has_array() { format!(", n = {}", model.n()) } else { String::new() };
+    let doc = model.topology().doc.trim();
+    format!("model {}{n}, closure {}: {} states\n  {doc}\n", model.name(), model.closure(), model.n_states())
+}
+
+/// The human-readable listing.
+fn listing(model: &dyn Model, p: &[f64], style: Style) -> String {
+    let mut s = title(model);
+    s.push_str("\nstates\n");
+    s.push_str(&table(&state_rows(model), &["#", "name", "unit", "meaning"]));
+    s.push_str("\nparameters\n");
+    s.push_str(&table(&param_rows(model, p), &["name", "value", "unit", "meaning"]));
+    s.push('\n');
+    s.push_str(&model.equations(style));
+    s
+}
+
+fn state_rows(model: &dyn Model) -> Vec<Vec<String>> {
+    let states = model.states();
+    states.iter().enumerate().map(|(k, st)| vec![k.to_string(), st.name.clone(), st.unit.into(), st.meaning.clone()]).collect()
+}
+
+fn param_rows(model: &dyn Model, p: &[f64]) -> Vec<Vec<String>> {
+    let rows = model.params().iter().zip(p);
+    rows.map(|(info, &v)| {
+        let doc = if v == info.default { info.doc.to_string() } else { format!("{} (default {})", info.doc, fmt(info.default)) };
+        vec![info.name.into(), fmt(v), info.unit.into(), doc]
+    })
+    .collect()
+}
+
+/// Six significant digits (the JSON output keeps every digit), in exponent form
+/// for small or large magnitudes.
+fn fmt(v: f64) -> String {
+    let v: f64 = format!("{v:.5e}").parse().unwrap_or(v);
+    let a = v.abs();
+    if a != 0.0 && !(1e-3..1e6).contains(&a) {
+        format!("{v:e}")
+    } else {
+        format!("{v}")
+    }
+}
+
+/// Left-aligned columns with a header; the last column is not padded.
+fn table(rows: &[Vec<String>], header: &[&str]) -> String {
+    let mut width: Vec<usize> = header.iter().map(|h| h.chars().count()).collect();
+    for r in rows {
+        for (w, c) in width.iter_mut().zip(r) {
+            *w = (*w).max(c.chars().count());
+        }
+    }
+    let head: Vec<String> = header.iter().map(|h| h.to_string()).collect();
+    std::iter::once(&head).chain(rows).map(|r| line(r, &width)).collect()
+}
+
+fn line(r: &[String], width: &[usize]) -> String {
+    let last = r.len() - 1;
+    let cells: Vec<String> =
+        r.iter().enumerate().map(|(k, c)| if k == last { c.clone() } else { format!("{c:<w$}", w = width[k]) }).collect();
+    format!("  {}\n", cells.join("  ").trim_end())
+}
+
+/// The listing as JSON.
+fn json(model: &dyn Model, p: &[f64], style: Style) -> serde_json::Value {
+    let states: Vec<_> = model
+        .states()
+        .into_iter()
+        .map(|s| serde_json::json!({ "name": s.name, "unit": s.unit, "meaning": s.meaning }))
+        .collect();
+    let params: Vec<_> = model
+        .params()
+        .iter()
+        .zip(p)
+        .map(|(i, v)| serde_json::json!({ "name": i.name, "value": v, "default": i.default, "unit": i.unit, "doc": i.doc }))
+        .collect();
+    serde_json::json!({
+        "model": model.name(),
+        "n": model.n(),
+        "has_sections": model.has_array(),
+        "closure": model.closure().as_str(),
+        "n_states": model.n_states(),
+        "doc": model.topology().doc.trim(),
+        "states": states,
+        "params": params,
+        "equations_style": if matches!(style, Style::Latex) { "latex" } else { "text" },
+        "equations": model.equations(style),
+    })
+}
