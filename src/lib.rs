@@ -1,7 +1,46 @@
 //! # stirling: energetic, symbolic modeling of free-piston Stirling engines
 //!
-//! The facade: re-exports the symbolic core ([`dsl`]), the `stirling_model!` macro and
-//! the model family with its analyses ([`models`]).
+//! Declare a topology with [`stirling_model!`]; get, at compile time, a model type that
+//! implements [`dsl::Model`]: the right-hand side, the analytic Jacobian, the parameter
+//! Jacobian, the equations as text and LaTeX, and the bond-graph view. The analyses in
+//! [`models`] run on any such model. The seed's family (`schmidt`, `cv1`, `cv2`,
+//! `nsection`) is in [`models::family`].
+//!
+//! The generated code names the symbolic core `::stirling_dsl`, so a crate that declares
+//! models depends on `stirling-dsl` as well as on this crate (or on `stirling-macros`).
+//!
+//! ```
+//! use stirling::dsl::{Closure, Model, Style};
+//! use stirling::stirling_model;
+//!
+//! stirling_model! {
+//!     /// A gas spring: one piston on one control volume with one heat port.
+//!     pub model GasSpring {
+//!         params {
+//!             m: 1.0 "kg", k: 50.0 "N/m", c: 2.0 "N s/m", A: 1e-3 "m^2", V0: 1e-4 "m^3",
+//!             Tw: 300.0 "K", h: 50.0 "W/(m^2 K)", Aw: 0.02 "m^2",
+//!             R: 287.0 "J/(kg K)", gamma: 1.4 "-", P0: 1e5 "Pa", eps: 1e-5 "kg/s",
+//!         }
+//!         gas { R: R, gamma: gamma, charge: P0, mdot_eps: eps }
+//!         body piston(y, w) { mass: m, spring: k, damper: c }
+//!         space outside { pressure: P0, faces { piston: A } }
+//!         cv gas { volume: V0, faces { piston: -A }, port wall { h: h, area: Aw, wall: Tw } }
+//!     }
+//! }
+//!
+//! let model = GasSpring::new(1, Closure::Full).unwrap();
+//! let p = model.default_params();
+//! let mut x = vec![0.0; model.n_states()]; // [y, w, P_gas]
+//! model.equilibrium_guess(&p, &mut x);
+//! let mut f = vec![0.0; x.len()];
+//! model.rhs(&p, &x, 0.0, &mut f);
+//! assert!(f.iter().all(|v| v.abs() < 1e-9)); // at rest
+//! let j = model.jacobian_dense(&p, &x, 0.0);
+//! // the gas spring stiffens the piston: d(w')/dy = -(k + gamma P0 A^2 / V0) / m
+//! let stiff = -(50.0 + 1.4 * 1e5 * 1e-6 / 1e-4) / 1.0;
+//! assert!((j[1 + 3 * 0] - stiff).abs() < 1e-9 * stiff.abs());
+//! println!("{}", model.equations(Style::Text));
+//! ```
 
 pub use stirling_dsl as dsl;
 pub use stirling_macros::stirling_model;

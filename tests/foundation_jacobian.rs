@@ -66,8 +66,7 @@ fn checker_catches_a_wrong_entry() {
     let names = model.state_names();
     let scales = common::state_scales(&model, &p);
     let f = |xx: &[f64], out: &mut [f64]| model.rhs(&p, xx, 0.0, out);
-    let steps: Vec<f64> = scales.iter().map(|s| 1e-5 * s).collect();
-    let fd = common::fd_jacobian(&f, &x, n, &steps);
+    let fd = common::fd_jacobian(&f, &x, n, &common::fd_steps(&model, &p, &x));
     let mut jac = model.jacobian_dense(&p, &x, 0.0);
     assert!(common::compare(&jac, &fd, &names, &names, &scales, &scales, REL, common::TINY).is_empty());
     // perturb the largest entry of the mass column of the hot CV by 1e-5 relative

@@ -95,13 +95,21 @@ fn listing(model: &dyn Model, p: &[f64], style: Style) -> String {
 
 fn state_rows(model: &dyn Model) -> Vec<Vec<String>> {
     let states = model.states();
-    states.iter().enumerate().map(|(k, st)| vec![k.to_string(), st.name.clone(), st.unit.into(), st.meaning.clone()]).collect()
+    states
+        .iter()
+        .enumerate()
+        .map(|(k, st)| vec![k.to_string(), st.name.clone(), st.unit.into(), st.meaning.clone()])
+        .collect()
 }
 
 fn param_rows(model: &dyn Model, p: &[f64]) -> Vec<Vec<String>> {
     let rows = model.params().iter().zip(p);
     rows.map(|(info, &v)| {
-        let doc = if v == info.default { info.doc.to_string() } else { format!("{} (default {})", info.doc, fmt(info.default)) };
+        let doc = if v == info.default {
+            info.doc.to_string()
+        } else {
+            format!("{} (default {})", info.doc, fmt(info.default))
+        };
         vec![info.name.into(), fmt(v), info.unit.into(), doc]
     })
     .collect()
@@ -133,8 +141,11 @@ fn table(rows: &[Vec<String>], header: &[&str]) -> String {
 
 fn line(r: &[String], width: &[usize]) -> String {
     let last = r.len() - 1;
-    let cells: Vec<String> =
-        r.iter().enumerate().map(|(k, c)| if k == last { c.clone() } else { format!("{c:<w$}", w = width[k]) }).collect();
+    let cells: Vec<String> = r
+        .iter()
+        .enumerate()
+        .map(|(k, c)| if k == last { c.clone() } else { format!("{c:<w$}", w = width[k]) })
+        .collect();
     format!("  {}\n", cells.join("  ").trim_end())
 }
 

@@ -3,6 +3,9 @@
 mod common;
 mod cmd_models;
 // <mods>
+mod cmd_linearize;
+mod cmd_locus;
+mod cmd_simulate;
 mod cmd_info;
 
 use clap::{Parser, Subcommand};
@@ -24,6 +27,12 @@ enum Command {
         json: bool,
     },
     // <commands>
+    /// Equilibrium, poles, the loop broken at a pressure force, gain and phase margins
+    Linearize(cmd_linearize::LinearizeArgs),
+    /// Root locus: the poles over a parameter range
+    Locus(cmd_locus::LocusArgs),
+    /// Simulate a model (stiff BDF); --limit-cycle refines the periodic orbit by shooting
+    Simulate(cmd_simulate::SimulateArgs),
     /// States, parameters and generated equations of a model, or its bond graph (--graph)
     Info(cmd_info::InfoArgs),
 }
@@ -33,6 +42,9 @@ fn main() {
     let result = match cli.command {
         Command::Models { json } => cmd_models::run(json),
         // <dispatch>
+        Command::Linearize(a) => cmd_linearize::run(&a),
+        Command::Locus(a) => cmd_locus::run(&a),
+        Command::Simulate(a) => cmd_simulate::run(&a),
         Command::Info(a) => cmd_info::run(&a),
     };
     if let Err(e) = result {

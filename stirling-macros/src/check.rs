@@ -47,6 +47,13 @@ pub fn lower(ast: &ModelAst) -> syn::Result<Topology> {
     Ok(l.topo)
 }
 
+/// Names the generated functions use for their own locals: a declared name equal to one
+/// would shadow it (or be shadowed) in the emitted code.
+fn generated_local(name: &str) -> bool {
+    let temp = name.strip_prefix('t').is_some_and(|d| !d.is_empty() && d.bytes().all(|b| b.is_ascii_digit()));
+    matches!(name, "p" | "x" | "t" | "u" | "out" | "sink" | "f" | "nf" | "jf") || temp || name.starts_with("o_") || name.starts_with("__")
+}
+
 fn model_name(ast: &ModelAst) -> String {
     for it in &ast.items {
         if let Item::Name(s) = it {
@@ -82,6 +89,20 @@ impl Lower {
         }
         self.declared.insert(name, id.span());
         true
+    }
+
+    /// As [`Lower::declare`], for a name that becomes a local of the generated code
+    /// (parameters, lets).
+    fn declare_local(&mut self, id: &Ident) -> bool {
+        let name = id.to_string();
+        if generated_local(&name) {
+            self.cx.error(
+                id.span(),
+                format!("`{name}` is reserved for the generated code (`p`, `x`, `t`, `u`, `out`, `sink`, `f`, `nf`, `jf`, `t0`, `t1`, .., `o_*`, `__*`): choose another name for this parameter or `let`"),
+            );
+            return false;
+        }
+        self.declare(id)
     }
 
     fn run(&mut self, ast: &ModelAst) {
@@ -157,7 +178,7 @@ impl Lower {
     }
 
     fn param(&mut self, p: &crate::ast::ParamAst) {
-        if !self.declare(&p.name) {
+        if !self.declare_local(&p.name) {
             return;
         }
         let empty = HashMap::new();
@@ -212,7 +233,7 @@ impl Lower {
 
     fn let_(&mut self, name: &Ident, e: &syn::Expr) {
         let id = self.expr(e, None);
-        if self.declare(name) {
+        if self.declare_local(name) {
             let named = self.topo.arena.named(&name.to_string(), id);
             self.lets.insert(name.to_string(), named);
         }

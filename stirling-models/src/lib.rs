@@ -9,6 +9,10 @@ pub mod family;
 pub mod params;
 pub mod plot;
 // <analysis mods>
+/// Nonlinear simulation, limit cycles, Floquet multipliers and cycle work.
+pub mod sim;
+/// Linear analysis: equilibrium, poles, the loop broken at a pressure force, margins, locus.
+pub mod linear;
 pub mod registry;
 
 pub use registry::{build, RegistryError, FAMILY};

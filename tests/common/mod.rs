@@ -18,8 +18,11 @@ pub fn rng(seed: u64) -> StdRng {
 pub enum Spread {
     /// Each pressure within +-5 % of the charge: the upwind switches are saturated.
     Wide,
-    /// Each pressure within +-1 Pa of the charge: the links' smooth upwind switches
-    /// (width `mdot_eps R_link`, about 0.5 Pa) are in their transition.
+    /// Each pressure within +-1 Pa (log-uniform magnitude, 0.003 to 1 Pa) of one common level, itself within +-5 % of the charge:
+    /// the links' smooth upwind switches (width `mdot_eps R_link`, 0.01 to 0.5 Pa) are in
+    /// their transition, while the level stays away from the bounce pressure (a level equal
+    /// to it makes entries such as `d v'/d Ar = (Pb - P)/md` cancellations that finite
+    /// differences cannot resolve to 1e-6).
     Balanced,
 }
 
@@ -28,6 +31,7 @@ pub enum Spread {
 pub fn random_state(model: &dyn Model, p: &[f64], spread: Spread, rng: &mut StdRng) -> Vec<f64> {
     let mut x = vec![0.0; model.n_states()];
     model.equilibrium_guess(p, &mut x);
+    let level = 1.0 + 0.05 * rng.gen_range(-1.0..1.0);
     for (xi, s) in x.iter_mut().zip(model.states()) {
         let u: f64 = rng.gen_range(-1.0..1.0);
         *xi = match s.kind {
@@ -35,7 +39,7 @@ pub fn random_state(model: &dyn Model, p: &[f64], spread: Spread, rng: &mut StdR
             StateKind::Velocity(_) => 0.5 * u,
             StateKind::Pressure(_) => match spread {
                 Spread::Wide => *xi * (1.0 + 0.05 * u),
-                Spread::Balanced => *xi + u,
+                Spread::Balanced => *xi * level + u * 10f64.powf(rng.gen_range(-2.5..0.0)),
             },
             StateKind::Mass(_) => *xi * (1.0 + 0.05 * u),
         };
@@ -55,37 +59,125 @@ pub fn state_scales(model: &dyn Model, p: &[f64]) -> Vec<f64> {
         .map(|(s, &x0)| match s.kind {
             StateKind::Position(_) => 1e-2,
             StateKind::Velocity(_) => 0.1,
-            // well below the 0.5 Pa width of the upwind switch
             StateKind::Pressure(_) => 100.0,
             StateKind::Mass(_) => x0.abs(),
         })
         .collect()
 }
 
-/// Central differences of `f` (`m` outputs) around `x`, one column per input, column-major,
-/// with Richardson extrapolation over the steps `h_j` and `h_j / 2` (error `O(h^4)`).
-pub fn fd_jacobian(f: &dyn Fn(&[f64], &mut [f64]), x: &[f64], m: usize, steps: &[f64]) -> Vec<f64> {
-    let mut out = vec![0.0; m * x.len()];
-    let (mut fp, mut fm) = (vec![0.0; m], vec![0.0; m]);
-    let mut xx = x.to_vec();
-    let mut central = |j: usize, h: f64, xx: &mut Vec<f64>| -> Vec<f64> {
-        xx[j] = x[j] + h;
-        f(xx, &mut fp);
-        xx[j] = x[j] - h;
-        f(xx, &mut fm);
-        xx[j] = x[j];
-        // the step actually taken, after rounding of x +- h
-        let dx = (x[j] + h) - (x[j] - h);
-        fp.iter().zip(&fm).map(|(a, b)| (a - b) / dx).collect()
-    };
-    for j in 0..x.len() {
-        let d1 = central(j, steps[j], &mut xx);
-        let d2 = central(j, steps[j] / 2.0, &mut xx);
-        for i in 0..m {
-            out[i + m * j] = (4.0 * d2[i] - d1[i]) / 3.0;
+/// Upper finite-difference steps of the states for [`fd_jacobian`]: 1e-3 of the typical
+/// magnitude, except the pressures. The smooth upwind switch `tanh(mdot / mdot_eps)` has a
+/// width of `mdot_eps R_link` in pressure, 0.01 Pa for the shortest links of the 50-section
+/// chain, so pressures start at 1e-3 Pa.
+///
+/// The quadratic flow law's `mdot(dP)` is only once differentiable at `dP = 0` (it holds
+/// `dP |dP|`), so a central difference must not straddle that point either: the pressure
+/// step is also at most 5 % of the smallest gap between two pressures of `x`.
+pub fn fd_steps(model: &dyn Model, p: &[f64], x: &[f64]) -> Vec<f64> {
+    let scales = state_scales(model, p);
+    let states = model.states();
+    let pressures: Vec<f64> =
+        states.iter().zip(x).filter(|(s, _)| matches!(s.kind, StateKind::Pressure(_))).map(|(_, &v)| v).collect();
+    let mut gap = f64::INFINITY;
+    for (i, a) in pressures.iter().enumerate() {
+        for b in &pressures[i + 1..] {
+            gap = gap.min((a - b).abs());
         }
     }
-    out
+    let dp = 1e-3f64.min(0.05 * gap);
+    states.iter().zip(scales).map(|(s, scale)| if matches!(s.kind, StateKind::Pressure(_)) { dp } else { 1e-3 * scale }).collect()
+}
+
+/// Finite-difference derivatives of `f` (`m` outputs) around `x`, one column per input,
+/// column-major: Ridders' method (Numerical Recipes `dfridr`), i.e. central differences at
+/// steps `h_j, h_j/1.4, h_j/1.4^2, ..` extrapolated to zero step in a Neville tableau, each
+/// output keeping the estimate with the smallest error estimate. `h_j` is an upper step:
+/// below the scale on which `f` varies nonlinearly in input `j`, so the tableau converges.
+pub fn fd_jacobian(f: &dyn Fn(&[f64], &mut [f64]), x: &[f64], m: usize, steps: &[f64]) -> Vec<f64> {
+    ridders(f, x, m, steps).0
+}
+
+/// As [`fd_jacobian`], starting from each of `starts` (factors of `steps`) and keeping, per
+/// entry, the estimate with the smallest error estimate: for parameters, whose scales of
+/// nonlinearity range from the parameter itself down to a few percent of it.
+pub fn fd_jacobian_multi(f: &dyn Fn(&[f64], &mut [f64]), x: &[f64], m: usize, steps: &[f64], starts: &[f64]) -> Vec<f64> {
+    let mut best: Option<(Vec<f64>, Vec<f64>)> = None;
+    for s in starts {
+        let h: Vec<f64> = steps.iter().map(|h| h * s).collect();
+        let (est, err) = ridders(f, x, m, &h);
+        best = Some(match best {
+            None => (est, err),
+            Some((mut be, mut berr)) => {
+                for k in 0..be.len() {
+                    if err[k] < berr[k] {
+                        (be[k], berr[k]) = (est[k], err[k]);
+                    }
+                }
+                (be, berr)
+            }
+        });
+    }
+    best.map(|b| b.0).unwrap_or_default()
+}
+
+/// Ridders' extrapolation: the estimates and their error estimates, column-major.
+fn ridders(f: &dyn Fn(&[f64], &mut [f64]), x: &[f64], m: usize, steps: &[f64]) -> (Vec<f64>, Vec<f64>) {
+    const CON: f64 = 1.4;
+    const NTAB: usize = 14;
+    const SAFE: f64 = 2.0;
+    let mut out = vec![0.0; m * x.len()];
+    let mut errs = vec![0.0; m * x.len()];
+    let (mut fp, mut fm) = (vec![0.0; m], vec![0.0; m]);
+    let mut xx = x.to_vec();
+    for j in 0..x.len() {
+        let mut central = |h: f64| -> Vec<f64> {
+            xx[j] = x[j] + h;
+            f(&xx, &mut fp);
+            xx[j] = x[j] - h;
+            f(&xx, &mut fm);
+            xx[j] = x[j];
+            // the step actually taken, after rounding of x +- h
+            let dx = (x[j] + h) - (x[j] - h);
+            fp.iter().zip(&fm).map(|(a, b)| (a - b) / dx).collect()
+        };
+        let mut h = steps[j];
+        // tableau[k][i]: extrapolation order k at step level i, one value per output
+        let mut tab: Vec<Vec<Vec<f64>>> = vec![vec![Vec::new(); NTAB]; NTAB];
+        tab[0][0] = central(h);
+        let mut best = tab[0][0].clone();
+        let mut err = vec![f64::INFINITY; m];
+        let mut done = vec![false; m];
+        for i in 1..NTAB {
+            h /= CON;
+            tab[0][i] = central(h);
+            let mut fac = CON * CON;
+            for k in 1..=i {
+                tab[k][i] = (0..m).map(|r| (tab[k - 1][i][r] * fac - tab[k - 1][i - 1][r]) / (fac - 1.0)).collect();
+                fac *= CON * CON;
+                for r in (0..m).filter(|&r| !done[r]) {
+                    let e = (tab[k][i][r] - tab[k - 1][i][r]).abs().max((tab[k][i][r] - tab[k - 1][i - 1][r]).abs());
+                    if e <= err[r] {
+                        err[r] = e;
+                        best[r] = tab[k][i][r];
+                    }
+                }
+            }
+            // a higher order that got worse by a significant factor: stop early
+            for r in 0..m {
+                if (tab[i][i][r] - tab[i - 1][i - 1][r]).abs() >= SAFE * err[r] {
+                    done[r] = true;
+                }
+            }
+            if done.iter().all(|&d| d) {
+                break;
+            }
+        }
+        for r in 0..m {
+            out[r + m * j] = best[r];
+            errs[r + m * j] = err[r];
+        }
+    }
+    (out, errs)
 }
 
 /// One disagreement between an analytic and a finite-difference matrix.
@@ -99,9 +191,10 @@ pub struct Mismatch {
 
 /// Compare column-major `analytic` against `fd` (`m` rows). Both are first scaled by
 /// `col_scale_j / row_scale_i`; an entry is significant when either value exceeds
-/// `tiny` times its scaled column's maximum, and then must agree to `rel`; entries
-/// below that must both be below it (a term the analytic Jacobian drops, or invents,
-/// shows up as a mismatch either way).
+/// `tiny` times the larger of its scaled column's and row's maximum (the row's for a column
+/// that is zero, such as a parameter the rows do not depend on), and then must agree to
+/// `rel`. A term the analytic Jacobian drops, or invents, is significant on one side, so
+/// it shows up as a mismatch either way.
 pub fn compare(
     analytic: &[f64],
     fd: &[f64],
@@ -114,11 +207,23 @@ pub fn compare(
 ) -> Vec<Mismatch> {
     let m = row_names.len();
     let mut bad = Vec::new();
-    for (j, cs) in col_scale.iter().enumerate() {
-        let scaled = |v: f64, i: usize| v * cs / row_scale[i];
-        let colmax = (0..m).map(|i| scaled(analytic[i + m * j], i).abs().max(scaled(fd[i + m * j], i).abs())).fold(0.0, f64::max);
-        let floor = tiny * colmax;
+    let scaled = |k: usize, i: usize, j: usize| {
+        let s = col_scale[j] / row_scale[i];
+        (analytic[k] * s).abs().max((fd[k] * s).abs())
+    };
+    let mut colmax = vec![0.0f64; col_scale.len()];
+    let mut rowmax = vec![0.0f64; m];
+    for j in 0..col_scale.len() {
         for i in 0..m {
+            let v = scaled(i + m * j, i, j);
+            colmax[j] = colmax[j].max(v);
+            rowmax[i] = rowmax[i].max(v);
+        }
+    }
+    for j in 0..col_scale.len() {
+        let scaled = |v: f64, i: usize| v * col_scale[j] / row_scale[i];
+        for i in 0..m {
+            let floor = tiny * colmax[j].max(rowmax[i]);
             let (a, d) = (analytic[i + m * j], fd[i + m * j]);
             let (sa, sd) = (scaled(a, i).abs(), scaled(d, i).abs());
             let ok = if sa.max(sd) > floor { (a - d).abs() <= rel * a.abs().max(d.abs()) } else { true };
@@ -143,16 +248,14 @@ pub fn check_jacobians(model: &dyn Model, p: &[f64], x: &[f64]) -> Vec<Mismatch>
     let scales = state_scales(model, p);
     // states
     let f = |xx: &[f64], out: &mut [f64]| model.rhs(p, xx, 0.0, out);
-    let steps: Vec<f64> = scales.iter().map(|s| 1e-5 * s).collect();
-    let fd = fd_jacobian(&f, x, n, &steps);
+    let fd = fd_jacobian(&f, x, n, &fd_steps(model, p, x));
     let jac = model.jacobian_dense(p, x, 0.0);
     let mut bad = compare(&jac, &fd, &names, &names, &scales, &scales, REL, TINY);
     // parameters
     let pnames: Vec<String> = model.params().iter().map(|q| format!("param {}", q.name)).collect();
     let g = |pp: &[f64], out: &mut [f64]| model.rhs(pp, x, 0.0, out);
     let pscales: Vec<f64> = p.iter().map(|v| if *v == 0.0 { 1.0 } else { v.abs() }).collect();
-    let psteps: Vec<f64> = pscales.iter().map(|s| 1e-5 * s).collect();
-    let pfd = fd_jacobian(&g, p, n, &psteps);
+    let pfd = fd_jacobian_multi(&g, p, n, &pscales, &[0.5, 0.1]);
     let pjac = model.param_jacobian_dense(p, x, 0.0);
     bad.extend(compare(&pjac, &pfd, &names, &pnames, &scales, &pscales, REL, TINY));
     bad

@@ -52,7 +52,7 @@ macro_rules! test_engine {
                     kp: 61.482 "N/m",
                     bd: 0.48643 "N s/m",
                     bp: 7.9083 "N s/m",
-                    b: 0.1 "N s/m",
+                    bc: 0.1 "N s/m",
                     bqd: 0.5 "N s^2/m^2",
                     bqp: 5.0 "N s^2/m^2",
                     Awh0: 0.0128 "m^2",
@@ -70,7 +70,7 @@ macro_rules! test_engine {
                 gas { R: R, gamma: gamma, charge: Pmean, mdot_eps: mdot_eps }
                 body displacer(x, v) { mass: md, spring: kd, damper: bd, quad_damper: bqd }
                 body piston(y, w) { mass: mp, spring: kp, damper: bp, quad_damper: bqp }
-                coupling displacer, piston { damper: b }
+                coupling displacer, piston { damper: bc }
                 space bounce { pressure: Pb, faces { displacer: Ar, piston: A - Ar } }
                 $($body)*
             }

@@ -44,7 +44,7 @@ pub fn closure_methods(arena: &mut Arena, lay: &Layout, tag: &str, private: &Tok
         method(&f("jac"), quote!(#xp, t: f64, #sink), quote!(), lay, jac),
         method(&f("pjac"), quote!(#xp, t: f64, #sink), quote!(), lay, pjac),
         method(&f("forces"), quote!(#xp, out: &mut [f64]), quote!(), lay, forces),
-        method(&f("force_grad"), quote!(k: usize, #xp, out: &mut [f64]), quote!(), lay, grads),
+        method(&f("force_grad"), quote!(__body: usize, #xp, out: &mut [f64]), quote!(), lay, grads),
         method(&f("init"), quote!(p: &[f64], out: &mut [f64]), quote!(), lay, init),
         method(&f("vessels"), quote!(#xp, f: &mut dyn FnMut(usize, [f64; 7])), quote!(), lay, vessels),
         method(&f("mech"), quote!(#xp), quote!(-> [f64; 2]), lay, mech),

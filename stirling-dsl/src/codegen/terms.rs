@@ -22,7 +22,7 @@ pub fn forces(arena: &Arena, lay: &Layout, private: &TokenStream) -> TokenStream
     quote! { #(#lets)* #(#stores)* }
 }
 
-/// `match k { 0 => { out[col] += dF_0/dx_col; ... } ... }`.
+/// `match __body { 0 => { out[col] += dF_0/dx_col; ... } ... }`.
 pub fn force_gradients(arena: &mut Arena, lay: &Layout, private: &TokenStream) -> TokenStream {
     let mut arms = Vec::new();
     for (k, &f) in lay.sys.forces.iter().enumerate() {
@@ -44,7 +44,7 @@ pub fn force_gradients(arena: &mut Arena, lay: &Layout, private: &TokenStream) -
         let k = Literal::usize_unsuffixed(k);
         arms.push(quote! { #k => { #(#lets)* #(#stores)* } });
     }
-    quote! { match k { #(#arms)* _ => {} } }
+    quote! { match __body { #(#arms)* _ => {} } }
 }
 
 /// The equilibrium guess as `out[...] = ...` over all blocks.

@@ -10,7 +10,7 @@
 //! i.e. the relative rate of change of each state, in 1/s.
 
 use nalgebra::{DMatrix, DVector};
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 use stirling_dsl::{Model, StateKind};
 
 use super::LinearError;
@@ -31,7 +31,7 @@ impl Default for NewtonOptions {
 }
 
 /// A solved equilibrium.
-#[derive(Clone, Debug, PartialEq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Equilibrium {
     /// The state at rest.
     pub x: Vec<f64>,

@@ -8,10 +8,10 @@
 //! costs `O(n^2)`: `H J H = J - 2 u (u'J) - 2 (J u) u' + 4 (u'J u) u u'`, then drop row and column `j`.
 
 use nalgebra::{DMatrix, DVector};
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 /// The conserved-inventory mode.
-#[derive(Clone, Debug, PartialEq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct InventoryMode {
     /// `c J c' / c c'`: the eigenvalue along the inventory direction (zero to round-off).
     pub eigenvalue: f64,

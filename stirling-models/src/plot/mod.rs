@@ -1,2 +1,12 @@
 //! SVG plots (plotters): one file per kind of figure.
 // <plot mods>
+/// Bode diagram with the margins marked (seed Figure 8).
+pub mod bode;
+/// Root locus over a parameter.
+pub mod locus;
+/// Pole map with the right half plane shaded (seed Figure 6).
+pub mod poles;
+/// Start-up time response (x, y, pressures against time).
+pub mod timeseries;
+/// PV diagram per vessel over one cycle.
+pub mod pv;

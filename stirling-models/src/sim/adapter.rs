@@ -121,8 +121,8 @@ impl<'a, 's> OdeEquationsRef<'a> for Eqn<'s> {
     type Reset = UnitCallable<M>;
 }
 
-impl OdeEquations for Eqn<'_> {
-    fn rhs(&self) -> Rhs<'_, '_> {
+impl<'s> OdeEquations for Eqn<'s> {
+    fn rhs<'a>(&'a self) -> Rhs<'a, 's> {
         Rhs(self)
     }
     fn mass(&self) -> Option<UnitCallable<M>> {
@@ -131,7 +131,7 @@ impl OdeEquations for Eqn<'_> {
     fn root(&self) -> Option<UnitCallable<M>> {
         None
     }
-    fn init(&self) -> Init<'_, '_> {
+    fn init<'a>(&'a self) -> Init<'a, 's> {
         Init(self)
     }
     fn set_params(&mut self, _p: &V) {}

@@ -100,3 +100,56 @@ fn wrap_deg(a: f64) -> f64 {
     }
     a
 }
+
+/// Result of running until the motion repeats.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Settled {
+    /// State at the last upward crossing of `y = 0`.
+    pub x0: Vec<f64>,
+    /// Time of that crossing and the last period.
+    pub t: f64,
+    pub period: f64,
+    /// The whole sampled run (for the start-up plot).
+    pub trajectory: super::integrate::Trajectory,
+}
+
+/// Run from `x0` until `cycles` successive periods agree within `tol` (relative,
+/// states relative to their magnitudes) or `t_max` is reached.
+pub fn settle(
+    model: &dyn Model,
+    p: &[f64],
+    x0: &[f64],
+    t_max: f64,
+    samples: &[f64],
+    cycles: usize,
+    tol: f64,
+    opts: &super::integrate::SimOptions,
+    mut progress: Option<&mut dyn FnMut(f64)>,
+) -> Result<Settled, super::SimError> {
+    use super::integrate::{check_physical, integrate, Hooks};
+    use super::system::{state_scale, ModelSystem};
+    let iy = model
+        .states()
+        .iter()
+        .position(|s| s.kind == StateKind::Position(1))
+        .ok_or_else(|| super::SimError::BadOption("cycle detection needs the power piston position".into()))?;
+    let scale = state_scale(model, p);
+    let mut found = None;
+    let mut on_crossing = |c: &[Crossing]| {
+        found = periodic(c, &scale, cycles, tol);
+        found.is_some()
+    };
+    let check = |t: f64, x: &[f64]| check_physical(model, p, t, x);
+    let mut prog = |t: f64| {
+        if let Some(f) = progress.as_mut() {
+            f(t)
+        }
+    };
+    let hooks = Hooks { crossing: Some(iy), on_crossing: Some(&mut on_crossing), check: Some(&check), progress: Some(&mut prog) };
+    let tr = integrate(&ModelSystem { model, p }, x0, t_max, samples, opts, hooks)?;
+    let last = tr.crossings.last().cloned();
+    match (found, last) {
+        (Some(period), Some(c)) => Ok(Settled { x0: c.x, t: c.t, period, trajectory: tr }),
+        _ => Err(super::SimError::NotPeriodic { t: tr.t_end, crossings: tr.crossings.len() }),
+    }
+}

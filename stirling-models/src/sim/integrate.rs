@@ -10,7 +10,7 @@
 //! hundred states; `nsection` at n = 1000 (2008 states) costs about a second per
 //! factorization (the sparse faer route is not wired in yet).
 
-use diffsol::{error::OdeSolverError, DiffsolError, NalgebraLU, OdeBuilder, OdeSolverMethod, OdeSolverStopReason, Vector, VectorCommon};
+use diffsol::{error::OdeSolverError, DiffsolError, NalgebraLU, OdeBuilder, OdeSolverMethod, OdeSolverStopReason, Vector};
 use serde::Serialize;
 use stirling_dsl::{Model, StateKind};
 
@@ -126,6 +126,10 @@ pub fn integrate(sys: &dyn OdeSystem, x0: &[f64], t_end: f64, samples: &[f64], o
         .build_from_eqn(eqn)
         .map_err(|e| SimError::SolverFailure { t: 0.0, why: e.to_string() })?;
     problem.ode_options.min_timestep = opts.min_step;
+    // diffsol counts Newton failures over the whole run, not per step: with the sharp
+    // upwind switch of the enthalpy flows they add up on long runs. Step-size collapse
+    // (min_step) is the real stop.
+    problem.ode_options.max_nonlinear_solver_failures = opts.max_steps;
     let mut solver = problem.bdf::<NalgebraLU<f64>>().map_err(|e| map_err(e, 0.0))?;
     solver.set_stop_time(t_end).map_err(|e| map_err(e, 0.0))?;
     let mut out = Trajectory::default();
@@ -228,7 +232,7 @@ fn map_err(e: DiffsolError, t: f64) -> SimError {
     match e {
         DiffsolError::OdeSolverError(OdeSolverError::StepSizeTooSmall { time }) => SimError::StepSizeCollapse { t: time },
         DiffsolError::OdeSolverError(OdeSolverError::TooManyNonlinearSolverFailures { time, num_failures }) => {
-            SimError::SolverFailure { t: time, why: format!("Newton failed to converge {num_failures} times in a row") }
+            SimError::SolverFailure { t: time, why: format!("Newton failed to converge ({num_failures} failures in the run)") }
         }
         DiffsolError::OdeSolverError(OdeSolverError::TooManyErrorTestFailures { time, num_failures }) => {
             SimError::SolverFailure { t: time, why: format!("{num_failures} consecutive error-test failures") }
@@ -237,7 +241,17 @@ fn map_err(e: DiffsolError, t: f64) -> SimError {
     }
 }
 
-/// Reject a nonphysical state: non-finite entries, non-positive volume, pressure,
+fn rest_volumes(model: &dyn Model, p: &[f64]) -> Vec<f64> {
+    let nv = model.vessel_names().len();
+    let mut eq = vec![0.0; model.n_states()];
+    model.equilibrium_guess(p, &mut eq);
+    let (mut pr, mut vol) = (vec![0.0; nv], vec![0.0; nv]);
+    model.pv(p, &eq, &mut pr, &mut vol);
+    vol
+}
+
+/// Reject a nonphysical state: non-finite entries, non-positive volume (of every
+/// vessel with a positive rest volume), pressure,
 /// temperature or mass (the error names the time and the quantity).
 pub fn check_physical(model: &dyn Model, p: &[f64], t: f64, x: &[f64]) -> Result<(), SimError> {
     let names = model.state_names();
@@ -247,8 +261,10 @@ pub fn check_physical(model: &dyn Model, p: &[f64], t: f64, x: &[f64]) -> Result
     let vessels = model.vessel_names();
     let (mut pr, mut vol) = (vec![0.0; vessels.len()], vec![0.0; vessels.len()]);
     model.pv(p, x, &mut pr, &mut vol);
+    let rest = rest_volumes(model, p);
     for (i, name) in vessels.iter().enumerate() {
-        if !(vol[i] > 0.0) {
+        // a space declared without a rest volume (the bounce space) only counts displacement
+        if rest[i] > 0.0 && !(vol[i] > 0.0) {
             return Err(SimError::Nonphysical { t, quantity: format!("volume of `{name}` (m^3)"), value: vol[i] });
         }
         if !(pr[i] > 0.0) {

@@ -1,0 +1,122 @@
+//! Snapshots of the pure expansion (formatted with prettyplease) and of the printed
+//! equations, for small models: review them like code.
+
+use proc_macro2::{TokenStream, TokenTree};
+
+use crate::ast::ModelAst;
+use crate::expand::expand;
+
+/// One gas space on one piston with one heat port, against a bounce space.
+const ONE_CV: &str = r#"
+    /// One gas space on one piston.
+    pub model OneCv {
+        params {
+            /// specific gas constant
+            R: 287.05 "J/(kg K)",
+            gamma: 1.4 "-",
+            P0: 101325.0 "Pa",
+            m: 0.3 "kg",
+            k: 60.0 "N/m",
+            A: 2.6e-3 "m^2",
+            V0: 1.5e-4 "m^3",
+            Tw: 450.0 "K",
+            h: 500.0 "W/(m^2 K)",
+            Aw: 0.0128 "m^2",
+            eps: 1.0e-5 "kg/s",
+        }
+        gas { R: R, gamma: gamma, charge: P0, mdot_eps: eps }
+        body piston(y, w) { mass: m, spring: k }
+        space bounce { pressure: P0, faces { piston: A } }
+        cv gas { volume: V0, faces { piston: -A }, port wall { h: h, area: Aw, wall: Tw } }
+    }
+"#;
+
+/// Two CVs joined by one link, on one piston.
+const TWO_CV: &str = r#"
+    /// Two gas spaces joined by a flow resistance.
+    pub model TwoCv {
+        params {
+            R: 287.05 "J/(kg K)",
+            gamma: 1.4 "-",
+            P0: 101325.0 "Pa",
+            m: 0.3 "kg",
+            k: 60.0 "N/m",
+            A: 2.6e-3 "m^2",
+            V1: 1.5e-4 "m^3",
+            V2: 1.2e-4 "m^3",
+            Th: 600.0 "K",
+            Tk: 300.0 "K",
+            h: 500.0 "W/(m^2 K)",
+            Aw: 0.0128 "m^2",
+            Rf: 1.0e5 "Pa s/kg",
+            eps: 1.0e-5 "kg/s",
+        }
+        gas { R: R, gamma: gamma, charge: P0, mdot_eps: eps }
+        body piston(y, w) { mass: m, spring: k }
+        space bounce { pressure: P0, faces { piston: A } }
+        cv hot { volume: V1, port heater { h: h, area: Aw, wall: Th } }
+        cv cold { volume: V2, faces { piston: -A }, port cooler { h: h, area: Aw, wall: Tk } }
+        link hot -> cold { resistance: Rf }
+    }
+"#;
+
+fn parse(src: &str) -> ModelAst {
+    syn::parse_str(src).expect("the test model parses")
+}
+
+/// The expansion, formatted.
+fn expanded(src: &str) -> String {
+    let tokens = expand(parse(src)).unwrap_or_else(|e| panic!("expansion failed: {e}"));
+    let file: syn::File = syn::parse2(tokens).expect("the expansion is valid Rust");
+    prettyplease::unparse(&file)
+}
+
+/// The printed text equations of one closure, as the expansion embeds them
+/// (the string literal of `Model::equations` that starts with `header`).
+fn equations(src: &str, header: &str) -> String {
+    fn find(ts: TokenStream, header: &str, out: &mut Vec<String>) {
+        for tt in ts {
+            match tt {
+                TokenTree::Group(g) => find(g.stream(), header, out),
+                TokenTree::Literal(l) => {
+                    if let Ok(s) = syn::parse_str::<syn::LitStr>(&l.to_string()) {
+                        if s.value().starts_with(header) {
+                            out.push(s.value());
+                        }
+                    }
+                }
+                _ => {}
+            }
+        }
+    }
+    let mut found = Vec::new();
+    find(expand(parse(src)).expect("expansion"), header, &mut found);
+    assert_eq!(found.len(), 1, "one equations text starts with {header:?}");
+    found.remove(0)
+}
+
+#[test]
+fn expansion_one_cv() {
+    insta::assert_snapshot!(expanded(ONE_CV));
+}
+
+#[test]
+fn expansion_two_cv() {
+    insta::assert_snapshot!(expanded(TWO_CV));
+}
+
+#[test]
+fn equations_two_cv_full() {
+    insta::assert_snapshot!(equations(TWO_CV, "model twocv, closure full"));
+}
+
+#[test]
+fn equations_two_cv_frozen() {
+    insta::assert_snapshot!(equations(TWO_CV, "model twocv, closure frozen"));
+}
+
+#[test]
+fn tmp_dump() {
+    let src = std::fs::read_to_string("/tmp/model.txt").unwrap();
+    std::fs::write("/tmp/expanded.rs", expanded(&src)).unwrap();
+}

@@ -1,0 +1,220 @@
+//! Linear analysis of any generated model (PHYSICS.md sections 6-7).
+//!
+//! The pipeline of [`linearize`]:
+//! 1. [`equilibrium`]: `f(x*) = 0` by Newton with the analytic Jacobian (mass constraint with `full`);
+//! 2. `J = df/dx (x*)` from the generated Jacobian;
+//! 3. [`reduce`]: the dynamic part `T' J T` on `ker c` and the inventory mode;
+//! 4. [`poles`]: the closed-loop poles `eig(T' J T)`;
+//! 5. [`loop_break`]: the loop broken at a pressure-force (or common-pressure) input,
+//!    `L(s) = K (sI - A0)^-1 B` with `A0 - B K = J`, evaluated by [`response`];
+//! 6. [`margins`] of `L(jw)` as MATLAB's `margin`, and [`bode`] / Nyquist data.
+//!
+//! [`locus`] repeats 1-4 over a parameter range. [`LinearReport`] is the serializable summary
+//! that `stirling linearize --json` prints.
+
+pub mod balance;
+pub mod bode;
+pub mod equilibrium;
+pub mod locus;
+pub mod loop_break;
+pub mod margins;
+pub mod poles;
+pub mod reduce;
+pub mod response;
+
+use nalgebra::{DMatrix, DVector};
+use serde::{Deserialize, Serialize};
+use stirling_dsl::Model;
+
+/// The matrix crate of the public API (`DMatrix`, `DVector`, `Complex`).
+pub use nalgebra;
+pub use bode::{Bode, Nyquist};
+pub use equilibrium::{Equilibrium, NewtonOptions};
+pub use locus::{Locus, LocusPoint};
+pub use loop_break::{Channel, LoopBreak};
+pub use margins::{GainMargin, Margins, PhaseMargin};
+pub use poles::Pole;
+pub use reduce::{InventoryMode, Reduction};
+pub use response::FrequencyResponse;
+
+/// Why a linear analysis cannot be done.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum LinearError {
+    #[error("equilibrium: Newton did not converge in {iterations} iterations (scaled residual {residual:.3e} 1/s, tolerance {tol:.1e})")]
+    NoConvergence { iterations: usize, residual: f64, tol: f64 },
+    #[error("equilibrium: the Newton system is singular at iteration {iteration}")]
+    Singular { iteration: usize },
+    #[error("non-finite values in the {what}")]
+    NonFinite { what: &'static str },
+    #[error("loop channel `{name}` does not exist for model `{model}`; valid channels: {valid}")]
+    UnknownChannel { name: String, model: String, valid: String },
+    #[error("channel `pressure` needs a single-pressure model; the bodies of `{model}` see different pressures (choose a body channel)")]
+    NotSinglePressure { model: String },
+    #[error("unknown parameter `{name}` for model `{model}`; valid parameters: {valid}")]
+    UnknownParam { name: String, model: String, valid: String },
+    #[error("the parameter range is empty (use at least one step)")]
+    EmptyRange,
+    #[error("{0}")]
+    Param(String),
+    #[error("eigenvalue computation failed: {0}")]
+    Eigen(String),
+}
+
+/// Settings of [`linearize`].
+#[derive(Clone, Debug, PartialEq)]
+pub struct LinearOptions {
+    /// Loop channel by name (`pressure` or a body); `None`: [`loop_break::default_channel`].
+    pub channel: Option<String>,
+    pub newton: NewtonOptions,
+    /// Grid density for crossovers and Bode data (points per decade).
+    pub per_decade: usize,
+}
+
+impl Default for LinearOptions {
+    fn default() -> Self {
+        Self { channel: None, newton: NewtonOptions::default(), per_decade: 100 }
+    }
+}
+
+/// Equilibrium, Jacobian, reduction and poles: steps 1-4 of the pipeline.
+#[derive(Clone, Debug)]
+pub struct DynamicPoles {
+    pub equilibrium: Equilibrium,
+    /// The full Jacobian at the equilibrium.
+    pub jacobian: DMatrix<f64>,
+    pub reduction: Reduction,
+    /// Poles of the reduced Jacobian, sorted.
+    pub poles: Vec<Pole>,
+}
+
+/// Steps 1-4: equilibrium, Jacobian, inventory reduction and poles.
+pub fn dynamic_poles(model: &dyn Model, p: &[f64], newton: &NewtonOptions) -> Result<DynamicPoles, LinearError> {
+    let equilibrium = equilibrium::solve(model, p, newton)?;
+    let n = model.n_states();
+    let jacobian = DMatrix::from_vec(n, n, model.jacobian_dense(p, &equilibrium.x, 0.0));
+    let reduction = reduce::reduce(&jacobian, &equilibrium::mass_states(model));
+    let poles = poles::poles(&reduction.a)?;
+    Ok(DynamicPoles { equilibrium, jacobian, reduction, poles })
+}
+
+/// The loop broken at one channel, reduced on the inventory.
+#[derive(Clone, Debug)]
+pub struct OpenLoop {
+    /// The triple in full state coordinates.
+    pub full: LoopBreak,
+    /// `T' A0 T`, `T' B`, `K T` (the full triple without mass states).
+    pub a: DMatrix<f64>,
+    pub b: DVector<f64>,
+    pub k: DVector<f64>,
+    /// Poles of the open loop (`eig A0`), sorted.
+    pub poles: Vec<Pole>,
+    pub response: FrequencyResponse,
+}
+
+impl OpenLoop {
+    /// `L(jw)`.
+    pub fn at(&self, w: f64) -> nalgebra::Complex<f64> {
+        self.response.at(w)
+    }
+}
+
+/// The complete linear analysis.
+#[derive(Clone, Debug)]
+pub struct Linearization {
+    pub dynamics: DynamicPoles,
+    pub open_loop: OpenLoop,
+    /// The grid the margins were bracketed on.
+    pub grid: Vec<f64>,
+    pub margins: Margins,
+}
+
+/// The whole pipeline.
+pub fn linearize(model: &dyn Model, p: &[f64], opts: &LinearOptions) -> Result<Linearization, LinearError> {
+    let dynamics = dynamic_poles(model, p, &opts.newton)?;
+    let x = &dynamics.equilibrium.x;
+    let channel = match &opts.channel {
+        Some(name) => loop_break::parse_channel(model, p, x, name)?,
+        None => loop_break::default_channel(model, p, x),
+    };
+    let full = loop_break::break_loop(model, p, x, &dynamics.jacobian, channel)?;
+    let red = &dynamics.reduction;
+    let (a, b, k) = (red.reduce(&full.a), red.project(&full.b), red.project(&full.k()));
+    let ol_poles = poles::poles(&a)?;
+    let response = FrequencyResponse::new(&a, &b, &k);
+    let open_loop = OpenLoop { full, a, b, k, poles: ol_poles, response };
+    let all: Vec<Pole> = dynamics.poles.iter().chain(&open_loop.poles).copied().collect();
+    let per_decade = if model.n_states() > 400 { opts.per_decade.min(20) } else { opts.per_decade };
+    let grid = bode::frequency_grid(&all, per_decade);
+    let margins = margins::margins(&|w| open_loop.at(w), &grid);
+    Ok(Linearization { dynamics, open_loop, grid, margins })
+}
+
+impl Linearization {
+    /// Bode data of `L(jw)` on the analysis grid.
+    pub fn bode(&self) -> Bode {
+        bode::bode(&|w| self.open_loop.at(w), &self.grid)
+    }
+
+    /// Nyquist data of `L(jw)` on the analysis grid.
+    pub fn nyquist(&self) -> Nyquist {
+        bode::nyquist(&|w| self.open_loop.at(w), &self.grid)
+    }
+
+    /// The serializable summary.
+    pub fn report(&self, model: &dyn Model) -> LinearReport {
+        let ol = &self.open_loop;
+        LinearReport {
+            model: model.name().to_string(),
+            n: model.n(),
+            closure: model.closure().to_string(),
+            n_states: model.n_states(),
+            state_names: model.state_names(),
+            equilibrium: self.dynamics.equilibrium.clone(),
+            poles: self.dynamics.poles.clone(),
+            rhp_count: self.dynamics.poles.iter().filter(|p| p.rhp).count(),
+            inventory_mode: self.dynamics.reduction.inventory.clone(),
+            loop_break: LoopReport {
+                channel: ol.full.name.clone(),
+                unit: ol.full.unit.to_string(),
+                b: ol.full.b.iter().copied().collect(),
+                k: ol.full.k().iter().copied().collect(),
+                open_loop_poles: ol.poles.clone(),
+                open_loop_rhp_count: ol.poles.iter().filter(|p| p.rhp).count(),
+            },
+            margins: self.margins.clone(),
+        }
+    }
+}
+
+/// The loop as reported: `x' = A0 x + B u`, `u = -K x`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct LoopReport {
+    /// `pressure` or the body name.
+    pub channel: String,
+    /// Unit of `u`.
+    pub unit: String,
+    /// Input column `B` (full state order).
+    pub b: Vec<f64>,
+    /// Feedback gain `K` (full state order).
+    pub k: Vec<f64>,
+    pub open_loop_poles: Vec<Pole>,
+    pub open_loop_rhp_count: usize,
+}
+
+/// What `stirling linearize --json` prints.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct LinearReport {
+    pub model: String,
+    pub n: usize,
+    pub closure: String,
+    pub n_states: usize,
+    pub state_names: Vec<String>,
+    pub equilibrium: Equilibrium,
+    /// Closed-loop (dynamic) poles, sorted by decreasing real part.
+    pub poles: Vec<Pole>,
+    pub rhp_count: usize,
+    pub inventory_mode: Option<InventoryMode>,
+    #[serde(rename = "loop")]
+    pub loop_break: LoopReport,
+    pub margins: Margins,
+}

@@ -1,0 +1,50 @@
+//! Root locus: the poles at every parameter value of a [`Locus`], colored from blue (first
+//! value) to red (last), with the right half plane shaded as in the pole map.
+
+use std::path::Path;
+
+use plotters::prelude::*;
+
+use super::poles::{frame, DrawError};
+use crate::linear::Locus;
+
+/// Draw the root locus to an SVG file.
+pub fn root_locus(path: &Path, locus: &Locus) -> Result<(), DrawError> {
+    let err = DrawError::at(path);
+    let ((x0, x1, y1), out) = frame(locus.points.iter().flat_map(|p| p.poles.iter()));
+    let root = SVGBackend::new(path, (800, 600)).into_drawing_area();
+    root.fill(&WHITE).map_err(|e| err(e.to_string()))?;
+    let (first, last) = (locus.points.first().map_or(0.0, |p| p.value), locus.points.last().map_or(0.0, |p| p.value));
+    let mut title = format!("{}: root locus over {} = {first} .. {last} (blue -> red)", locus.model, locus.param);
+    if out > 0 {
+        title.push_str(&format!(", {out} stiff poles off frame"));
+    }
+    let mut chart = ChartBuilder::on(&root)
+        .caption(title, ("sans-serif", 18))
+        .margin(15)
+        .x_label_area_size(45)
+        .y_label_area_size(60)
+        .build_cartesian_2d(x0..x1, -y1..y1)
+        .map_err(|e| err(e.to_string()))?;
+    chart
+        .configure_mesh()
+        .x_desc("Real axis (1/s)")
+        .y_desc("Imaginary axis (rad/s)")
+        .draw()
+        .map_err(|e| err(e.to_string()))?;
+    let shade = RGBColor(255, 210, 210).filled();
+    chart.draw_series(std::iter::once(Rectangle::new([(0.0, -y1), (x1, y1)], shade))).map_err(|e| err(e.to_string()))?;
+    let axis = BLACK.mix(0.5);
+    chart.draw_series(LineSeries::new([(x0, 0.0), (x1, 0.0)], axis)).map_err(|e| err(e.to_string()))?;
+    chart.draw_series(LineSeries::new([(0.0, -y1), (0.0, y1)], axis)).map_err(|e| err(e.to_string()))?;
+    let k = locus.points.len().max(2) - 1;
+    for (i, pt) in locus.points.iter().enumerate() {
+        let t = i as f64 / k as f64;
+        let color = RGBColor((255.0 * t) as u8, 0, (255.0 * (1.0 - t)) as u8);
+        let visible = pt.poles.iter().filter(|p| p.re >= x0 && p.im.abs() <= y1);
+        chart
+            .draw_series(visible.map(|p| Circle::new((p.re, p.im), 3, color.filled())))
+            .map_err(|e| err(e.to_string()))?;
+    }
+    root.present().map_err(|e| err(e.to_string()))
+}

@@ -1,0 +1,150 @@
+//! Nonlinear simulation: the stiff integrator on the analytic Jacobian, limit
+//! cycles by shooting, Floquet multipliers, and cycle work.
+//!
+//! - [`integrate`]: BDF step loop (diffsol), samples, crossings, nonphysical checks.
+//! - [`system`]: the model, energy-quadrature and variational systems.
+//! - [`cycle`]: periodicity from upward crossings of the piston position; amplitudes, phase.
+//! - [`shooting`]: Newton on the return map, monodromy matrix, Floquet multipliers.
+//! - [`work`]: `closed-integral P dV` per vessel, indicated power.
+//!
+//! [`limit_cycle`] chains them: settle from a perturbed state, shoot, measure.
+
+mod adapter;
+pub mod cycle;
+pub mod integrate;
+pub mod shooting;
+pub mod system;
+pub mod work;
+
+use serde::Serialize;
+use stirling_dsl::Model;
+
+pub use cycle::{figures, periodic, settle, CycleFigures, Settled};
+pub use integrate::{check_physical, integrate, simulate, uniform_samples, Crossing, Hooks, SimOptions, SolverStats, Trajectory};
+pub use shooting::{floquet_multipliers, shoot, LimitCycle, ShootingOptions};
+pub use system::{state_scale, EnergySystem, ModelSystem, OdeSystem, VariationalSystem};
+pub use work::{cycle_work, indicated_power, CycleWork};
+
+/// Why a simulation stopped short.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum SimError {
+    #[error("nonphysical state at t = {t:.6e} s: {quantity} = {value:.6e}")]
+    Nonphysical { t: f64, quantity: String, value: f64 },
+    #[error("step size collapsed below the minimum at t = {t:.6e} s (the solution is singular or leaves the physical range there)")]
+    StepSizeCollapse { t: f64 },
+    #[error("solver failure at t = {t:.6e} s: {why}")]
+    SolverFailure { t: f64, why: String },
+    #[error("step limit of {max_steps} reached at t = {t:.6e} s")]
+    TooManySteps { t: f64, max_steps: usize },
+    #[error("initial state has {found} entries; the model has {expected} states")]
+    DimensionMismatch { expected: usize, found: usize },
+    #[error("no periodic motion by t = {t:.4} s ({crossings} upward piston crossings); run longer or start closer to the cycle")]
+    NotPeriodic { t: f64, crossings: usize },
+    #[error("shooting failed after {iterations} Newton iterations (scaled residual {residual:.3e}): {why}")]
+    ShootingFailed { iterations: usize, residual: f64, why: String },
+    #[error("{0}")]
+    BadOption(String),
+}
+
+/// A limit cycle with its figures.
+#[derive(Clone, Debug, PartialEq)]
+pub struct LimitCycleReport {
+    pub settled: Settled,
+    pub cycle: LimitCycle,
+    pub figures: CycleFigures,
+    pub work: CycleWork,
+    /// Uniform samples over one period of the converged orbit (last = first).
+    pub orbit: Vec<Vec<f64>>,
+    /// Counters of the settling run, the shooting and the orbit run together.
+    pub stats: SolverStats,
+}
+
+/// Settle from `x0` (at most `t_max`), refine by shooting, and measure the cycle.
+pub fn limit_cycle(model: &dyn Model, p: &[f64], x0: &[f64], t_max: f64, samples: &[f64], opts: &SimOptions, progress: Option<&mut dyn FnMut(f64)>) -> Result<LimitCycleReport, SimError> {
+    let settled = settle(model, p, x0, t_max, samples, 3, 1e-3, opts, progress)?;
+    let cycle = shoot(model, p, &settled.x0, settled.period, &ShootingOptions::default())?;
+    let n_orbit = 512;
+    let orbit_t = uniform_samples(cycle.period, n_orbit);
+    let orbit_run = simulate(model, p, &cycle.x0, cycle.period, &orbit_t, &ShootingOptions::default().sim)?;
+    let fig = figures(model, p, cycle.period, &orbit_run.x);
+    let work = cycle_work(model, p, cycle.period, &orbit_run.x);
+    let mut stats = settled.trajectory.stats;
+    stats.add(&cycle.stats);
+    stats.add(&orbit_run.stats);
+    Ok(LimitCycleReport { settled, cycle, figures: fig, work, orbit: orbit_run.x, stats })
+}
+
+/// Machine-readable summary of a run (the `--json` of `stirling simulate`).
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+pub struct SimSummary {
+    pub model: String,
+    pub n: usize,
+    pub closure: String,
+    pub n_states: usize,
+    pub t_end: f64,
+    pub final_state: Vec<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub frequency_hz: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub period_s: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub x_amp: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub y_amp: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub p_amp: Option<Vec<f64>>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub phase_deg: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub work_per_cycle_j: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub work_per_vessel_j: Option<Vec<(String, f64)>>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub power_w: Option<f64>,
+    /// Floquet multipliers `[re, im]`, largest modulus first.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub floquet: Option<Vec<[f64; 2]>>,
+    pub steps: usize,
+    pub rhs_calls: usize,
+    pub jacobian_calls: usize,
+    pub lu_factorizations: usize,
+}
+
+impl SimSummary {
+    /// Summary of a plain run.
+    pub fn from_run(model: &dyn Model, tr: &Trajectory) -> Self {
+        Self {
+            model: model.name().to_string(),
+            n: model.n(),
+            closure: format!("{:?}", model.closure()).to_lowercase(),
+            n_states: model.n_states(),
+            t_end: tr.t_end,
+            final_state: tr.x_end.clone(),
+            steps: tr.stats.steps,
+            rhs_calls: tr.stats.rhs_calls,
+            jacobian_calls: tr.stats.jacobian_calls,
+            lu_factorizations: tr.stats.lu_factorizations,
+            ..Default::default()
+        }
+    }
+
+    /// Add the limit-cycle figures (and its counters).
+    pub fn with_cycle(mut self, lc: &LimitCycleReport) -> Self {
+        let f = &lc.figures;
+        self.frequency_hz = Some(f.frequency_hz);
+        self.period_s = Some(f.period);
+        self.x_amp = Some(f.x_amp);
+        self.y_amp = Some(f.y_amp);
+        self.p_amp = Some(f.p_amp.clone());
+        self.phase_deg = Some(f.phase_deg);
+        self.work_per_cycle_j = Some(lc.work.total);
+        self.work_per_vessel_j = Some(lc.work.vessels.iter().cloned().zip(lc.work.per_vessel.iter().cloned()).collect());
+        self.power_w = Some(indicated_power(lc.work.total, f.frequency_hz));
+        self.floquet = Some(lc.cycle.floquet.iter().map(|&(re, im)| [re, im]).collect());
+        self.steps = lc.stats.steps;
+        self.rhs_calls = lc.stats.rhs_calls;
+        self.jacobian_calls = lc.stats.jacobian_calls;
+        self.lu_factorizations = lc.stats.lu_factorizations;
+        self
+    }
+}
