@@ -14,7 +14,8 @@
 //!     cv hot { volume: Vh0, faces { displacer: -A }, port hot { h: hh, area: Awh, wall: Th } }
 //!     cv regen[n] { volume: Vr / n, port wall { h: hr, area: Awr / n, wall: Th - (j + 0.5) * (Th - Tk) / n } }
 //!     link hot -> regen[0] { resistance: Rf / (2.0 * n) }
-//!     link regen[j] -> regen[j + 1] for j in 0..n - 1 { resistance: Rf / n }
+//!     link regen[j] -> regen[j + 1] for j in 0..n - 1 { resistance: Rf / n, quadratic: Rq / n }
+//!     link cold -> bounce { conductance: Gleak }            // mdot = G dP, exact zero at G = 0
 //! }
 //! ```
 

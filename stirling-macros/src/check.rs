@@ -384,11 +384,21 @@ impl Lower {
         let var = l.range.as_ref().map(|r| r.var.to_string());
         let from = self.end(&l.from, var.as_deref());
         let to = self.end(&l.to, var.as_deref());
-        let f = self.fields(&l.fields, &["resistance", "quadratic"], "`link`");
-        let resistance = self.required(&f, "resistance", l.span, "`link`", var.as_deref());
-        let quadratic = self.optional(&f, "quadratic", var.as_deref());
+        let f = self.fields(&l.fields, &["resistance", "conductance", "quadratic"], "`link`");
+        let conductance = self.optional(&f, "conductance", var.as_deref());
+        let resistance = match conductance {
+            Some(g) => {
+                if f.contains_key("resistance") || f.contains_key("quadratic") {
+                    self.cx.error(l.span, "a `link` takes either `conductance: G` (mdot = G dP) or `resistance: R` with optional `quadratic: Rq`, not both");
+                }
+                let one = self.topo.arena.num(1.0);
+                self.topo.arena.div(one, g)
+            }
+            None => self.required(&f, "resistance", l.span, "`link` (or `conductance: G`)", var.as_deref()),
+        };
+        let quadratic = if conductance.is_some() { None } else { self.optional(&f, "quadratic", var.as_deref()) };
         let (Some(from), Some(to)) = (from, to) else { return };
-        let link = LinkDecl { from, to, resistance, quadratic };
+        let link = LinkDecl { from, to, resistance, quadratic, conductance };
         if self.link_shape_ok(l, &link) {
             self.topo.links.push(link);
         }

@@ -114,9 +114,3 @@ fn equations_two_cv_full() {
 fn equations_two_cv_frozen() {
     insta::assert_snapshot!(equations(TWO_CV, "model twocv, closure frozen"));
 }
-
-#[test]
-fn tmp_dump() {
-    let src = std::fs::read_to_string("/tmp/model.txt").unwrap();
-    std::fs::write("/tmp/expanded.rs", expanded(&src)).unwrap();
-}

@@ -77,7 +77,7 @@ pub fn validate(model: &dyn Model, p: &[f64]) -> Result<(), ParamError> {
         if !v.is_finite() {
             return bad("must be finite");
         }
-        let must_be_positive = matches!(info.unit, "kg" | "m^2" | "m^3" | "K" | "Pa" | "J/(kg K)" | "kg/s" | "Pa s/kg");
+        let must_be_positive = matches!(info.unit, "kg" | "m^2" | "m^3" | "K" | "Pa" | "J/(kg K)" | "kg/s" | "Pa s/kg" | "W/(m^2 K)");
         if must_be_positive && v <= 0.0 {
             return bad(&format!("must be positive (unit {})", info.unit));
         }

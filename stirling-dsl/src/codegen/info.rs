@@ -38,8 +38,8 @@ pub fn states(lay: &Layout, krate: &TokenStream) -> TokenStream {
         let (kind, unit, what, elem) = match b.kind {
             BlockKind::Position(k) => (quote!(Position), "m", format!("position of the {}", topo.bodies[k].name), Some(k)),
             BlockKind::Velocity(k) => (quote!(Velocity), "m/s", format!("velocity of the {}", topo.bodies[k].name), Some(k)),
-            BlockKind::Pressure(i) => (quote!(Pressure), "Pa", format!("gas pressure in {}", topo.cvs[i].name), None),
-            BlockKind::Mass(i) => (quote!(Mass), "kg", format!("gas mass in {}", topo.cvs[i].name), None),
+            BlockKind::Pressure(i) => (quote!(Pressure), "Pa", format!("gas pressure in CV {}", topo.cvs[i].name), None),
+            BlockKind::Mass(i) => (quote!(Mass), "kg", format!("gas mass in CV {}", topo.cvs[i].name), None),
         };
         let cv = match b.kind {
             BlockKind::Pressure(i) | BlockKind::Mass(i) => i,
@@ -52,7 +52,7 @@ pub fn states(lay: &Layout, krate: &TokenStream) -> TokenStream {
         };
         let name = &b.name;
         let (name_expr, meaning_expr, range) = if b.array {
-            (quote!(format!("{}[{}]", #name, j)), quote!(format!("{} section {}", #what, j + 1)), quote!(0..n))
+            (quote!(format!("{}[{}]", #name, j)), quote!(format!("{}[{}]", #what, j)), quote!(0..n))
         } else {
             (quote!(#name.to_string()), quote!(#what.to_string()), quote!(0..1usize))
         };

@@ -140,7 +140,7 @@ fn params_struct(topo: &Topology, spec: &ModelSpec) -> TokenStream {
         }
 
         impl #ps {
-            /// The values in [`Model::params`](#krate::Model::params) order.
+            /// The values in `Model::params` order.
             pub fn to_vec(&self) -> Vec<f64> {
                 vec![#( self.#fields ),*]
             }

@@ -12,3 +12,6 @@ mod subst;
 pub use arena::Arena;
 pub use node::{sign, At, Func, Id, Node, Sym};
 pub use print::{Printer, Style};
+
+#[cfg(test)]
+mod tests;

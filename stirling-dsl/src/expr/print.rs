@@ -84,7 +84,7 @@ impl<'a> Printer<'a> {
             Node::Sub(x, y) => (format!("{} - {}", self.wrap(x, P_ADD), self.wrap(y, P_MUL)), P_ADD),
             Node::Mul(x, y) => (self.product(x, y), P_MUL),
             Node::Div(x, y) => (self.quotient(x, y), self.div_prec()),
-            Node::Neg(x) => (format!("-{}", self.wrap(x, P_NEG)), P_NEG),
+            Node::Neg(x) => (format!("-{}", self.wrap(x, P_MUL)), P_NEG),
             Node::Powi(x, k) => (self.power(x, &k.to_string()), P_POW),
             Node::Powf(x, y) => (self.power(x, &self.go(y).0), P_POW),
             Node::Func(f, x) => (self.call(f, x), P_ATOM),
@@ -104,6 +104,9 @@ impl<'a> Printer<'a> {
     }
 
     fn number(&self, v: f64) -> (String, u8) {
+        if v == std::f64::consts::PI {
+            return (if self.style == Style::Latex { "\\pi".into() } else { "pi".into() }, P_ATOM);
+        }
         let s = format_number(v);
         let p = if v < 0.0 { P_NEG } else { P_ATOM };
         match self.style {

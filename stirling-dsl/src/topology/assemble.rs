@@ -302,15 +302,16 @@ impl<'t> Assembler<'t> {
         let tpl = self.cv[i];
         let gas = self.t.gas.clone().expect("checked");
         let a = &mut self.t.arena;
+        let signed = |a: &mut crate::expr::Arena, start: Id, pick: &dyn Fn(&Flow) -> Id| {
+            flows.iter().fold(start, |acc, f| if f.into { a.add(acc, pick(f)) } else { a.sub(acc, pick(f)) })
+        };
         if !want_p {
-            let terms: Vec<Id> = flows.iter().map(|f| if f.into { f.mdot } else { a.neg(f.mdot) }).collect();
-            return a.sum(terms);
+            let zero = a.num(0.0);
+            return signed(a, zero, &|f| f.mdot);
         }
-        let terms: Vec<Id> = flows.iter().map(|f| if f.into { f.h } else { a.neg(f.h) }).collect();
-        let hnet = a.sum(terms);
         let one = a.num(1.0);
         let gm1 = a.sub(gas.gamma, one);
-        let qh = a.add(tpl.q, hnet);
+        let qh = signed(a, tpl.q, &|f| f.h);
         let e = a.mul(gm1, qh);
         let gp = a.mul(gas.gamma, tpl.p);
         let w = a.mul(gp, tpl.vdot);
@@ -342,13 +343,15 @@ impl<'t> Assembler<'t> {
         let shift = if l.is_chain() { Place::Shift(-base) } else { Place::Own };
         let r = self.placed(l.resistance, shift);
         let rq = l.quadratic.map(|q| self.placed(q, shift));
+        let g = l.conductance.map(|g| self.placed(g, shift));
         let name = if l.is_chain() { chain_name(&from_name, base) } else { format!("{from_name}_{to_name}") };
         let gas = self.t.gas.clone().expect("checked");
         let a = &mut self.t.arena;
         let dp = a.sub(p_from, p_to);
-        let mdot_raw = match rq {
-            None => a.div(dp, r),
-            Some(rq) => quadratic_flow(a, dp, r, rq),
+        let mdot_raw = match (g, rq) {
+            (Some(g), _) => a.mul(g, dp),
+            (None, None) => a.div(dp, r),
+            (None, Some(rq)) => quadratic_flow(a, dp, r, rq),
         };
         let mdot = a.named(&format!("mdot_{name}"), mdot_raw);
         let h_raw = enthalpy(a, mdot, t_from, t_to, &gas);
@@ -367,7 +370,8 @@ impl<'t> Assembler<'t> {
                 let pl = end_place(c, at, row, base);
                 let tpl = self.cv[c];
                 let (p, t) = (self.placed(tpl.p, pl), self.placed(tpl.t, pl));
-                (p, t, end_name(&self.t.cvs[c].name, self.t.cvs[c].array, at))
+                let at_shown = if pl == Place::Own && self.t.cvs[c].array { At::Rel(0) } else { at };
+                (p, t, end_name(&self.t.cvs[c].name, self.t.cvs[c].array, at_shown))
             }
         }
     }
@@ -536,7 +540,8 @@ fn end_name(name: &str, array: bool, at: At) -> String {
     match at {
         At::First => format!("{name}[0]"),
         At::Last => format!("{name}[n-1]"),
-        _ => name.to_string(),
+        At::Rel(r) => format!("{name}[{}]", super::frame::index_text(r)),
+        At::Scalar => name.to_string(),
     }
 }
 

@@ -105,7 +105,7 @@ pub struct End {
     pub at: At,
 }
 
-/// A mass-flow link `from -> to`: `dP = R mdot + Rq mdot |mdot|`, carrying upwind enthalpy.
+/// A mass-flow link `from -> to`: `dP = R mdot + Rq mdot |mdot|` (or `mdot = G dP`), carrying upwind enthalpy.
 /// A chain link (`from`/`to` at `Rel` offsets) repeats for `j in 0..n-1`.
 #[derive(Clone, Debug)]
 pub struct LinkDecl {
@@ -114,6 +114,10 @@ pub struct LinkDecl {
     pub resistance: Id,
     /// Quadratic (turbulent) coefficient `Rq`, if declared.
     pub quadratic: Option<Id>,
+    /// Conductance `G`, if the link was declared with `conductance:` instead of
+    /// `resistance:`: the flow law is then `mdot = G dP` (exactly zero at `G = 0`, e.g. a
+    /// seal leak at its null value) and `resistance` holds `1/G` for display only.
+    pub conductance: Option<Id>,
 }
 
 impl LinkDecl {

@@ -8,7 +8,8 @@ engine_model! {
         name "cv1";
         cv gas {
             volume: Vh0 + Vc0 + Vr,
-            faces { displacer: -A + (A - Ar), piston: -(A - Ar) },
+            // hot face -A plus cold face (A - Ar) on the displacer
+            faces { displacer: -Ar, piston: -(A - Ar) },
             port hot { h: hh, area: Awh0 - pi * D * x, wall: Th },
             port cold { h: hk, area: Awc0 + pi * D * (x - y), wall: Tk },
             port regen { h: hr, area: Awr, wall: (Th + Tk) / 2.0 },

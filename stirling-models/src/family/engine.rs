@@ -3,10 +3,20 @@
 //! Each member adds its gas spaces and links.
 
 /// Wrap a family member's gas declaration into the common engine frame.
+///
+/// The second form (used by `crate::effects`) adds fields to the frame's declarations:
+/// `model Name with { displacer { , force: .. } piston { , force: .. } bounce { , temperature: .. } } { .. }`
+/// (each bracket's tokens are appended verbatim to that item's field list).
 macro_rules! engine_model {
+    ($(#[$meta:meta])* model $name:ident with { displacer { $($fd:tt)* } piston { $($fp:tt)* } bounce { $($fb:tt)* } } { $($body:tt)* }) => {
+        engine_model! { @frame [$(#[$meta])*] $name [$($fd)*] [$($fp)*] [$($fb)*] $($body)* }
+    };
     ($(#[$meta:meta])* model $name:ident { $($body:tt)* }) => {
+        engine_model! { @frame [$(#[$meta])*] $name [] [] [] $($body)* }
+    };
+    (@frame [$($meta:tt)*] $name:ident [$($fd:tt)*] [$($fp:tt)*] [$($fb:tt)*] $($body:tt)*) => {
         ::stirling_macros::stirling_model! {
-            $(#[$meta])*
+            $($meta)*
             pub model $name {
                 params {
                     /// specific gas constant
@@ -69,10 +79,10 @@ macro_rules! engine_model {
                 // cylinder diameter
                 let D = sqrt(4.0 * A / pi);
                 gas { R: R, gamma: gamma, charge: Pmean, mdot_eps: mdot_eps }
-                body displacer(x, v) { mass: md, spring: kd, damper: bd, quad_damper: bqd }
-                body piston(y, w) { mass: mp, spring: kp, damper: bp, quad_damper: bqp }
+                body displacer(x, v) { mass: md, spring: kd, damper: bd, quad_damper: bqd $($fd)* }
+                body piston(y, w) { mass: mp, spring: kp, damper: bp, quad_damper: bqp $($fp)* }
                 coupling displacer, piston { damper: b }
-                space bounce { pressure: Pb, faces { displacer: Ar, piston: A - Ar } }
+                space bounce { pressure: Pb, faces { displacer: Ar, piston: A - Ar } $($fb)* }
                 $($body)*
             }
         }

@@ -2,7 +2,7 @@
 
 mod cv1;
 mod cv2;
-mod engine;
+pub(crate) mod engine;
 mod nsection;
 mod schmidt;
 

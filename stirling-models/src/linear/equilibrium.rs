@@ -122,8 +122,7 @@ fn newton_step(model: &dyn Model, p: &[f64], x: &[f64], f: &[f64], masses: &[usi
         }
         rhs[last] = charge - masses.iter().map(|&i| x[i]).sum::<f64>();
     }
-    let dx = j.lu().solve(&rhs)?;
-    dx.iter().all(|v| v.is_finite()).then_some(dx)
+    super::solve::solve(&j, &rhs)
 }
 
 type Trial = (Vec<f64>, Vec<f64>, f64);

@@ -21,6 +21,7 @@ pub mod margins;
 pub mod poles;
 pub mod reduce;
 pub mod response;
+pub mod solve;
 
 use nalgebra::{DMatrix, DVector};
 use serde::{Deserialize, Serialize};

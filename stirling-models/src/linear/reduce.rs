@@ -133,7 +133,7 @@ fn inventory_mode(j: &DMatrix<f64>, mass: &[usize], basis: &KernelBasis, a: &DMa
     // the null vector is z = [-A^-1 g; 1], r = H z scaled so that c r = 1.
     let hjh_col = basis.reflect(&(j * basis.reflect(&unit(n, basis.drop))));
     let g = hjh_col.remove_row(basis.drop);
-    let direction = a.clone().lu().solve(&(-g)).map(|zr| {
+    let direction = super::solve::solve(a, &(-g)).map(|zr| {
         let r = basis.expand(&zr) + basis.reflect(&unit(n, basis.drop));
         let cr = c.dot(&r);
         (r / cr).iter().copied().collect()

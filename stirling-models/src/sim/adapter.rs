@@ -1,43 +1,132 @@
 //! The diffsol adapter: an [`OdeSystem`] as diffsol `OdeEquations`, handing the
 //! solver the full analytic Jacobian (no colouring, no Jacobian-vector probing).
+//!
+//! Two linear-algebra backends share one adapter ([`Backend`]):
+//! - dense: `NalgebraMat` + `NalgebraLU`, the Jacobian written column-major;
+//! - sparse: `FaerSparseMat` + `FaerSparseLU`, the pattern from
+//!   [`OdeSystem::sparsity`] (united with the entries present at the initial
+//!   state), the values scattered from [`OdeSystem::jac_triplets`] (entries at one
+//!   position accumulate).
 
-use std::cell::Cell;
+use std::cell::{Cell, RefCell};
 
 use diffsol::{
-    op::OpStatistics, ConstantOp, Matrix, NalgebraContext, NalgebraMat, NalgebraVec, NonLinearOp, NonLinearOpJacobian,
-    OdeEquations, OdeEquationsRef, Op, UnitCallable, Vector, VectorCommon,
+    op::OpStatistics, ConstantOp, FaerContext, FaerSparseMat, FaerVec, Matrix, MatrixSparsity, NalgebraContext, NalgebraMat, NalgebraVec, NonLinearOp,
+    NonLinearOpJacobian, OdeEquations, OdeEquationsRef, Op, UnitCallable, Vector,
 };
+use faer::sparse::SymbolicSparseColMat;
 
 use super::system::OdeSystem;
 
-pub(crate) type M = NalgebraMat<f64>;
-pub(crate) type V = NalgebraVec<f64>;
-
-/// A system with its initial state and call counters.
-pub(crate) struct Eqn<'s> {
-    pub sys: &'s dyn OdeSystem,
-    pub y0: Vec<f64>,
-    pub ctx: NalgebraContext,
-    pub n_rhs: Cell<usize>,
-    pub n_jac: Cell<usize>,
+/// A diffsol matrix type the adapter can fill.
+pub(crate) trait Backend: Matrix<T = f64> + 'static {
+    fn new_ctx() -> Self::C;
+    fn slice(v: &Self::V) -> &[f64];
+    fn slice_mut(v: &mut Self::V) -> &mut [f64];
+    /// The Jacobian pattern for this backend (`None` for dense storage).
+    fn pattern(sys: &dyn OdeSystem, x0: &[f64]) -> Option<Self::Sparsity>;
+    /// Overwrite `m` with `df/dx` at `(t, x)`.
+    fn fill(eqn: &Eqn<'_, Self>, t: f64, x: &[f64], m: &mut Self);
 }
 
-impl<'s> Eqn<'s> {
-    pub fn new(sys: &'s dyn OdeSystem, y0: Vec<f64>) -> Self {
-        Self { sys, y0, ctx: NalgebraContext::default(), n_rhs: Cell::new(0), n_jac: Cell::new(0) }
+pub(crate) type DenseM = NalgebraMat<f64>;
+pub(crate) type SparseM = FaerSparseMat<f64>;
+
+impl Backend for DenseM {
+    fn new_ctx() -> NalgebraContext {
+        NalgebraContext::default()
+    }
+    fn slice(v: &NalgebraVec<f64>) -> &[f64] {
+        v.inner().as_slice()
+    }
+    fn slice_mut(v: &mut NalgebraVec<f64>) -> &mut [f64] {
+        v.inner_mut().as_mut_slice()
+    }
+    fn pattern(_: &dyn OdeSystem, _: &[f64]) -> Option<Self::Sparsity> {
+        None
+    }
+    fn fill(eqn: &Eqn<'_, Self>, t: f64, x: &[f64], m: &mut Self) {
+        let data = m.inner_mut().as_mut_slice();
+        data.fill(0.0);
+        eqn.sys.jac(t, x, data);
     }
 }
 
-pub(crate) struct Rhs<'a, 's>(&'a Eqn<'s>);
-pub(crate) struct Init<'a, 's>(&'a Eqn<'s>);
+impl Backend for SparseM {
+    fn new_ctx() -> FaerContext {
+        FaerContext::default()
+    }
+    fn slice(v: &FaerVec<f64>) -> &[f64] {
+        v.inner().col_as_slice(0)
+    }
+    fn slice_mut(v: &mut FaerVec<f64>) -> &mut [f64] {
+        v.inner_mut().col_as_slice_mut(0)
+    }
+    fn pattern(sys: &dyn OdeSystem, x0: &[f64]) -> Option<Self::Sparsity> {
+        let n = sys.dim();
+        let mut rc = sys.sparsity().unwrap_or_else(|| (0..n).flat_map(|c| (0..n).map(move |r| (r, c))).collect());
+        let mut trip = Vec::new();
+        sys.jac_triplets(0.0, x0, &mut trip);
+        rc.extend(trip.iter().map(|&(r, c, _)| (r, c)));
+        rc.extend((0..n).map(|i| (i, i)));
+        rc.sort_unstable();
+        rc.dedup();
+        Some(<SymbolicSparseColMat<usize> as MatrixSparsity<SparseM>>::try_from_indices(n, n, rc).expect("a valid Jacobian pattern"))
+    }
+    fn fill(eqn: &Eqn<'_, Self>, t: f64, x: &[f64], m: &mut Self) {
+        let mut trip = eqn.trip.borrow_mut();
+        trip.clear();
+        eqn.sys.jac_triplets(t, x, &mut trip);
+        let (sym, vals) = m.inner_mut()[0].parts_mut();
+        vals.fill(0.0);
+        scatter(sym.col_ptr(), sym.row_idx(), vals, &trip);
+    }
+}
+
+/// Add triplets into CSC values (sorted rows per column). Panics on an entry
+/// outside the pattern: the structural pattern must cover every Jacobian entry.
+pub(crate) fn scatter(col_ptr: &[usize], row_idx: &[usize], vals: &mut [f64], trip: &[(usize, usize, f64)]) {
+    for &(r, c, v) in trip {
+        let (a, b) = (col_ptr[c], col_ptr[c + 1]);
+        match row_idx[a..b].binary_search(&r) {
+            Ok(k) => vals[a + k] += v,
+            Err(_) => {
+                if v != 0.0 {
+                    panic!("Jacobian entry ({r}, {c}) lies outside the structural sparsity pattern")
+                }
+            }
+        }
+    }
+}
+
+/// A system with its initial state and call counters.
+pub(crate) struct Eqn<'s, M: Backend> {
+    pub sys: &'s dyn OdeSystem,
+    pub y0: Vec<f64>,
+    pub ctx: M::C,
+    pub sparsity: Option<M::Sparsity>,
+    pub n_rhs: Cell<usize>,
+    pub n_jac: Cell<usize>,
+    trip: RefCell<Vec<(usize, usize, f64)>>,
+}
+
+impl<'s, M: Backend> Eqn<'s, M> {
+    pub fn new(sys: &'s dyn OdeSystem, y0: Vec<f64>) -> Self {
+        let sparsity = M::pattern(sys, &y0);
+        Self { sys, y0, ctx: M::new_ctx(), sparsity, n_rhs: Cell::new(0), n_jac: Cell::new(0), trip: RefCell::new(Vec::new()) }
+    }
+}
+
+pub(crate) struct Rhs<'a, 's, M: Backend>(&'a Eqn<'s, M>);
+pub(crate) struct Init<'a, 's, M: Backend>(&'a Eqn<'s, M>);
 
 macro_rules! impl_op {
     ($t:ident) => {
-        impl Op for $t<'_, '_> {
+        impl<M: Backend> Op for $t<'_, '_, M> {
             type T = f64;
-            type V = V;
+            type V = M::V;
             type M = M;
-            type C = NalgebraContext;
+            type C = M::C;
             fn context(&self) -> &Self::C {
                 &self.0.ctx
             }
@@ -62,42 +151,44 @@ macro_rules! impl_op {
 impl_op!(Rhs);
 impl_op!(Init);
 
-impl NonLinearOp for Rhs<'_, '_> {
-    fn call_inplace(&self, x: &V, t: f64, y: &mut V) {
+impl<M: Backend> NonLinearOp for Rhs<'_, '_, M> {
+    fn call_inplace(&self, x: &M::V, t: f64, y: &mut M::V) {
         self.0.n_rhs.set(self.0.n_rhs.get() + 1);
-        self.0.sys.rhs(t, x.inner().as_slice(), y.inner_mut().as_mut_slice());
+        self.0.sys.rhs(t, M::slice(x), M::slice_mut(y));
     }
 }
 
-impl NonLinearOpJacobian for Rhs<'_, '_> {
-    fn jac_mul_inplace(&self, x: &V, t: f64, v: &V, y: &mut V) {
-        let n = self.0.y0.len();
-        let mut j = vec![0.0; n * n];
-        self.0.sys.jac(t, x.inner().as_slice(), &mut j);
-        let (v, y) = (v.inner().as_slice(), y.inner_mut().as_mut_slice());
-        for (i, yi) in y.iter_mut().enumerate() {
-            *yi = (0..n).map(|k| j[i + n * k] * v[k]).sum();
+impl<M: Backend> NonLinearOpJacobian for Rhs<'_, '_, M> {
+    fn jac_mul_inplace(&self, x: &M::V, t: f64, v: &M::V, y: &mut M::V) {
+        let mut trip = self.0.trip.borrow_mut();
+        trip.clear();
+        self.0.sys.jac_triplets(t, M::slice(x), &mut trip);
+        let (v, y) = (M::slice(v), M::slice_mut(y));
+        y.fill(0.0);
+        for &(r, c, a) in trip.iter() {
+            y[r] += a * v[c];
         }
     }
-    fn jacobian_inplace(&self, x: &V, t: f64, y: &mut M) {
+    fn jacobian_inplace(&self, x: &M::V, t: f64, y: &mut M) {
         self.0.n_jac.set(self.0.n_jac.get() + 1);
-        let data = y.inner_mut().as_mut_slice();
-        data.fill(0.0);
-        self.0.sys.jac(t, x.inner().as_slice(), data);
+        M::fill(self.0, t, M::slice(x), y);
+    }
+    fn jacobian_sparsity(&self) -> Option<M::Sparsity> {
+        self.0.sparsity.clone()
     }
 }
 
-impl ConstantOp for Init<'_, '_> {
-    fn call_inplace(&self, _t: f64, y: &mut V) {
-        y.inner_mut().as_mut_slice().copy_from_slice(&self.0.y0);
+impl<M: Backend> ConstantOp for Init<'_, '_, M> {
+    fn call_inplace(&self, _t: f64, y: &mut M::V) {
+        M::slice_mut(y).copy_from_slice(&self.0.y0);
     }
 }
 
-impl Op for Eqn<'_> {
+impl<M: Backend> Op for Eqn<'_, M> {
     type T = f64;
-    type V = V;
+    type V = M::V;
     type M = M;
-    type C = NalgebraContext;
+    type C = M::C;
     fn context(&self) -> &Self::C {
         &self.ctx
     }
@@ -112,17 +203,17 @@ impl Op for Eqn<'_> {
     }
 }
 
-impl<'a, 's> OdeEquationsRef<'a> for Eqn<'s> {
-    type Rhs = Rhs<'a, 's>;
-    type Init = Init<'a, 's>;
+impl<'a, 's, M: Backend> OdeEquationsRef<'a> for Eqn<'s, M> {
+    type Rhs = Rhs<'a, 's, M>;
+    type Init = Init<'a, 's, M>;
     type Root = UnitCallable<M>;
     type Mass = UnitCallable<M>;
     type Out = UnitCallable<M>;
     type Reset = UnitCallable<M>;
 }
 
-impl<'s> OdeEquations for Eqn<'s> {
-    fn rhs<'a>(&'a self) -> Rhs<'a, 's> {
+impl<'s, M: Backend> OdeEquations for Eqn<'s, M> {
+    fn rhs<'a>(&'a self) -> Rhs<'a, 's, M> {
         Rhs(self)
     }
     fn mass(&self) -> Option<UnitCallable<M>> {
@@ -131,9 +222,9 @@ impl<'s> OdeEquations for Eqn<'s> {
     fn root(&self) -> Option<UnitCallable<M>> {
         None
     }
-    fn init<'a>(&'a self) -> Init<'a, 's> {
+    fn init<'a>(&'a self) -> Init<'a, 's, M> {
         Init(self)
     }
-    fn set_params(&mut self, _p: &V) {}
-    fn get_params(&self, _p: &mut V) {}
+    fn set_params(&mut self, _p: &M::V) {}
+    fn get_params(&self, _p: &mut M::V) {}
 }

@@ -6,15 +6,16 @@
 //! Governing equation: `x' = f(t, x)` with error control
 //! `|err_i| <= rtol |x_i| + atol scale_i` (`scale_i` from [`OdeSystem::scale`]).
 //!
-//! Limit: the linear algebra is dense (`O(n^3)` per LU). It is fast up to a few
-//! hundred states; `nsection` at n = 1000 (2008 states) costs about a second per
-//! factorization (the sparse faer route is not wired in yet).
+//! Linear algebra ([`LinearSolverKind`]): dense nalgebra LU (`O(n^3)` per
+//! factorization) for small systems, faer sparse LU on the structural pattern of
+//! [`OdeSystem::sparsity`] for systems of more than [`SPARSE_THRESHOLD`] states
+//! (by default; `nsection` at n = 1000, 2008 states, needs it).
 
-use diffsol::{error::OdeSolverError, DiffsolError, NalgebraLU, OdeBuilder, OdeSolverMethod, OdeSolverStopReason, Vector};
+use diffsol::{error::OdeSolverError, DiffsolError, FaerSparseLU, NalgebraLU, OdeBuilder, OdeSolverMethod, OdeSolverStopReason, Vector};
 use serde::Serialize;
 use stirling_dsl::{Model, StateKind};
 
-use super::adapter::{Eqn, M, V};
+use super::adapter::{Backend, DenseM, Eqn, SparseM};
 use super::system::{ModelSystem, OdeSystem};
 use super::SimError;
 
@@ -29,11 +30,40 @@ pub struct SimOptions {
     pub min_step: f64,
     /// Largest number of steps.
     pub max_steps: usize,
+    /// Dense or sparse linear algebra (default: chosen by size).
+    pub linear_solver: LinearSolverKind,
 }
 
 impl Default for SimOptions {
     fn default() -> Self {
-        Self { rtol: 1e-7, atol: 1e-7, min_step: 1e-13, max_steps: 5_000_000 }
+        Self { rtol: 1e-7, atol: 1e-7, min_step: 1e-13, max_steps: 5_000_000, linear_solver: LinearSolverKind::Auto }
+    }
+}
+
+/// Above this many states (and when the system knows its Jacobian pattern),
+/// [`LinearSolverKind::Auto`] picks the sparse LU.
+pub const SPARSE_THRESHOLD: usize = 60;
+
+/// The linear algebra of the implicit solver.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum LinearSolverKind {
+    /// Sparse when the system has a pattern and more than [`SPARSE_THRESHOLD`] states.
+    #[default]
+    Auto,
+    /// Dense nalgebra LU.
+    Dense,
+    /// faer sparse LU (falls back to a full pattern if the system has none).
+    Sparse,
+}
+
+impl LinearSolverKind {
+    /// Whether a system of `dim` states (with a known pattern or not) goes sparse.
+    pub fn use_sparse(self, dim: usize, has_pattern: bool) -> bool {
+        match self {
+            LinearSolverKind::Auto => has_pattern && dim > SPARSE_THRESHOLD,
+            LinearSolverKind::Dense => false,
+            LinearSolverKind::Sparse => true,
+        }
     }
 }
 
@@ -93,6 +123,10 @@ pub struct Hooks<'h> {
     pub check: Option<&'h dyn Fn(f64, &[f64]) -> Result<(), SimError>>,
     /// Called after every accepted step with the current time.
     pub progress: Option<&'h mut dyn FnMut(f64)>,
+    /// Called after every accepted step with `(t_prev, t, dense)`: `dense(s, out)`
+    /// writes the state at any `s` in `[t_prev, t]` (the solver's dense output).
+    #[allow(clippy::type_complexity)]
+    pub on_step: Option<&'h mut dyn FnMut(f64, f64, &dyn Fn(f64, &mut [f64])) -> Result<(), SimError>>,
 }
 
 /// Uniform sample times `0, dt, .., t_end` (`count + 1` points).
@@ -107,8 +141,28 @@ pub fn simulate(model: &dyn Model, p: &[f64], x0: &[f64], t_end: f64, samples: &
     integrate(&ModelSystem { model, p }, x0, t_end, samples, opts, hooks)
 }
 
+/// Build the BDF solver on one backend and run the step loop.
+macro_rules! run {
+    ($m:ty, $ls:ty, $sys:expr, $x0:expr, $t_end:expr, $samples:expr, $opts:expr, $atol:expr, $hooks:expr) => {{
+        let eqn = Eqn::<$m>::new($sys, $x0.to_vec());
+        let mut problem = OdeBuilder::<$m>::new()
+            .rtol($opts.rtol)
+            .atol($atol)
+            .build_from_eqn(eqn)
+            .map_err(|e| SimError::SolverFailure { t: 0.0, why: e.to_string() })?;
+        problem.ode_options.min_timestep = $opts.min_step;
+        // diffsol counts Newton failures over the whole run, not per step: with the sharp
+        // upwind switch of the enthalpy flows they add up on long runs. Step-size collapse
+        // (min_step) is the real stop.
+        problem.ode_options.max_nonlinear_solver_failures = $opts.max_steps;
+        let mut solver = problem.bdf::<$ls>().map_err(|e| map_err(e, 0.0))?;
+        solver.set_stop_time($t_end).map_err(|e| map_err(e, 0.0))?;
+        step_loop::<$m, _>(&mut solver, $x0, $t_end, $samples, $opts, $hooks)
+    }};
+}
+
 /// Integrate any system from `x0` at `t = 0` to `t_end`.
-pub fn integrate(sys: &dyn OdeSystem, x0: &[f64], t_end: f64, samples: &[f64], opts: &SimOptions, mut hooks: Hooks) -> Result<Trajectory, SimError> {
+pub fn integrate(sys: &dyn OdeSystem, x0: &[f64], t_end: f64, samples: &[f64], opts: &SimOptions, hooks: Hooks) -> Result<Trajectory, SimError> {
     if x0.len() != sys.dim() {
         return Err(SimError::DimensionMismatch { expected: sys.dim(), found: x0.len() });
     }
@@ -119,19 +173,15 @@ pub fn integrate(sys: &dyn OdeSystem, x0: &[f64], t_end: f64, samples: &[f64], o
         check(0.0, x0)?;
     }
     let atol: Vec<f64> = sys.scale().iter().map(|s| opts.atol * s).collect();
-    let eqn = Eqn::new(sys, x0.to_vec());
-    let mut problem = OdeBuilder::<M>::new()
-        .rtol(opts.rtol)
-        .atol(atol)
-        .build_from_eqn(eqn)
-        .map_err(|e| SimError::SolverFailure { t: 0.0, why: e.to_string() })?;
-    problem.ode_options.min_timestep = opts.min_step;
-    // diffsol counts Newton failures over the whole run, not per step: with the sharp
-    // upwind switch of the enthalpy flows they add up on long runs. Step-size collapse
-    // (min_step) is the real stop.
-    problem.ode_options.max_nonlinear_solver_failures = opts.max_steps;
-    let mut solver = problem.bdf::<NalgebraLU<f64>>().map_err(|e| map_err(e, 0.0))?;
-    solver.set_stop_time(t_end).map_err(|e| map_err(e, 0.0))?;
+    if opts.linear_solver.use_sparse(sys.dim(), sys.sparsity().is_some()) {
+        run!(SparseM, FaerSparseLU<f64>, sys, x0, t_end, samples, opts, atol, hooks)
+    } else {
+        run!(DenseM, NalgebraLU<f64>, sys, x0, t_end, samples, opts, atol, hooks)
+    }
+}
+
+
+fn step_loop<'a, 's: 'a, M: Backend, S: OdeSolverMethod<'a, Eqn<'s, M>>>(solver: &mut S, x0: &[f64], t_end: f64, samples: &[f64], opts: &SimOptions, mut hooks: Hooks) -> Result<Trajectory, SimError> {
     let mut out = Trajectory::default();
     let mut next = 0;
     while next < samples.len() && samples[next] <= 0.0 {
@@ -141,30 +191,37 @@ pub fn integrate(sys: &dyn OdeSystem, x0: &[f64], t_end: f64, samples: &[f64], o
     }
     let (mut t_prev, mut x_prev) = (0.0, x0.to_vec());
     let mut stopped = false;
+    let interp = |y: Result<M::V, DiffsolError>, t: f64| -> Result<Vec<f64>, SimError> { y.map(|v| M::slice(&v).to_vec()).map_err(|e| map_err(e, t)) };
     for _ in 0..opts.max_steps {
         let reason = solver.step().map_err(|e| map_err(e, solver.state().t))?;
         let t = solver.state().t;
-        let x = solver.state().y.clone_as_vec();
+        let x = M::slice(solver.state().y).to_vec();
         if let Some(check) = hooks.check {
             check(t, &x)?;
         }
         while next < samples.len() && samples[next] <= t {
-            let y: V = solver.interpolate(samples[next]).map_err(|e| map_err(e, t))?;
             out.t.push(samples[next]);
-            out.x.push(y.clone_as_vec());
+            out.x.push(interp(solver.interpolate(samples[next]), t)?);
             next += 1;
         }
         if let Some(k) = hooks.crossing {
             if x_prev[k] < 0.0 && x[k] >= 0.0 {
-                let tc = refine_crossing(&solver, k, (t_prev, x_prev[k]), (t, x[k]));
-                let xc: V = solver.interpolate(tc).map_err(|e| map_err(e, t))?;
-                out.crossings.push(Crossing { t: tc, x: xc.clone_as_vec() });
+                let tc = refine_crossing::<M, S>(solver, k, (t_prev, x_prev[k]), (t, x[k]));
+                out.crossings.push(Crossing { t: tc, x: interp(solver.interpolate(tc), t)? });
                 if let Some(f) = hooks.on_crossing.as_mut() {
                     if f(&out.crossings) {
                         stopped = true;
                     }
                 }
             }
+        }
+        if let Some(f) = hooks.on_step.as_mut() {
+            let s: &S = solver;
+            let dense = |tau: f64, y: &mut [f64]| match s.interpolate(tau) {
+                Ok(v) => y.copy_from_slice(M::slice(&v)),
+                Err(_) => y.fill(f64::NAN),
+            };
+            f(t_prev, t, &dense)?;
         }
         if let Some(f) = hooks.progress.as_mut() {
             f(t);
@@ -192,7 +249,7 @@ pub fn integrate(sys: &dyn OdeSystem, x0: &[f64], t_end: f64, samples: &[f64], o
 }
 
 /// Illinois regula falsi on the dense output for the zero of state `k` in `(a, b)`.
-fn refine_crossing<'a, S: OdeSolverMethod<'a, Eqn<'a>>>(solver: &S, k: usize, a: (f64, f64), b: (f64, f64)) -> f64 {
+fn refine_crossing<'a, 's: 'a, M: Backend, S: OdeSolverMethod<'a, Eqn<'s, M>>>(solver: &S, k: usize, a: (f64, f64), b: (f64, f64)) -> f64 {
     let (mut ta, mut ga) = a;
     let (mut tb, mut gb) = b;
     let mut side = 0;
@@ -202,10 +259,7 @@ fn refine_crossing<'a, S: OdeSolverMethod<'a, Eqn<'a>>>(solver: &S, k: usize, a:
         }
         let tc = tb - gb * (tb - ta) / (gb - ga);
         let gc = match solver.interpolate(tc) {
-            Ok(y) => {
-                let y: V = y;
-                y[k]
-            }
+            Ok(y) => M::slice(&y)[k],
             Err(_) => return tc,
         };
         if (tb - ta).abs() < 1e-15 * tb.abs().max(1.0) || gc == 0.0 {

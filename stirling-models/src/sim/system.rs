@@ -16,6 +16,26 @@ pub trait OdeSystem {
     fn jac(&self, t: f64, x: &[f64], jac: &mut [f64]);
     /// Typical magnitude of each state, used to scale absolute tolerances.
     fn scale(&self) -> Vec<f64>;
+    /// Structural pattern of `df/dx` as `(row, col)` pairs, if known (`None`:
+    /// treat as dense; the sparse linear algebra is then never chosen automatically).
+    fn sparsity(&self) -> Option<Vec<(usize, usize)>> {
+        None
+    }
+    /// Append `df/dx` as `(row, col, value)` triplets (entries at one position add up).
+    /// The default goes through the dense [`OdeSystem::jac`].
+    fn jac_triplets(&self, t: f64, x: &[f64], out: &mut Vec<(usize, usize, f64)>) {
+        let n = self.dim();
+        let mut j = vec![0.0; n * n];
+        self.jac(t, x, &mut j);
+        for c in 0..n {
+            for r in 0..n {
+                let v = j[r + c * n];
+                if v != 0.0 {
+                    out.push((r, c, v));
+                }
+            }
+        }
+    }
 }
 
 /// Typical magnitudes of a model's states at equilibrium (position 1 cm,
@@ -55,6 +75,12 @@ impl OdeSystem for ModelSystem<'_> {
     fn scale(&self) -> Vec<f64> {
         state_scale(self.model, self.p)
     }
+    fn sparsity(&self) -> Option<Vec<(usize, usize)>> {
+        Some(self.model.sparsity(self.p))
+    }
+    fn jac_triplets(&self, t: f64, x: &[f64], out: &mut Vec<(usize, usize, f64)>) {
+        self.model.jacobian(self.p, x, t, &mut JacSink::Triplets(out));
+    }
 }
 
 /// A model plus one quadrature state `z' = heat + boundary + mechanical`
@@ -93,6 +119,13 @@ impl OdeSystem for EnergySystem<'_> {
         });
         s.push(e.abs().max(1.0));
         s
+    }
+    fn sparsity(&self) -> Option<Vec<(usize, usize)>> {
+        self.inner.sparsity()
+    }
+    fn jac_triplets(&self, t: f64, x: &[f64], out: &mut Vec<(usize, usize, f64)>) {
+        let n = self.inner.dim();
+        self.inner.jac_triplets(t, &x[..n], out);
     }
 }
 

@@ -1,0 +1,208 @@
+"""`nsection` (full closure) as a CasADi SX graph: RHS, its sparse `jacobian`, generated C
+compiled with `gcc -O3`, and one simulated second with CVODES (BDF, Newton, analytic Jacobian
+from the graph).
+
+Timing of the compiled functions (fair to CasADi): a Python call into `casadi.external` costs
+microseconds of wrapper overhead, more than the RHS itself at small n. So the generated code
+also contains `f.map(K, 'serial')` and `J.map(K, 'serial')` (one C call evaluating K copies in
+a loop inside the compiled library). For K1 < K2 the per-evaluation time is
+`(t(K2) - t(K1)) / (K2 - K1)`, which cancels the per-call wrapper overhead exactly and leaves
+the cost of the generated kernel, as our Rust timing measures the kernel in-process.
+
+CVODES: states are scaled `z = x / s` with the same scales as ours, so a scalar `abstol`
+reproduces our per-state `atol * s_i`; `reltol = rtol`. Two runs are timed: CasADi's default
+(the SX virtual machine evaluates the RHS and Jacobian for CVODES) and with `jit=True`
+(CasADi generates and compiles the integrator's functions with gcc -O3); the faster one is
+the comparison.
+
+Run alone: `python casadi_model.py --n 10`.
+"""
+import argparse
+import json
+import os
+import subprocess
+import tempfile
+import time
+
+import casadi as ca
+import numpy as np
+
+from common import Topology, median_time
+
+BUILD = os.path.join(os.path.dirname(os.path.abspath(__file__)), ".build")
+
+
+def build_graph(topo: Topology):
+    p = topo.p
+    ncv, nx = topo.ncv, topo.nx
+    z = ca.SX.sym("z", nx)
+    x, v, y, w = z[0], z[1], z[2], z[3]
+    P = [z[4 + i] for i in range(ncv)]
+    m = [z[4 + ncv + i] for i in range(ncv)]
+    g, R, cp, eps = p["gamma"], p["R"], topo.cp, p["mdot_eps"]
+    V, Vd, T = [], [], []
+    for i in range(ncv):
+        Vi = float(topo.V0[i])
+        if topo.ax[i] != 0:
+            Vi = Vi + float(topo.ax[i]) * x
+        if topo.ay[i] != 0:
+            Vi = Vi + float(topo.ay[i]) * y
+        V.append(Vi)
+        Vd.append(float(topo.ax[i]) * v + float(topo.ay[i]) * w)
+        T.append(P[i] * Vi / (m[i] * R))
+    E = []
+    for i in range(ncv):
+        Aw = float(topo.Aw0[i])
+        if topo.dAx[i] != 0:
+            Aw = Aw + float(topo.dAx[i]) * x
+        if topo.dAy[i] != 0:
+            Aw = Aw + float(topo.dAy[i]) * y
+        E.append(float(topo.h[i]) * Aw * (float(topo.Tw[i]) - T[i]))
+    Mn = [0] * ncv
+    for l in range(ncv - 1):
+        mdot = (P[l] - P[l + 1]) / float(topo.Rl[l])
+        s = 0.5 * (1 + ca.tanh(mdot / eps))
+        H = cp * mdot * (s * T[l] + (1 - s) * T[l + 1])
+        E[l] = E[l] - H
+        E[l + 1] = E[l + 1] + H
+        Mn[l] = Mn[l] - mdot
+        Mn[l + 1] = Mn[l + 1] + mdot
+    Pd = [((g - 1) * E[i] - g * P[i] * Vd[i]) / V[i] for i in range(ncv)]
+    Fx = topo.Fx0 + sum(float(topo.ax[i]) * P[i] for i in range(ncv) if topo.ax[i] != 0)
+    Fy = topo.Fy0 + sum(float(topo.ay[i]) * P[i] for i in range(ncv) if topo.ay[i] != 0)
+    vd = (Fx - p["kd"] * x - p["bd"] * v - p["b"] * (v - w) - p["bqd"] * v * ca.fabs(v)) / p["md"]
+    wd = (Fy - p["kp"] * y - p["bp"] * w - p["b"] * (w - v) - p["bqp"] * w * ca.fabs(w)) / p["mp"]
+    f = ca.vertcat(v, vd, w, wd, *Pd, *Mn)
+    return z, f
+
+
+class CasadiModel:
+    def __init__(self, topo: Topology, K=(16, 256)):
+        self.topo = topo
+        self.z, self.f = build_graph(topo)
+        self.J = ca.jacobian(self.f, self.z)  # sparse SX
+        self.F = ca.Function("f", [self.z], [self.f])
+        self.Jf = ca.Function("jacf", [self.z], [self.J])
+        self.K = K
+        self._compile()
+
+    def _compile(self):
+        os.makedirs(BUILD, exist_ok=True)
+        name = f"nsection_{self.topo.n}"
+        cg = ca.CodeGenerator(name + ".c", {"with_header": False})
+        cg.add(self.F)
+        cg.add(self.Jf)
+        for k in self.K:
+            cg.add(self.F.map(f"f_map{k}", "serial", k, [], []))
+            cg.add(self.Jf.map(f"jacf_map{k}", "serial", k, [], []))
+        cwd = os.getcwd()
+        os.chdir(BUILD)
+        try:
+            cg.generate()
+            t0 = time.perf_counter()
+            subprocess.run(["gcc", "-O3", "-march=native", "-fPIC", "-shared", name + ".c", "-o", name + ".so"], check=True)
+            self.compile_seconds = time.perf_counter() - t0
+        finally:
+            os.chdir(cwd)
+        so = os.path.join(BUILD, name + ".so")
+        self.lib = so
+        self.cF = ca.external("f", so)
+        self.cJ = ca.external("jacf", so)
+        self.cFmap = {k: ca.external(f"f_map{k}", so) for k in self.K}
+        self.cJmap = {k: ca.external(f"jacf_map{k}", so) for k in self.K}
+
+    def rhs(self, zv):
+        return np.array(self.cF(zv)).ravel()
+
+    def jac_triplets(self, zv):
+        Jm = self.cJ(zv)  # DM, sparse
+        sp = Jm.sparsity()
+        r, c = sp.get_triplet()
+        return np.array(r), np.array(c), np.array(Jm.nonzeros())
+
+    def kernel_times(self, zv):
+        """Per-evaluation seconds of the compiled RHS and Jacobian, wrapper overhead cancelled."""
+        k1, k2 = self.K
+        Z1 = ca.DM(np.tile(zv[:, None], (1, k1)))
+        Z2 = ca.DM(np.tile(zv[:, None], (1, k2)))
+        out = {}
+        for key, fmap, single in (("rhs", self.cFmap, self.cF), ("jac", self.cJmap, self.cJ)):
+            t1 = median_time(lambda: fmap[k1](Z1), reps=31)
+            t2 = median_time(lambda: fmap[k2](Z2), reps=31)
+            out[key] = max((t2 - t1) / (k2 - k1), 0.0)
+            out[key + "_python_call"] = median_time(lambda: single(zv), reps=31)
+        out["jac_nnz"] = int(self.J.nnz())
+        return out
+
+    def simulate(self, t_end=1.0, rtol=1e-7, atol=1e-7, jit=False, max_s=None):
+        topo = self.topo
+        s = topo.scale()
+        zs = ca.SX.sym("zs", topo.nx)
+        ode = ca.substitute(self.f, self.z, zs * s) / s
+        opts = {
+            "abstol": atol, "reltol": rtol, "max_num_steps": 10_000_000,
+            "linear_multistep_method": "bdf", "nonlinear_solver_iteration": "newton",
+            "newton_scheme": "direct",
+        }
+        if jit:
+            opts.update({"jit": True, "compiler": "shell",
+                         "jit_options": {"compiler": "gcc", "flags": ["-O3", "-march=native"], "verbose": False}})
+        t0 = time.perf_counter()
+        F = ca.integrator("F", "cvodes", {"x": zs, "ode": ode}, 0.0, t_end, opts)
+        setup = time.perf_counter() - t0
+        z0 = topo.sim_start() / s
+        t0 = time.perf_counter()
+        try:
+            r = F(x0=z0)
+            ok, err = True, None
+        except RuntimeError as e:
+            ok, err = False, str(e).splitlines()[-1]
+        el = time.perf_counter() - t0
+        st = F.stats()
+        res = {"ok": ok and bool(st.get("success", True)), "seconds": el, "setup_seconds": setup, "t_end": t_end, "jit": jit}
+        if err:
+            res["error"] = err
+        for k_out, k_in in (("steps", "nsteps"), ("rhs_calls", "nfevals"), ("jacobian_calls", "njevals"),
+                            ("lu_factorizations", "nlinsetups"), ("error_test_failures", "netfails")):
+            if k_in in st:
+                res[k_out] = int(st[k_in])
+        if ok:
+            res["x_end"] = (np.array(r["xf"]).ravel() * s).tolist()
+        res["linear_solver"] = st.get("linear_solver", "default")
+        return res
+
+
+def run(n, params=None, do_sim=True, t_end=1.0, rtol=1e-7, atol=1e-7, jit_sim=True, vm_sim=True):
+    topo = Topology(n, params)
+    t0 = time.perf_counter()
+    cm = CasadiModel(topo)
+    build_s = time.perf_counter() - t0
+    z = topo.fairness_state()
+    r, c, vals = cm.jac_triplets(z)
+    out = {
+        "n": n, "n_states": topo.nx, "build_and_compile_seconds": build_s,
+        "x": z.tolist(), "f": cm.rhs(z).tolist(),
+        "jac": [[int(a), int(b), float(v)] for a, b, v in zip(r, c, vals)],
+        "timings": cm.kernel_times(z),
+    }
+    if do_sim:
+        sims = []
+        if vm_sim:
+            sims.append(cm.simulate(t_end, rtol, atol, jit=False))
+        if jit_sim:
+            sims.append(cm.simulate(t_end, rtol, atol, jit=True))
+        out["sims"] = sims
+    return out
+
+
+if __name__ == "__main__":
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--n", type=int, default=10)
+    ap.add_argument("--no-sim", action="store_true")
+    ap.add_argument("--t-end", type=float, default=1.0)
+    a = ap.parse_args()
+    res = run(a.n, do_sim=not a.no_sim, t_end=a.t_end)
+    res.pop("jac"); res.pop("x"); res.pop("f")
+    for s_ in res.get("sims", []):
+        s_.pop("x_end", None)
+    print(json.dumps(res, indent=1))

@@ -1,0 +1,320 @@
+//! A free-piston engine that is not in the seed's family, declared in user code with the
+//! public `stirling_model!` DSL only, and run through every analysis.
+//!
+//! The engine is the default B-10B-like engine (PHYSICS.md section 8) with two changes:
+//! - **closed bounce space**: the gas under the piston is a control volume `bounce` with its
+//!   own state `P_bounce` and a heat port to a wall at `Tb` (a gas spring with hysteresis
+//!   loss, PHYSICS.md section 9), instead of a space held at the fixed pressure `Pb`;
+//! - **linear alternator** on the power piston: an extra force `-c_alt w`; its power
+//!   `c_alt w^2` is the electric output. The piston's own damping `bp` is friction only.
+//!
+//! The working gas is the `nsection` layout (hot space, `n` regenerator sections, cold space).
+//!
+//! Run: `cargo run --release --example custom_topology -- --n 4 --out target/custom_topology`
+//! (`--json` prints a machine-readable summary; `--t-max` bounds the settling run).
+//!
+//! Printed: equilibrium, dynamic poles, the loop broken at the piston force with its margins,
+//! the limit cycle (frequency, strokes, phase, Floquet multipliers), the work per vessel,
+//! indicated and electric power; written: `poles.svg`, `bode.svg`, `startup.svg`, `pv.svg`.
+
+use std::error::Error;
+use std::path::{Path, PathBuf};
+
+use stirling::dsl::{Closure, Model, StateKind};
+use stirling::models::linear::{self, LinearOptions, Linearization};
+use stirling::models::plot;
+use stirling::models::sim::{self, LimitCycleReport, SimOptions, SimSummary};
+use stirling::stirling_model;
+
+stirling_model! {
+    /// Default engine with a closed, heat-exchanging bounce space and a linear alternator.
+    pub model AlternatorEngine {
+        name "alternator_engine";
+        params {
+            /// specific gas constant
+            R: 287.05 "J/(kg K)",
+            /// heat-capacity ratio
+            gamma: 1.4 "-",
+            /// cylinder and displacer area
+            A: pi / 4.0 * 0.06 * 0.06 "m^2",
+            /// displacer rod area
+            Ar: pi / 4.0 * 0.015 * 0.015 "m^2",
+            /// hot-space volume at rest
+            Vh0: 1.5e-4 "m^3",
+            /// cold-space volume at rest
+            Vc0: 1.2e-4 "m^3",
+            /// regenerator volume
+            Vr: 4.0e-5 "m^3",
+            /// bounce-space volume at rest (closed crankcase)
+            Vb0: 2.0e-3 "m^3",
+            /// heater wall temperature
+            Th: 600.0 "K",
+            /// cooler wall temperature
+            Tk: 300.0 "K",
+            /// bounce-space wall temperature
+            Tb: 300.0 "K",
+            /// charge pressure (working and bounce gas at rest)
+            Pmean: 101325.0 "Pa",
+            /// displacer moving mass
+            md: 0.08228 "kg",
+            /// power-piston moving mass (with the alternator's mover)
+            mp: 0.33363 "kg",
+            /// displacer spring rate
+            kd: 650.74 "N/m",
+            /// power-piston spring rate
+            kp: 61.482 "N/m",
+            /// displacer viscous damping
+            bd: 0.48643 "N s/m",
+            /// power-piston friction
+            bp: 1.9083 "N s/m",
+            /// alternator load: force -c_alt w on the piston, electric power c_alt w^2
+            c_alt: 6.0 "N s/m",
+            /// displacer-piston coupling damping
+            b: 0.1 "N s/m",
+            /// displacer quadratic damping
+            bqd: 0.5 "N s^2/m^2",
+            /// power-piston quadratic damping
+            bqp: 5.0 "N s^2/m^2",
+            /// hot-space wall area at rest
+            Awh0: 0.0128 "m^2",
+            /// cold-space wall area at rest
+            Awc0: 0.0112 "m^2",
+            /// regenerator wall area
+            Awr: 0.0377 "m^2",
+            /// bounce-space wall area
+            Awb: 0.06 "m^2",
+            /// heater heat-transfer coefficient
+            hh: 500.0 "W/(m^2 K)",
+            /// cooler heat-transfer coefficient
+            hk: 500.0 "W/(m^2 K)",
+            /// regenerator heat-transfer coefficient
+            hr: 100.0 "W/(m^2 K)",
+            /// bounce-space heat-transfer coefficient
+            hb: 20.0 "W/(m^2 K)",
+            /// regenerator flow resistance
+            Rf: 1.0e5 "Pa s/kg",
+            /// smoothing scale of the upwind switch
+            mdot_eps: 1.0e-5 "kg/s",
+        }
+        // cylinder diameter
+        let D = sqrt(4.0 * A / pi);
+        gas { R: R, gamma: gamma, charge: Pmean, mdot_eps: mdot_eps }
+        body displacer(x, v) { mass: md, spring: kd, damper: bd, quad_damper: bqd }
+        body piston(y, w) { mass: mp, spring: kp, damper: bp, quad_damper: bqp, force: -c_alt * w }
+        coupling displacer, piston { damper: b }
+        cv hot {
+            volume: Vh0,
+            faces { displacer: -A },
+            port hot { h: hh, area: Awh0 - pi * D * x, wall: Th },
+        }
+        cv regen[n] {
+            volume: Vr / n,
+            port wall { h: hr, area: Awr / n, wall: Th - (j + 0.5) * (Th - Tk) / n },
+        }
+        cv cold {
+            volume: Vc0,
+            faces { displacer: A - Ar, piston: -(A - Ar) },
+            port cold { h: hk, area: Awc0 + pi * D * (x - y), wall: Tk },
+        }
+        // the closed bounce space: same faces as the seed's fixed-pressure space, but a gas
+        // volume of its own (no mass-flow link, so its mass is a constant)
+        cv bounce {
+            volume: Vb0,
+            faces { displacer: Ar, piston: A - Ar },
+            port wall { h: hb, area: Awb, wall: Tb },
+        }
+        link hot -> regen[0] { resistance: Rf / (2.0 * n) }
+        link regen[j] -> regen[j + 1] for j in 0..n - 1 { resistance: Rf / n }
+        link regen[n - 1] -> cold { resistance: Rf / (2.0 * n) }
+    }
+}
+
+/// Command-line settings.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Args {
+    /// Regenerator sections.
+    pub n: usize,
+    /// Folder for the SVG figures (none: no figures).
+    pub out: Option<PathBuf>,
+    /// Print JSON instead of text.
+    pub json: bool,
+    /// Longest settling run (s).
+    pub t_max: f64,
+    /// Print anything at all (the tests run quietly).
+    pub quiet: bool,
+}
+
+impl Default for Args {
+    fn default() -> Self {
+        Self { n: 2, out: Some(PathBuf::from("target/custom_topology")), json: false, t_max: 20.0, quiet: false }
+    }
+}
+
+const USAGE: &str = "usage: custom_topology [--n N] [--out DIR | --no-plots] [--json] [--t-max SECONDS]";
+
+/// Parse `--n N`, `--out DIR`, `--no-plots`, `--json`, `--t-max T`.
+pub fn parse_args<I: IntoIterator<Item = String>>(args: I) -> Result<Args, String> {
+    let mut a = Args::default();
+    let mut it = args.into_iter();
+    while let Some(flag) = it.next() {
+        let mut value = |name: &str| it.next().ok_or_else(|| format!("{name} needs a value\n{USAGE}"));
+        match flag.as_str() {
+            "--n" => a.n = value("--n")?.parse().map_err(|e| format!("--n: {e}\n{USAGE}"))?,
+            "--out" => a.out = Some(PathBuf::from(value("--out")?)),
+            "--no-plots" => a.out = None,
+            "--json" => a.json = true,
+            "--t-max" => a.t_max = value("--t-max")?.parse().map_err(|e| format!("--t-max: {e}\n{USAGE}"))?,
+            "-h" | "--help" => return Err(USAGE.to_string()),
+            other => return Err(format!("unknown argument `{other}`\n{USAGE}")),
+        }
+    }
+    if a.n == 0 {
+        return Err(format!("--n must be at least 1\n{USAGE}"));
+    }
+    Ok(a)
+}
+
+/// What a run found.
+pub struct Summary {
+    pub model: AlternatorEngine,
+    pub p: Vec<f64>,
+    pub linear: Linearization,
+    pub cycle: LimitCycleReport,
+    /// Mean alternator power `c_alt <w^2>` over the cycle (W).
+    pub electric_power_w: f64,
+    /// Indicated power `W f` (W).
+    pub indicated_power_w: f64,
+    /// Figures written.
+    pub files: Vec<PathBuf>,
+}
+
+/// Start: equilibrium with the displacer displaced by 5 mm.
+pub fn perturbed(model: &dyn Model, p: &[f64]) -> Vec<f64> {
+    let mut x = vec![0.0; model.n_states()];
+    model.equilibrium_guess(p, &mut x);
+    let ix = model.states().iter().position(|s| s.kind == StateKind::Position(0)).expect("displacer");
+    x[ix] += 5e-3;
+    x
+}
+
+/// Mean of `c_alt w^2` over uniform orbit samples (last = first).
+pub fn electric_power(model: &dyn Model, p: &[f64], orbit: &[Vec<f64>]) -> f64 {
+    let iw = model.states().iter().position(|s| s.kind == StateKind::Velocity(1)).expect("piston velocity");
+    let c_alt = p[model.param_index("c_alt").expect("c_alt")];
+    let k = orbit.len().saturating_sub(1).max(1);
+    orbit.iter().take(k).map(|x| c_alt * x[iw] * x[iw]).sum::<f64>() / k as f64
+}
+
+/// Build the model, run the analyses, write the figures.
+pub fn run(args: &Args) -> Result<Summary, Box<dyn Error>> {
+    let model = AlternatorEngine::new(args.n, Closure::Full)?;
+    let p = model.default_params();
+    let lin = linear::linearize(&model, &p, &LinearOptions::default())?;
+    let x0 = perturbed(&model, &p);
+    let samples = sim::uniform_samples(args.t_max.min(1.0), 2000);
+    let cycle = sim::limit_cycle(&model, &p, &x0, args.t_max, &samples, &SimOptions::default(), None)?;
+    let electric_power_w = electric_power(&model, &p, &cycle.orbit);
+    let indicated_power_w = sim::indicated_power(cycle.work.total, cycle.figures.frequency_hz);
+    let files = match &args.out {
+        Some(dir) => figures(dir, &model, &p, &lin, &cycle)?,
+        None => Vec::new(),
+    };
+    Ok(Summary { model, p, linear: lin, cycle, electric_power_w, indicated_power_w, files })
+}
+
+fn figures(dir: &Path, model: &dyn Model, p: &[f64], lin: &Linearization, lc: &LimitCycleReport) -> Result<Vec<PathBuf>, Box<dyn Error>> {
+    std::fs::create_dir_all(dir)?;
+    let title = format!("{} (n = {})", model.name(), model.n());
+    let states = model.states();
+    let find = |k: StateKind| states.iter().position(|s| s.kind == k).unwrap_or(0);
+    let pressures: Vec<(String, usize)> =
+        states.iter().enumerate().filter(|(_, s)| matches!(s.kind, StateKind::Pressure(_))).map(|(i, s)| (s.name.clone(), i)).collect();
+    let files = [dir.join("poles.svg"), dir.join("bode.svg"), dir.join("startup.svg"), dir.join("pv.svg")];
+    plot::poles::pole_map(&files[0], &title, &lin.dynamics.poles, &lin.open_loop.poles)?;
+    plot::bode::bode_diagram(&files[1], &title, &lin.bode(), &lin.margins)?;
+    let tr = &lc.settled.trajectory;
+    plot::timeseries::startup_svg(&files[2], &title, &tr.t, &tr.x, find(StateKind::Position(0)), find(StateKind::Position(1)), &pressures)?;
+    let nv = model.vessel_names().len();
+    let mut loops = vec![Vec::new(); nv];
+    let (mut pr, mut v) = (vec![0.0; nv], vec![0.0; nv]);
+    for x in &lc.orbit {
+        model.pv(p, x, &mut pr, &mut v);
+        for i in 0..nv {
+            loops[i].push((v[i], pr[i]));
+        }
+    }
+    plot::pv::pv_svg(&files[3], &title, &lc.work.vessels, &loops, &lc.work.per_vessel)?;
+    Ok(files.to_vec())
+}
+
+/// The text report.
+pub fn print(s: &Summary) {
+    let m = &s.model;
+    let lin = &s.linear;
+    let eq = &lin.dynamics.equilibrium;
+    println!("model {} (n = {}, closure {}, {} states)", m.name(), m.n(), m.closure(), m.n_states());
+    println!("equilibrium: {} Newton iterations, scaled residual {:.2e} 1/s", eq.iterations, eq.scaled_residual);
+    for (name, v) in m.state_names().iter().zip(&eq.x) {
+        println!("  {name:>12} = {v:.6e}");
+    }
+    if let Some(inv) = &lin.dynamics.reduction.inventory {
+        println!("inventory mode: eigenvalue {:.2e} 1/s, conservation defect {:.2e}", inv.eigenvalue, inv.conservation_defect);
+    }
+    println!("dynamic poles (1/s):");
+    for pole in &lin.dynamics.poles {
+        println!("  {:>12.4} {:+12.4}j  ({:7.3} Hz, zeta {:+.4}){}", pole.re, pole.im, pole.freq_hz, pole.damping_ratio, if pole.rhp { "  unstable" } else { "" });
+    }
+    let mg = &lin.margins;
+    let fmt = |v: Option<f64>, unit: &str| v.map(|v| format!("{v:.3} {unit}")).unwrap_or_else(|| "none".into());
+    println!("loop broken at `{}` ({}):", lin.open_loop.full.name, lin.open_loop.full.unit);
+    println!("  Gm = {} at {}, Pm = {} at {}", fmt(mg.gain_db, "dB"), fmt(mg.phase_crossover_rad_s, "rad/s"), fmt(mg.phase_deg, "deg"), fmt(mg.gain_crossover_rad_s, "rad/s"));
+    let lc = &s.cycle;
+    let f = &lc.figures;
+    println!("limit cycle (settled at t = {:.3} s, shooting {} iterations, residual {:.2e}):", lc.settled.t, lc.cycle.iterations, lc.cycle.residual);
+    println!("  f = {:.4} Hz ({:.3} rad/s), x_amp = {:.3} mm, y_amp = {:.3} mm, phase x-y = {:.2} deg", f.frequency_hz, 2.0 * std::f64::consts::PI * f.frequency_hz, 1e3 * f.x_amp, 1e3 * f.y_amp, f.phase_deg);
+    let names = m.vessel_names();
+    let pa: Vec<String> = names.iter().zip(&f.p_amp).map(|(n, a)| format!("{n} {:.3} kPa", 1e-3 * a)).collect();
+    println!("  pressure amplitudes: {}", pa.join(", "));
+    let moduli: Vec<String> = lc.cycle.floquet.iter().map(|(re, im)| format!("{:.4}", re.hypot(*im))).collect();
+    println!("  Floquet |mu|: {}", moduli.join(" "));
+    println!("work per cycle (closed-integral P dV, J):");
+    for (n, w) in lc.work.vessels.iter().zip(&lc.work.per_vessel) {
+        println!("  {n:>12} {w:+.5e}");
+    }
+    println!("  {:>12} {:+.5e}", "total", lc.work.total);
+    println!("indicated power {:.4} W, electric (alternator) power {:.4} W", s.indicated_power_w, s.electric_power_w);
+    for file in &s.files {
+        println!("wrote {}", file.display());
+    }
+}
+
+/// The `--json` report: the linear report and the limit-cycle summary.
+pub fn json(s: &Summary) -> serde_json::Value {
+    let lc = SimSummary::from_run(&s.model, &s.cycle.settled.trajectory).with_cycle(&s.cycle);
+    serde_json::json!({
+        "linear": serde_json::to_value(s.linear.report(&s.model)).unwrap_or_default(),
+        "limit_cycle": serde_json::to_value(&lc).unwrap_or_default(),
+        "indicated_power_w": s.indicated_power_w,
+        "electric_power_w": s.electric_power_w,
+        "files": s.files.iter().map(|f| f.display().to_string()).collect::<Vec<_>>(),
+    })
+}
+
+#[allow(dead_code)]
+fn main() {
+    let args = match parse_args(std::env::args().skip(1)) {
+        Ok(a) => a,
+        Err(e) => {
+            eprintln!("{e}");
+            std::process::exit(2);
+        }
+    };
+    match run(&args) {
+        Ok(s) if args.json => println!("{}", serde_json::to_string_pretty(&json(&s)).unwrap_or_default()),
+        Ok(s) => print(&s),
+        Err(e) => {
+            eprintln!("custom_topology: {e}");
+            std::process::exit(1);
+        }
+    }
+}

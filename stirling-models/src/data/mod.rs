@@ -1,0 +1,129 @@
+//! Measured data: a CSV with a header, `t` [s] and any of `p` (cold-side absolute pressure,
+//! Pa), `p_hot` (Pa), `x`, `y` (m); `#` comment lines; other columns ignored.
+//!
+//! Every malformed input is a [`DataError`] naming the file, the row (1-based line number in
+//! the file) and the column. Sensor offsets are estimated ([`offsets`]), never assumed zero.
+
+mod csv;
+pub mod offsets;
+
+pub use csv::{parse_csv, read_csv, write_csv};
+pub use offsets::{cycle_mean, remove_position_offsets, PositionOffsets};
+
+use std::fmt;
+
+/// The measured channels.
+pub const CHANNELS: [&str; 4] = ["p", "p_hot", "x", "y"];
+
+/// A malformed input: where and why.
+#[derive(Clone, Debug, PartialEq)]
+pub struct DataError {
+    /// File name (or the source label given to [`parse_csv`]).
+    pub file: String,
+    /// 1-based line number in the file.
+    pub row: usize,
+    /// Column name (as in the header, or the expected name when it is missing).
+    pub column: String,
+    /// What is wrong and what was expected.
+    pub message: String,
+}
+
+impl fmt::Display for DataError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "{}: row {}, column `{}`: {}", self.file, self.row, self.column, self.message)
+    }
+}
+
+impl std::error::Error for DataError {}
+
+/// A measured record: uniform or not, strictly increasing time.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Measured {
+    /// Where it came from (file name).
+    pub source: String,
+    pub t: Vec<f64>,
+    pub p: Option<Vec<f64>>,
+    pub p_hot: Option<Vec<f64>>,
+    pub x: Option<Vec<f64>>,
+    pub y: Option<Vec<f64>>,
+}
+
+impl Measured {
+    /// A channel by name (`p`, `p_hot`, `x`, `y`).
+    pub fn channel(&self, name: &str) -> Option<&[f64]> {
+        match name {
+            "p" => self.p.as_deref(),
+            "p_hot" => self.p_hot.as_deref(),
+            "x" => self.x.as_deref(),
+            "y" => self.y.as_deref(),
+            _ => None,
+        }
+    }
+
+    /// Mutable channel by name.
+    pub fn channel_mut(&mut self, name: &str) -> Option<&mut Vec<f64>> {
+        match name {
+            "p" => self.p.as_mut(),
+            "p_hot" => self.p_hot.as_mut(),
+            "x" => self.x.as_mut(),
+            "y" => self.y.as_mut(),
+            _ => None,
+        }
+    }
+
+    /// Names of the channels present.
+    pub fn channels(&self) -> Vec<&'static str> {
+        CHANNELS.into_iter().filter(|c| self.channel(c).is_some()).collect()
+    }
+
+    /// Number of samples.
+    pub fn len(&self) -> usize {
+        self.t.len()
+    }
+
+    /// Whether there are no samples.
+    pub fn is_empty(&self) -> bool {
+        self.t.is_empty()
+    }
+
+    /// Indices `[i0, i1)` of the samples with `a <= t <= b`.
+    pub fn range(&self, a: f64, b: f64) -> (usize, usize) {
+        let i0 = self.t.partition_point(|&t| t < a);
+        let i1 = self.t.partition_point(|&t| t <= b);
+        (i0, i1.max(i0))
+    }
+
+    /// The samples with `a <= t <= b` (time kept absolute).
+    pub fn slice(&self, a: f64, b: f64) -> Measured {
+        let (i0, i1) = self.range(a, b);
+        let cut = |c: &Option<Vec<f64>>| c.as_ref().map(|v| v[i0..i1].to_vec());
+        Measured { source: self.source.clone(), t: self.t[i0..i1].to_vec(), p: cut(&self.p), p_hot: cut(&self.p_hot), x: cut(&self.x), y: cut(&self.y) }
+    }
+
+    /// Mean sample interval.
+    pub fn dt(&self) -> f64 {
+        if self.t.len() < 2 {
+            return f64::NAN;
+        }
+        (self.t[self.t.len() - 1] - self.t[0]) / (self.t.len() - 1) as f64
+    }
+}
+
+/// `a:b` as two times (either may be empty: start or end of the record).
+pub fn parse_span(s: &str, rec: &Measured) -> Result<(f64, f64), String> {
+    let (a, b) = s.split_once(':').ok_or_else(|| format!("bad time span `{s}`: expected a:b in seconds, e.g. 0:0.6"))?;
+    let t0 = rec.t.first().copied().unwrap_or(0.0);
+    let t1 = rec.t.last().copied().unwrap_or(0.0);
+    let num = |x: &str, d: f64| -> Result<f64, String> {
+        if x.trim().is_empty() {
+            Ok(d)
+        } else {
+            x.trim().parse::<f64>().ok().filter(|v| v.is_finite()).ok_or_else(|| format!("bad time `{x}` in span `{s}`"))
+        }
+    };
+    let (a, b) = (num(a, t0)?, num(b, t1)?);
+    if !(b > a) {
+        return Err(format!("empty time span `{s}`: the end must be after the start"));
+    }
+    Ok((a, b))
+}

@@ -1,0 +1,239 @@
+//! Effects the nominal models leave out (PHYSICS.md section 9), as model augmentations
+//! declared through the DSL ([`models`]), and the registry that names them.
+//!
+//! Each model effect is a set of extra parameters of an augmented family member
+//! ([`Cv1Fx`], [`NSectionFx`]) whose null values make it absent; the nominal model is the
+//! augmented model at the nulls. Sensor effects (`sensor_lag`, `sensor_gain`) act on the
+//! measured outputs, not on the model (see [`crate::rig`]).
+//!
+//! Not expressible in the DSL yet (they need new state kinds): regenerator matrix heat
+//! capacity (wall temperatures as states), heater dynamics (`Th` as a state), the closed
+//! bounce space as a control volume with its own heat port, the orifice leak law
+//! `C sign(dP)|dP|^0.5` (its slope is infinite at `dP = 0`), and the end-stop contact damper
+//! `-cc v` (needs a step function of the position).
+
+mod models;
+
+pub use models::{Cv1Fx, Cv1FxParams, NSectionFx, NSectionFxParams};
+
+use stirling_dsl::{Closure, Model};
+
+/// Whether an effect changes the model or only the measured outputs.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+pub enum EffectTarget {
+    Model,
+    Sensor,
+}
+
+/// One parameter of an effect.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
+pub struct EffectParam {
+    pub name: &'static str,
+    /// The value at which the effect is absent (`None`: a shape parameter with no null,
+    /// e.g. the travel to an end stop; it keeps its default).
+    pub null: Option<f64>,
+    /// A clearly visible strength on the default engine (for the rig and the self-checks).
+    pub typical: f64,
+    pub unit: &'static str,
+}
+
+/// An effect: its name, what it does, its parameters (the first is its strength).
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
+pub struct EffectInfo {
+    pub name: &'static str,
+    pub summary: &'static str,
+    pub target: EffectTarget,
+    pub params: &'static [EffectParam],
+    /// Base models whose augmented member carries it (all, for sensor effects).
+    pub applies_to: &'static [&'static str],
+}
+
+impl EffectInfo {
+    /// The strength parameter (`NAME=VALUE` on the rig sets it).
+    pub fn strength(&self) -> &'static EffectParam {
+        &self.params[0]
+    }
+}
+
+const fn ep(name: &'static str, null: Option<f64>, typical: f64, unit: &'static str) -> EffectParam {
+    EffectParam { name, null, typical, unit }
+}
+
+/// The effect library.
+pub const EFFECTS: &[EffectInfo] = &[
+    EffectInfo {
+        name: "leak",
+        summary: "seal leakage cold space -> bounce space, mdot = Gleak (Pc - Pb)",
+        target: EffectTarget::Model,
+        params: &[ep("Gleak", Some(0.0), 2.0e-8, "kg/(s Pa)")],
+        applies_to: &["cv1", "nsection"],
+    },
+    EffectInfo {
+        name: "coulomb",
+        summary: "Coulomb friction on both bodies, -Fc tanh(v / v_eps)",
+        target: EffectTarget::Model,
+        params: &[ep("Fcd", Some(0.0), 0.3, "N"), ep("Fcp", Some(0.0), 1.0, "N"), ep("v_eps", None, 1.0e-3, "m/s")],
+        applies_to: &["cv1", "nsection"],
+    },
+    EffectInfo {
+        name: "regen_quadratic",
+        summary: "quadratic (turbulent) regenerator friction, dP = Rf mdot + Rq mdot |mdot|",
+        target: EffectTarget::Model,
+        params: &[ep("Rq", Some(0.0), 1.0e9, "Pa s^2/kg^2")],
+        applies_to: &["nsection"],
+    },
+    EffectInfo {
+        name: "end_stops",
+        summary: "end stops, -kc relu(|q| - q_max) sign(q) on both bodies",
+        target: EffectTarget::Model,
+        params: &[ep("kc", Some(0.0), 2.0e5, "N/m"), ep("xmax", None, 0.01, "m"), ep("ymax", None, 0.01, "m")],
+        applies_to: &["cv1", "nsection"],
+    },
+    EffectInfo {
+        name: "sensor_lag",
+        summary: "first-order lag of the pressure transducers, time constant tau_p",
+        target: EffectTarget::Sensor,
+        params: &[ep("tau_p", Some(0.0), 2.0e-3, "s")],
+        applies_to: &["cv1", "nsection"],
+    },
+    EffectInfo {
+        name: "sensor_gain",
+        summary: "position-sensor gain errors, x_meas = (1 + gain_x) x, y_meas = (1 + gain_y) y",
+        target: EffectTarget::Sensor,
+        params: &[ep("gain_x", Some(0.0), 0.05, "-"), ep("gain_y", Some(0.0), 0.05, "-")],
+        applies_to: &["cv1", "nsection"],
+    },
+];
+
+/// Why an effect request cannot be served.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+pub enum EffectError {
+    #[error("unknown effect or effect parameter `{0}`: expected one of {1}")]
+    Unknown(String, String),
+    #[error("effect `{effect}` does not apply to model `{model}` (it applies to {applies})")]
+    NotApplicable { effect: String, model: String, applies: String },
+    #[error("model `{0}` has no augmented member: effects are declared for cv1 and nsection (aliases order5, order7, order8)")]
+    NoAugmented(String),
+    #[error("bad effect setting `{0}`: expected NAME=VALUE with a finite number, e.g. leak=2e-8 or Gleak=2e-8")]
+    BadSetting(String),
+    #[error("{0}")]
+    Model(String),
+}
+
+/// The effect by name.
+pub fn effect(name: &str) -> Option<&'static EffectInfo> {
+    EFFECTS.iter().find(|e| e.name == name)
+}
+
+/// The effect that owns a parameter.
+pub fn effect_of_param(param: &str) -> Option<(&'static EffectInfo, &'static EffectParam)> {
+    EFFECTS.iter().find_map(|e| e.params.iter().find(|p| p.name == param).map(|p| (e, p)))
+}
+
+/// The effects that apply to a base model.
+pub fn effects_for(base: &str) -> Vec<&'static EffectInfo> {
+    let base = canonical(base).map(|(b, _)| b).unwrap_or(base);
+    EFFECTS.iter().filter(|e| e.applies_to.contains(&base)).collect()
+}
+
+/// Canonical base name and the `n` an alias fixes.
+fn canonical(name: &str) -> Option<(&'static str, Option<usize>)> {
+    match name {
+        "cv1" | "order5" | "cv1_fx" => Some(("cv1", None)),
+        "nsection" | "nsection_fx" => Some(("nsection", None)),
+        "order7" => Some(("nsection", Some(1))),
+        "order8" => Some(("nsection", Some(2))),
+        _ => None,
+    }
+}
+
+/// The augmented model of a base model (`cv1` -> [`Cv1Fx`], `nsection` -> [`NSectionFx`]).
+pub fn augmented(base: &str, n: Option<usize>, closure: Closure) -> Result<Box<dyn Model>, EffectError> {
+    let (b, fixed) = canonical(base).ok_or_else(|| EffectError::NoAugmented(base.to_string()))?;
+    // reuse the registry's checks of n and aliases
+    crate::registry::build(base, n, closure).map_err(|e| EffectError::Model(e.to_string()))?;
+    Ok(match b {
+        "cv1" => Box::new(Cv1Fx::new(1, closure).map_err(|e| EffectError::Model(e.to_string()))?),
+        _ => {
+            let n = n.or(fixed).unwrap_or(1);
+            Box::new(NSectionFx::new(n, closure).map_err(|e| EffectError::Model(e.to_string()))?)
+        }
+    })
+}
+
+/// Parameters of the augmented model with every effect at its null (the nominal model).
+pub fn nominal_params(model: &dyn Model) -> Vec<f64> {
+    let mut p = model.default_params();
+    for e in EFFECTS {
+        for q in e.params {
+            if let (Some(null), Some(i)) = (q.null, model.param_index(q.name)) {
+                p[i] = null;
+            }
+        }
+    }
+    p
+}
+
+/// Effect settings: model parameters set on the augmented model and sensor parameters.
+#[derive(Clone, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct EffectSettings {
+    /// `(parameter, value)` of model effects, in the order given.
+    pub model: Vec<(String, f64)>,
+    /// `(parameter, value)` of sensor effects.
+    pub sensor: Vec<(String, f64)>,
+}
+
+impl EffectSettings {
+    /// Parse `NAME=VALUE` settings: `NAME` is an effect (sets its strength parameter) or an
+    /// effect parameter; checks that the effect applies to `base`.
+    pub fn parse(base: &str, settings: &[String]) -> Result<Self, EffectError> {
+        let base_c = canonical(base).map(|(b, _)| b).unwrap_or(base);
+        let mut out = EffectSettings::default();
+        for s in settings {
+            let (k, v) = s.split_once('=').ok_or_else(|| EffectError::BadSetting(s.clone()))?;
+            let (k, v) = (k.trim(), v.trim());
+            let v: f64 = v.parse().ok().filter(|v: &f64| v.is_finite()).ok_or_else(|| EffectError::BadSetting(s.clone()))?;
+            let (e, p) = match effect(k) {
+                Some(e) => (e, e.strength()),
+                None => effect_of_param(k).ok_or_else(|| {
+                    let names: Vec<String> = EFFECTS.iter().flat_map(|e| std::iter::once(e.name).chain(e.params.iter().map(|p| p.name))).map(String::from).collect();
+                    EffectError::Unknown(k.to_string(), names.join(", "))
+                })?,
+            };
+            if !e.applies_to.contains(&base_c) {
+                return Err(EffectError::NotApplicable { effect: e.name.into(), model: base.into(), applies: e.applies_to.join(", ") });
+            }
+            let list = if e.target == EffectTarget::Model { &mut out.model } else { &mut out.sensor };
+            list.retain(|(n, _)| n != p.name);
+            list.push((p.name.to_string(), v));
+        }
+        Ok(out)
+    }
+
+    /// A sensor parameter's value (its null when not set).
+    pub fn sensor_value(&self, name: &str) -> f64 {
+        self.sensor.iter().find(|(n, _)| n == name).map(|(_, v)| *v).unwrap_or_else(|| effect_of_param(name).and_then(|(_, p)| p.null).unwrap_or(0.0))
+    }
+
+    /// Apply the model settings to a parameter vector of the augmented model.
+    pub fn apply(&self, model: &dyn Model, p: &mut [f64]) -> Result<(), EffectError> {
+        for (k, v) in &self.model {
+            let i = model.param_index(k).ok_or_else(|| EffectError::NotApplicable { effect: k.clone(), model: model.name().into(), applies: String::new() })?;
+            p[i] = *v;
+        }
+        Ok(())
+    }
+
+    /// Names of the effects that are switched on (a strength away from its null).
+    pub fn active(&self) -> Vec<&'static str> {
+        let mut out: Vec<&'static str> = Vec::new();
+        for (k, v) in self.model.iter().chain(&self.sensor) {
+            if let Some((e, p)) = effect_of_param(k) {
+                if p.null.is_some_and(|n| n != *v) && !out.contains(&e.name) {
+                    out.push(e.name);
+                }
+            }
+        }
+        out
+    }
+}

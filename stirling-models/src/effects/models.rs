@@ -1,0 +1,94 @@
+//! The augmented family members: every DSL-expressible effect of PHYSICS.md section 9 as an
+//! extra parameter whose null value (0) makes the effect absent.
+//!
+//! - seal leak cold space -> bounce space: `mdot = Gleak (Pc - Pb)` (a `conductance:` link, so
+//!   `Gleak = 0` is exactly no flow; the bounce space gets `temperature: Tk` for the enthalpy);
+//! - Coulomb friction: `-Fcd tanh(v / v_eps)` on the displacer, `-Fcp tanh(w / v_eps)` on the piston;
+//! - end stops: `-kc relu(|q| - q_max) sign(q)` with `relu(u) = (u + |u|)/2`;
+//! - quadratic regenerator friction (`nsection` only): `quadratic: Rq` on the regenerator links,
+//!   split like `Rf` (`Rq/(2n)` at the ends, `Rq/n` between sections).
+
+use crate::family::engine::engine_model;
+
+engine_model! {
+    /// `cv1` with the DSL-expressible effects (leak, Coulomb friction, end stops) at null values.
+    model Cv1Fx with {
+        displacer { , force: -Fcd * tanh(v / v_eps) - kc * ((abs(x) - xmax) + abs(abs(x) - xmax)) / 2.0 * sign(x) }
+        piston { , force: -Fcp * tanh(w / v_eps) - kc * ((abs(y) - ymax) + abs(abs(y) - ymax)) / 2.0 * sign(y) }
+        bounce { , temperature: Tk }
+    } {
+        name "cv1_fx";
+        params {
+            /// seal-leak conductance, cold space to bounce space (0: no leak)
+            Gleak: 0.0 "kg/(s Pa)",
+            /// displacer Coulomb friction force (0: none)
+            Fcd: 0.0 "N",
+            /// power-piston Coulomb friction force (0: none)
+            Fcp: 0.0 "N",
+            /// velocity scale of the smoothed Coulomb friction
+            v_eps: 1.0e-3 "m/s",
+            /// end-stop contact stiffness (0: no stops)
+            kc: 0.0 "N/m",
+            /// displacer travel to its end stops
+            xmax: 0.01 "m",
+            /// power-piston travel to its end stops
+            ymax: 0.01 "m",
+        }
+        cv gas {
+            volume: Vh0 + Vc0 + Vr,
+            faces { displacer: -A + (A - Ar), piston: -(A - Ar) },
+            port hot { h: hh, area: Awh0 - pi * D * x, wall: Th },
+            port cold { h: hk, area: Awc0 + pi * D * (x - y), wall: Tk },
+            port regen { h: hr, area: Awr, wall: (Th + Tk) / 2.0 },
+        }
+        link gas -> bounce { conductance: Gleak }
+    }
+}
+
+engine_model! {
+    /// `nsection` with all DSL-expressible effects (leak, Coulomb friction, end stops,
+    /// quadratic regenerator friction) at null values.
+    model NSectionFx with {
+        displacer { , force: -Fcd * tanh(v / v_eps) - kc * ((abs(x) - xmax) + abs(abs(x) - xmax)) / 2.0 * sign(x) }
+        piston { , force: -Fcp * tanh(w / v_eps) - kc * ((abs(y) - ymax) + abs(abs(y) - ymax)) / 2.0 * sign(y) }
+        bounce { , temperature: Tk }
+    } {
+        name "nsection_fx";
+        params {
+            /// seal-leak conductance, cold space to bounce space (0: no leak)
+            Gleak: 0.0 "kg/(s Pa)",
+            /// displacer Coulomb friction force (0: none)
+            Fcd: 0.0 "N",
+            /// power-piston Coulomb friction force (0: none)
+            Fcp: 0.0 "N",
+            /// velocity scale of the smoothed Coulomb friction
+            v_eps: 1.0e-3 "m/s",
+            /// end-stop contact stiffness (0: no stops)
+            kc: 0.0 "N/m",
+            /// displacer travel to its end stops
+            xmax: 0.01 "m",
+            /// power-piston travel to its end stops
+            ymax: 0.01 "m",
+            /// quadratic (turbulent) regenerator friction, whole regenerator (0: linear only)
+            Rq: 0.0 "Pa s^2/kg^2",
+        }
+        cv hot {
+            volume: Vh0,
+            faces { displacer: -A },
+            port hot { h: hh, area: Awh0 - pi * D * x, wall: Th },
+        }
+        cv regen[n] {
+            volume: Vr / n,
+            port wall { h: hr, area: Awr / n, wall: Th - (j + 0.5) * (Th - Tk) / n },
+        }
+        cv cold {
+            volume: Vc0,
+            faces { displacer: A - Ar, piston: -(A - Ar) },
+            port cold { h: hk, area: Awc0 + pi * D * (x - y), wall: Tk },
+        }
+        link hot -> regen[0] { resistance: Rf / (2.0 * n), quadratic: Rq / (2.0 * n) }
+        link regen[j] -> regen[j + 1] for j in 0..n - 1 { resistance: Rf / n, quadratic: Rq / n }
+        link regen[n - 1] -> cold { resistance: Rf / (2.0 * n), quadratic: Rq / (2.0 * n) }
+        link cold -> bounce { conductance: Gleak }
+    }
+}

@@ -1,0 +1,284 @@
+//! The seed's two driven subsystems (its Figures 3-5):
+//! - stage 1, mechanics: the body states integrated with the pressure states prescribed from
+//!   the measured pressures (`p` on the cold side, `p_hot` on the hot side, sections in
+//!   between interpolated linearly); fitted: the free mechanical parameters, the initial body
+//!   states, the position offsets (which also absorb the static shift caused by any pressure
+//!   offset, since a constant force only moves the mean position);
+//! - stage 2, gas: the gas states integrated with the body states prescribed from the measured
+//!   positions (offsets removed) and velocities from a smoothing (Savitzky-Golay, quartic)
+//!   derivative; fitted: the free gas parameters and the pressure offsets. A pressure offset
+//!   also moves the stage-1 position offsets by the static response `-J_qq^-1 J_qP off`, so the
+//!   prescribed positions depend on it and its sensitivity column carries that input term.
+//!
+//! Gradients are forward sensitivities ([`super::sensitivity`]) on the generated Jacobians.
+
+use nalgebra::{DMatrix, DVector};
+use stirling_dsl::{Model, StateKind};
+
+use super::sensitivity::{Column, Driven, Given, Signal};
+use super::FitError;
+use crate::sim::{integrate, state_scale, Hooks, SimOptions};
+
+/// Savitzky-Golay smoothing (local polynomial of `degree` over `2h+1` samples): value and
+/// first derivative at every sample (windows shifted inside the record at the ends).
+pub fn savitzky_golay(y: &[f64], dt: f64, h: usize, degree: usize) -> (Vec<f64>, Vec<f64>) {
+    let n = y.len();
+    let h = h.min((n - 1) / 2).max(1);
+    let w = 2 * h + 1;
+    let deg = degree.min(w - 1);
+    // weights for evaluation point at offset `c` from the window start
+    let a = DMatrix::from_fn(w, deg + 1, |i, k| ((i as f64 - h as f64) / h as f64).powi(k as i32));
+    let pinv = (a.transpose() * &a).try_inverse().expect("Vandermonde of distinct points") * a.transpose();
+    let weights = |c: usize| -> (DVector<f64>, DVector<f64>) {
+        let s = (c as f64 - h as f64) / h as f64;
+        let v = DVector::from_fn(deg + 1, |k, _| s.powi(k as i32));
+        let d = DVector::from_fn(deg + 1, |k, _| if k == 0 { 0.0 } else { k as f64 * s.powi(k as i32 - 1) / (h as f64 * dt) });
+        (pinv.transpose() * v, pinv.transpose() * d)
+    };
+    let mid = weights(h);
+    let mut val = vec![0.0; n];
+    let mut der = vec![0.0; n];
+    for i in 0..n {
+        let start = i.saturating_sub(h).min(n - w);
+        let c = i - start;
+        let owned;
+        let (wv, wd) = if c == h {
+            (&mid.0, &mid.1)
+        } else {
+            owned = weights(c);
+            (&owned.0, &owned.1)
+        };
+        let seg = &y[start..start + w];
+        val[i] = seg.iter().zip(wv.iter()).map(|(a, b)| a * b).sum();
+        der[i] = seg.iter().zip(wd.iter()).map(|(a, b)| a * b).sum();
+    }
+    (val, der)
+}
+
+/// Noise standard deviation from third differences (the smooth signal cancels).
+pub fn noise_sigma(y: &[f64]) -> f64 {
+    if y.len() < 5 {
+        return 0.0;
+    }
+    let mut d: Vec<f64> = (0..y.len() - 3).map(|i| (y[i + 3] - 3.0 * y[i + 2] + 3.0 * y[i + 1] - y[i]).abs()).collect();
+    d.sort_by(f64::total_cmp);
+    d[d.len() / 2] / 0.6745 / 20f64.sqrt()
+}
+
+/// One fit variable.
+#[derive(Clone, Debug)]
+pub struct Var {
+    pub name: String,
+    pub initial: f64,
+    pub scale: f64,
+    pub kind: VarKind,
+}
+
+/// What a fit variable is.
+#[derive(Clone, Debug)]
+pub enum VarKind {
+    /// A model parameter.
+    Param(usize),
+    /// The initial value of free state number `pos`.
+    Initial(usize),
+    /// An additive offset of output `out`; `du` (per [`Given`], may be empty) is how the
+    /// prescribed inputs move per unit of the offset.
+    Offset { out: usize, du: Vec<f64> },
+}
+
+/// A measured output: free state number `pos` plus its offsets.
+#[derive(Clone, Debug)]
+pub struct Output {
+    pub channel: String,
+    pub pos: usize,
+    pub data: Vec<f64>,
+    pub sigma: f64,
+}
+
+/// A driven-subsystem fitting problem on a uniform record.
+pub struct Stage<'a> {
+    pub name: &'static str,
+    pub model: &'a dyn Model,
+    pub p: Vec<f64>,
+    pub base: Vec<f64>,
+    pub free: Vec<usize>,
+    pub given: Vec<Given>,
+    pub signals: Vec<Signal>,
+    pub z0: Vec<f64>,
+    pub vars: Vec<Var>,
+    pub outputs: Vec<Output>,
+    /// Record time of sample 0 and the interval.
+    pub t0: f64,
+    pub dt: f64,
+    pub sim: SimOptions,
+}
+
+/// Simulated outputs (rows: samples of the window) and their derivatives.
+pub struct StageRun {
+    /// Sample indices of the window.
+    pub first: usize,
+    pub yhat: Vec<Vec<f64>>,
+    /// `dyhat[o][k][v]`: output `o`, sample `k`, variable `v` (empty without sensitivities).
+    pub dyhat: Vec<Vec<Vec<f64>>>,
+}
+
+impl Stage<'_> {
+    /// Values of the variables at `u`.
+    pub fn values(&self, u: &[f64]) -> Vec<f64> {
+        self.vars.iter().zip(u).map(|(v, u)| v.initial + v.scale * u).collect()
+    }
+
+    /// Simulate sample indices `first..last` (inclusive), with sensitivities if asked.
+    pub fn run(&self, u: &[f64], first: usize, last: usize, sens: bool) -> Result<StageRun, FitError> {
+        let th = self.values(u);
+        let mut p = self.p.clone();
+        let mut z0 = self.z0.clone();
+        let mut given = self.given.clone();
+        let mut columns = Vec::new();
+        let mut col_of = vec![None; self.vars.len()];
+        for (k, (v, &val)) in self.vars.iter().zip(&th).enumerate() {
+            match &v.kind {
+                VarKind::Param(i) => {
+                    p[*i] = val;
+                    col_of[k] = Some(columns.len());
+                    columns.push(Column::Param { index: *i, scale: v.scale });
+                }
+                VarKind::Initial(pos) => {
+                    z0[*pos] = val;
+                    col_of[k] = Some(columns.len());
+                    columns.push(Column::Initial { pos: *pos, scale: v.scale });
+                }
+                VarKind::Offset { du, .. } => {
+                    if !du.is_empty() {
+                        for (g, d) in given.iter_mut().zip(du) {
+                            g.constant += d * val;
+                        }
+                        col_of[k] = Some(columns.len());
+                        columns.push(Column::Input { du: du.clone(), scale: v.scale });
+                    }
+                }
+            }
+        }
+        if !sens {
+            columns.clear();
+        }
+        let t_start = self.t0 + first as f64 * self.dt;
+        let signals: Vec<Signal> = self.signals.iter().map(|s| Signal { t0: s.t0 - t_start, ..s.clone() }).collect();
+        let zscale: Vec<f64> = {
+            let s = state_scale(self.model, &p);
+            self.free.iter().map(|&i| s[i]).collect()
+        };
+        let sys = Driven { model: self.model, p, base: self.base.clone(), free: self.free.clone(), given, signals, columns, zscale };
+        let x0 = sys.initial(&z0);
+        let samples: Vec<f64> = (0..=last - first).map(|k| k as f64 * self.dt).collect();
+        let t_end = samples[samples.len() - 1].max(self.dt);
+        let traj = integrate(&sys, &x0, t_end, &samples, &self.sim, Hooks::default()).map_err(|e| FitError::Sim(self.name.to_string(), e.to_string()))?;
+        let nz = self.free.len();
+        let mut yhat = vec![Vec::new(); self.outputs.len()];
+        let mut dyhat = vec![Vec::new(); self.outputs.len()];
+        for row in &traj.x {
+            for (o, out) in self.outputs.iter().enumerate() {
+                let mut y = row[out.pos];
+                let mut d = vec![0.0; if sens { self.vars.len() } else { 0 }];
+                for (k, v) in self.vars.iter().enumerate() {
+                    if let VarKind::Offset { out: oo, .. } = v.kind {
+                        if oo == o {
+                            y += th[k];
+                            if sens {
+                                d[k] += v.scale;
+                            }
+                        }
+                    }
+                    if sens {
+                        if let Some(c) = col_of[k] {
+                            d[k] += row[nz + c * nz + out.pos];
+                        }
+                    }
+                }
+                yhat[o].push(y);
+                if sens {
+                    dyhat[o].push(d);
+                }
+            }
+        }
+        Ok(StageRun { first, yhat, dyhat })
+    }
+
+    /// Weighted residuals and Jacobian on the sample indices `keep` (within `first..=last`).
+    pub fn residuals(&self, u: &[f64], first: usize, last: usize, keep: &[usize]) -> Result<(Vec<f64>, DMatrix<f64>), FitError> {
+        let run = self.run(u, first, last, true)?;
+        let nv = self.vars.len();
+        let rows = keep.len() * self.outputs.len();
+        let mut r = Vec::with_capacity(rows);
+        let mut j = DMatrix::zeros(rows, nv);
+        let mut row = 0;
+        for (o, out) in self.outputs.iter().enumerate() {
+            for &i in keep {
+                let k = i - first;
+                r.push((run.yhat[o][k] - out.data[i]) / out.sigma);
+                for v in 0..nv {
+                    j[(row, v)] = run.dyhat[o][k][v] / out.sigma;
+                }
+                row += 1;
+            }
+        }
+        Ok((r, j))
+    }
+}
+
+/// Indices of the body states (positions and velocities) and of the gas states.
+pub fn split_states(model: &dyn Model) -> (Vec<usize>, Vec<usize>) {
+    let mut bodies = Vec::new();
+    let mut gas = Vec::new();
+    for (i, s) in model.states().iter().enumerate() {
+        match s.kind {
+            StateKind::Position(_) | StateKind::Velocity(_) => bodies.push(i),
+            _ => gas.push(i),
+        }
+    }
+    (bodies, gas)
+}
+
+/// Indices of the pressure states, in CV order.
+pub fn pressure_states(model: &dyn Model) -> Vec<usize> {
+    model.states().iter().enumerate().filter(|(_, s)| matches!(s.kind, StateKind::Pressure(_))).map(|(i, _)| i).collect()
+}
+
+/// Weight of the cold-side channel in the prescribed pressure of CV `i` of `ncv` (hot = 0).
+pub fn cold_weight(i: usize, ncv: usize, have_hot: bool) -> f64 {
+    if !have_hot || ncv < 2 {
+        1.0
+    } else {
+        i as f64 / (ncv - 1) as f64
+    }
+}
+
+/// Static shift of the body positions per unit pressure offset on the cold and hot channels:
+/// `dq = -J_aq^-1 J_aP off` (rows: the velocity equations; columns: positions, pressures).
+pub fn static_shift(model: &dyn Model, p: &[f64], have_hot: bool) -> Result<[Vec<f64>; 2], FitError> {
+    let n = model.n_states();
+    let mut eq = vec![0.0; n];
+    model.equilibrium_guess(p, &mut eq);
+    let j = model.jacobian_dense(p, &eq, 0.0);
+    let st = model.states();
+    let pos: Vec<usize> = st.iter().enumerate().filter(|(_, s)| matches!(s.kind, StateKind::Position(_))).map(|(i, _)| i).collect();
+    let vel: Vec<usize> = st.iter().enumerate().filter(|(_, s)| matches!(s.kind, StateKind::Velocity(_))).map(|(i, _)| i).collect();
+    let ps = pressure_states(model);
+    let jaq = DMatrix::from_fn(vel.len(), pos.len(), |r, c| j[vel[r] + n * pos[c]]);
+    let lu = jaq.lu();
+    let mut out = [Vec::new(), Vec::new()];
+    for (ch, o) in out.iter_mut().enumerate() {
+        let rhs = DVector::from_fn(vel.len(), |r, _| {
+            ps.iter()
+                .enumerate()
+                .map(|(i, &pi)| {
+                    let wc = cold_weight(i, ps.len(), have_hot);
+                    j[vel[r] + n * pi] * if ch == 0 { wc } else { 1.0 - wc }
+                })
+                .sum::<f64>()
+        });
+        let dq = lu.solve(&(-rhs)).ok_or_else(|| FitError::Bad("the static stiffness of the bodies is singular".into()))?;
+        *o = dq.iter().copied().collect();
+    }
+    Ok(out)
+}

@@ -1,0 +1,136 @@
+//! A small Levenberg-Marquardt (Marquardt's diagonal scaling, Nielsen's damping update).
+//!
+//! Why not a crate: `levenberg-marquardt` (rust-cv, the maintained one) is built on nalgebra
+//! 0.33/0.34 while the workspace pins 0.35 (diffsol's), so it would pull a second nalgebra and
+//! convert at the boundary; and our residuals and Jacobians come together from one
+//! sensitivity integration that can fail (a nonphysical trial), which its trait cannot report.
+
+use nalgebra::{DMatrix, DVector};
+
+/// Residuals and their Jacobian (rows: residuals, columns: variables); `None` when the
+/// trial point cannot be evaluated (the step is then rejected).
+pub type Eval<'a> = dyn FnMut(&[f64]) -> Option<(Vec<f64>, DMatrix<f64>)> + 'a;
+
+/// Options.
+#[derive(Clone, Copy, Debug)]
+pub struct LmOptions {
+    pub max_iter: usize,
+    /// Stop when the relative decrease of the cost is below this.
+    pub ftol: f64,
+    /// Stop when the step is below this (in the variables' units).
+    pub xtol: f64,
+    pub lambda0: f64,
+}
+
+impl Default for LmOptions {
+    fn default() -> Self {
+        Self { max_iter: 50, ftol: 1e-10, xtol: 1e-9, lambda0: 1e-3 }
+    }
+}
+
+/// The result.
+#[derive(Clone, Debug)]
+pub struct LmResult {
+    pub x: Vec<f64>,
+    pub residuals: Vec<f64>,
+    pub jacobian: DMatrix<f64>,
+    /// `sum r^2 / 2`.
+    pub cost: f64,
+    pub iterations: usize,
+    pub evaluations: usize,
+    pub converged: bool,
+}
+
+/// Minimize `|r(x)|^2 / 2` from `x0`.
+pub fn minimize(eval: &mut Eval, x0: &[f64], opts: &LmOptions) -> Option<LmResult> {
+    let mut x = x0.to_vec();
+    let (mut r, mut jm) = eval(&x)?;
+    let mut evals = 1;
+    let cost = |r: &[f64]| r.iter().map(|v| v * v).sum::<f64>() / 2.0;
+    let mut c = cost(&r);
+    let mut lambda = opts.lambda0;
+    let mut nu = 2.0;
+    let mut converged = false;
+    let mut it = 0;
+    while it < opts.max_iter {
+        it += 1;
+        let jtj = jm.transpose() * &jm;
+        let g = jm.transpose() * DVector::from_column_slice(&r);
+        let mut accepted = false;
+        for _ in 0..30 {
+            let mut a = jtj.clone();
+            for i in 0..a.nrows() {
+                a[(i, i)] += lambda * jtj[(i, i)].max(1e-12);
+            }
+            let Some(ch) = a.cholesky() else {
+                lambda *= nu;
+                nu *= 2.0;
+                continue;
+            };
+            let step = ch.solve(&(-&g));
+            let xn: Vec<f64> = x.iter().zip(step.iter()).map(|(a, b)| a + b).collect();
+            let pred = -(step.dot(&g) + 0.5 * (step.transpose() * &jtj * &step)[(0, 0)]);
+            evals += 1;
+            if let Some((rn, jn)) = eval(&xn) {
+                let cn = cost(&rn);
+                if cn < c {
+                    let rho = if pred > 0.0 { (c - cn) / pred } else { 1.0 };
+                    lambda *= (1.0f64 / 3.0).max(1.0 - (2.0 * rho - 1.0).powi(3));
+                    nu = 2.0;
+                    let small_step = step.amax() < opts.xtol;
+                    let small_gain = (c - cn) < opts.ftol * c;
+                    x = xn;
+                    r = rn;
+                    jm = jn;
+                    c = cn;
+                    accepted = true;
+                    if small_step || small_gain {
+                        converged = true;
+                    }
+                    break;
+                }
+            }
+            lambda *= nu;
+            nu *= 2.0;
+        }
+        if !accepted {
+            // no decrease possible along any damped step: at a minimum to working precision
+            converged = true;
+            break;
+        }
+        if converged {
+            break;
+        }
+    }
+    Some(LmResult { x, residuals: r, jacobian: jm, cost: c, iterations: it, evaluations: evals, converged })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn fits_an_exponential() {
+        // y = a exp(b t), a = 2, b = -1.5
+        let t: Vec<f64> = (0..40).map(|k| k as f64 * 0.1).collect();
+        let y: Vec<f64> = t.iter().map(|t| 2.0 * (-1.5 * t).exp()).collect();
+        let mut f = |p: &[f64]| {
+            let r: Vec<f64> = t.iter().zip(&y).map(|(t, y)| p[0] * (p[1] * t).exp() - y).collect();
+            let j = DMatrix::from_fn(t.len(), 2, |i, k| if k == 0 { (p[1] * t[i]).exp() } else { p[0] * t[i] * (p[1] * t[i]).exp() });
+            Some((r, j))
+        };
+        let res = minimize(&mut f, &[1.0, -0.5], &LmOptions::default()).unwrap();
+        assert!((res.x[0] - 2.0).abs() < 1e-8 && (res.x[1] + 1.5).abs() < 1e-8, "{:?}", res.x);
+    }
+
+    #[test]
+    fn rosenbrock() {
+        let mut f = |p: &[f64]| {
+            let r = vec![10.0 * (p[1] - p[0] * p[0]), 1.0 - p[0]];
+            let j = DMatrix::from_row_slice(2, 2, &[-20.0 * p[0], 10.0, -1.0, 0.0]);
+            Some((r, j))
+        };
+        let res = minimize(&mut f, &[-1.2, 1.0], &LmOptions { max_iter: 200, ..Default::default() }).unwrap();
+        assert!((res.x[0] - 1.0).abs() < 1e-6 && (res.x[1] - 1.0).abs() < 1e-6, "{:?}", res.x);
+    }
+}

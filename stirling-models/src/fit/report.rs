@@ -1,0 +1,93 @@
+//! The fit report: estimates, standard errors, 95 % intervals, correlations, a collinearity
+//! warning, and the fit percentage `100 (1 - |y - yhat| / |y - mean y|)` per channel.
+
+use nalgebra::DMatrix;
+use serde::Serialize;
+
+/// One estimated quantity.
+#[derive(Clone, Debug, Serialize)]
+pub struct Estimate {
+    pub name: String,
+    pub initial: f64,
+    pub value: f64,
+    pub std_error: f64,
+    pub ci_low: f64,
+    pub ci_high: f64,
+    /// A model parameter (false: an offset or an initial state).
+    pub model_param: bool,
+}
+
+impl Estimate {
+    /// Whether `v` lies in the 95 % interval.
+    pub fn covers(&self, v: f64) -> bool {
+        self.ci_low <= v && v <= self.ci_high
+    }
+}
+
+/// Fit percentage of one channel on one block.
+#[derive(Clone, Debug, Serialize)]
+pub struct ChannelFit {
+    pub channel: String,
+    pub block: String,
+    pub fit_percent: f64,
+    pub rms: f64,
+    pub samples: usize,
+}
+
+/// The statistics of a least-squares fit.
+#[derive(Clone, Debug, Serialize)]
+pub struct FitStats {
+    pub estimates: Vec<Estimate>,
+    pub correlation: Vec<Vec<f64>>,
+    /// Pairs with |correlation| above 0.95, and a conditioning note.
+    pub warnings: Vec<String>,
+    /// Residual variance factor `s^2 = RSS / (N - k)` (about 1 when the noise model holds).
+    pub sigma2: f64,
+    pub samples: usize,
+}
+
+/// `100 (1 - |y - yhat| / |y - mean y|)`.
+pub fn fit_percent(y: &[f64], yhat: &[f64]) -> f64 {
+    let m = y.iter().sum::<f64>() / y.len().max(1) as f64;
+    let e: f64 = y.iter().zip(yhat).map(|(a, b)| (a - b) * (a - b)).sum::<f64>().sqrt();
+    let d: f64 = y.iter().map(|a| (a - m) * (a - m)).sum::<f64>().sqrt();
+    100.0 * (1.0 - e / d)
+}
+
+/// Estimates and correlations from the Jacobian of the weighted residuals `r` with respect to
+/// variables `u`, where quantity `k` is `initial_k + scale_k u_k`.
+pub fn stats(names: &[(String, bool)], initial: &[f64], scale: &[f64], u: &[f64], r: &[f64], j: &DMatrix<f64>) -> FitStats {
+    let (nr, k) = (r.len(), u.len());
+    let rss: f64 = r.iter().map(|v| v * v).sum();
+    let sigma2 = rss / (nr.saturating_sub(k)).max(1) as f64;
+    let jtj = j.transpose() * j;
+    // invert on the unit-diagonal scaling for conditioning
+    let d: Vec<f64> = (0..k).map(|i| jtj[(i, i)].max(1e-300).sqrt()).collect();
+    let scaled = DMatrix::from_fn(k, k, |a, b| jtj[(a, b)] / (d[a] * d[b]));
+    let inv = scaled.clone().try_inverse().unwrap_or_else(|| scaled.clone().pseudo_inverse(1e-14).expect("svd"));
+    let cov = DMatrix::from_fn(k, k, |a, b| sigma2 * inv[(a, b)] / (d[a] * d[b]));
+    let mut estimates = Vec::new();
+    for i in 0..k {
+        let se = cov[(i, i)].max(0.0).sqrt() * scale[i].abs();
+        let v = initial[i] + scale[i] * u[i];
+        estimates.push(Estimate { name: names[i].0.clone(), initial: initial[i], value: v, std_error: se, ci_low: v - 1.96 * se, ci_high: v + 1.96 * se, model_param: names[i].1 });
+    }
+    let correlation: Vec<Vec<f64>> = (0..k).map(|a| (0..k).map(|b| cov[(a, b)] / (cov[(a, a)] * cov[(b, b)]).sqrt()).collect()).collect();
+    let mut warnings = Vec::new();
+    for a in 0..k {
+        for b in a + 1..k {
+            if correlation[a][b].abs() > 0.95 {
+                warnings.push(format!(
+                    "`{}` and `{}` are nearly collinear (correlation {:.3}): the data cannot separate them; fix one or add excitation",
+                    names[a].0, names[b].0, correlation[a][b]
+                ));
+            }
+        }
+    }
+    let ev = scaled.symmetric_eigen().eigenvalues;
+    let (lo, hi) = ev.iter().fold((f64::INFINITY, 0.0f64), |(l, h), &e| (l.min(e), h.max(e)));
+    if lo <= hi * 1e-10 {
+        warnings.push(format!("the scaled information matrix is ill-conditioned (condition number {:.2e}): some combination of the free parameters is not identifiable", hi / lo.max(1e-300)));
+    }
+    FitStats { estimates, correlation, warnings, sigma2, samples: nr }
+}

@@ -1,0 +1,229 @@
+//! The virtual test rig: a truth model (the augmented family member with chosen effects),
+//! simulated from a perturbed equilibrium, sampled at a rate, passed through the sensor
+//! effects (pressure lag, position gain errors), offsets and seeded Gaussian noise.
+//!
+//! Outputs: `p` (cold-side CV pressure), `p_hot` (hot-side CV pressure, multi-CV models),
+//! `x`, `y`. The truth (parameters, effects, seed, noise, offsets) goes to a JSON sidecar.
+
+use std::path::{Path, PathBuf};
+
+use rand::{rngs::StdRng, Rng, SeedableRng};
+use serde::Serialize;
+use stirling_dsl::{Closure, Model, StateKind};
+
+use crate::data::{write_csv, Measured};
+use crate::effects::{augmented, EffectSettings};
+use crate::sim::{simulate, SimOptions};
+
+/// What the rig runs.
+#[derive(Clone, Debug, Serialize)]
+pub struct RigConfig {
+    /// Base model (`cv1`, `nsection`, or an alias).
+    pub model: String,
+    pub n: Option<usize>,
+    /// Parameter overrides `NAME=VALUE` (model parameters).
+    pub set: Vec<String>,
+    /// Effect settings `NAME=VALUE` (an effect name sets its strength, or an effect parameter).
+    pub effects: Vec<String>,
+    /// Record length (s) after settling.
+    pub t_end: f64,
+    /// Simulated time discarded before the record starts (s).
+    pub settle: f64,
+    /// Sample rate (Hz).
+    pub rate: f64,
+    /// Pressure noise standard deviation (Pa).
+    pub noise_p: f64,
+    /// Position noise standard deviation (m).
+    pub noise_x: f64,
+    /// Sensor offsets added to `p` and `p_hot` (Pa), `x`, `y` (m).
+    pub offset_p: f64,
+    pub offset_x: f64,
+    pub offset_y: f64,
+    /// Initial displacement of the displacer from rest (m).
+    pub x0: f64,
+    pub seed: u64,
+}
+
+impl Default for RigConfig {
+    fn default() -> Self {
+        Self {
+            model: "cv1".into(),
+            n: None,
+            set: Vec::new(),
+            effects: Vec::new(),
+            t_end: 1.0,
+            settle: 0.0,
+            rate: 2000.0,
+            noise_p: 50.0,
+            noise_x: 20e-6,
+            offset_p: 0.0,
+            offset_x: 0.0,
+            offset_y: 0.0,
+            x0: 2e-3,
+            seed: 1,
+        }
+    }
+}
+
+/// The truth sidecar.
+#[derive(Clone, Debug, Serialize)]
+pub struct Truth {
+    /// Augmented model name (e.g. `nsection_fx`) and its base.
+    pub model: String,
+    pub base: String,
+    pub n: usize,
+    /// Every parameter of the truth model.
+    pub parameters: std::collections::BTreeMap<String, f64>,
+    /// Effect settings and the effects switched on.
+    pub effects: EffectSettings,
+    pub active_effects: Vec<String>,
+    pub seed: u64,
+    pub noise: Noise,
+    pub offsets: std::collections::BTreeMap<String, f64>,
+    pub rate: f64,
+    pub t_end: f64,
+    pub settle: f64,
+    pub x0: f64,
+}
+
+/// Sensor noise levels.
+#[derive(Clone, Copy, Debug, Serialize)]
+pub struct Noise {
+    pub p: f64,
+    pub x: f64,
+}
+
+/// A rig run.
+#[derive(Clone, Debug)]
+pub struct RigOutput {
+    pub data: Measured,
+    pub truth: Truth,
+}
+
+/// Why the rig could not run.
+#[derive(Debug, thiserror::Error)]
+pub enum RigError {
+    #[error(transparent)]
+    Effect(#[from] crate::effects::EffectError),
+    #[error(transparent)]
+    Params(#[from] crate::params::ParamError),
+    #[error("simulation of the truth model failed: {0}")]
+    Sim(#[from] crate::sim::SimError),
+    #[error("{0}")]
+    Bad(String),
+    #[error("`{0}` exists: pass --force to overwrite")]
+    Exists(PathBuf),
+    #[error("cannot write `{0}`: {1}")]
+    Io(PathBuf, std::io::Error),
+}
+
+/// Gaussian samples by Box-Muller on a seeded generator.
+struct Gauss(StdRng);
+
+impl Gauss {
+    fn next(&mut self) -> f64 {
+        let u1: f64 = 1.0 - self.0.gen::<f64>();
+        let u2: f64 = self.0.gen::<f64>();
+        (-2.0 * u1.ln()).sqrt() * (2.0 * std::f64::consts::PI * u2).cos()
+    }
+}
+
+/// Indices of the cold-side and hot-side pressure states (last and first CV).
+pub fn pressure_states(model: &dyn Model) -> (usize, usize) {
+    let ps: Vec<usize> = model.states().iter().enumerate().filter(|(_, s)| matches!(s.kind, StateKind::Pressure(_))).map(|(i, _)| i).collect();
+    (*ps.last().expect("a CV model"), ps[0])
+}
+
+/// Exact first-order-hold discretization of `tau y' = u - y` on a uniform grid.
+pub fn first_order_lag(u: &[f64], dt: f64, tau: f64) -> Vec<f64> {
+    if tau <= 0.0 || u.is_empty() {
+        return u.to_vec();
+    }
+    let a = (-dt / tau).exp();
+    let c = 1.0 - tau / dt * (1.0 - a);
+    let mut y = vec![u[0]; u.len()];
+    for k in 1..u.len() {
+        y[k] = a * y[k - 1] + (1.0 - a) * u[k - 1] + c * (u[k] - u[k - 1]);
+    }
+    y
+}
+
+/// Run the rig.
+pub fn run(cfg: &RigConfig) -> Result<RigOutput, RigError> {
+    if !(cfg.t_end > 0.0 && cfg.rate > 0.0 && cfg.settle >= 0.0) {
+        return Err(RigError::Bad(format!("need --t-end > 0, --rate > 0, --settle >= 0 (got {}, {}, {})", cfg.t_end, cfg.rate, cfg.settle)));
+    }
+    if !(cfg.noise_p >= 0.0 && cfg.noise_x >= 0.0) {
+        return Err(RigError::Bad("noise levels must be non-negative".into()));
+    }
+    let model = augmented(&cfg.model, cfg.n, Closure::Full)?;
+    let fx = EffectSettings::parse(&cfg.model, &cfg.effects)?;
+    let mut p = crate::params::load(model.as_ref(), None, &cfg.set)?;
+    fx.apply(model.as_ref(), &mut p)?;
+    let mut x0 = vec![0.0; model.n_states()];
+    model.equilibrium_guess(&p, &mut x0);
+    x0[0] += cfg.x0;
+    let count = (cfg.t_end * cfg.rate).round() as usize;
+    let dt = 1.0 / cfg.rate;
+    let samples: Vec<f64> = (0..=count).map(|k| cfg.settle + k as f64 * dt).collect();
+    let opts = SimOptions { rtol: 1e-8, atol: 1e-8, ..Default::default() };
+    let traj = simulate(model.as_ref(), &p, &x0, cfg.settle + count as f64 * dt, &samples, &opts)?;
+    let (ic, ih) = pressure_states(model.as_ref());
+    let ncv = model.states().iter().filter(|s| matches!(s.kind, StateKind::Pressure(_))).count();
+    let col = |i: usize| traj.x.iter().map(|r| r[i]).collect::<Vec<f64>>();
+    let tau = fx.sensor_value("tau_p");
+    let (gx, gy) = (fx.sensor_value("gain_x"), fx.sensor_value("gain_y"));
+    let mut g = Gauss(StdRng::seed_from_u64(cfg.seed));
+    let mut noisy = |v: Vec<f64>, gain: f64, off: f64, sd: f64| v.into_iter().map(|s| (1.0 + gain) * s + off + sd * g.next()).collect::<Vec<f64>>();
+    let pc = noisy(first_order_lag(&col(ic), dt, tau), 0.0, cfg.offset_p, cfg.noise_p);
+    let ph = if ncv > 1 { Some(noisy(first_order_lag(&col(ih), dt, tau), 0.0, cfg.offset_p, cfg.noise_p)) } else { None };
+    let x = noisy(col(0), gx, cfg.offset_x, cfg.noise_x);
+    let y = noisy(col(2), gy, cfg.offset_y, cfg.noise_x);
+    let t: Vec<f64> = (0..=count).map(|k| k as f64 * dt).collect();
+    let data = Measured { source: format!("rig:{}", model.name()), t, p: Some(pc), p_hot: ph, x: Some(x), y: Some(y) };
+    let parameters = model.params().iter().zip(&p).map(|(i, v)| (i.name.to_string(), *v)).collect();
+    let offsets = [("p", cfg.offset_p), ("p_hot", cfg.offset_p), ("x", cfg.offset_x), ("y", cfg.offset_y)].into_iter().map(|(k, v)| (k.to_string(), v)).collect();
+    let truth = Truth {
+        model: model.name().to_string(),
+        base: cfg.model.clone(),
+        n: model.n(),
+        parameters,
+        active_effects: fx.active().into_iter().map(String::from).collect(),
+        effects: fx,
+        seed: cfg.seed,
+        noise: Noise { p: cfg.noise_p, x: cfg.noise_x },
+        offsets,
+        rate: cfg.rate,
+        t_end: cfg.t_end,
+        settle: cfg.settle,
+        x0: cfg.x0,
+    };
+    Ok(RigOutput { data, truth })
+}
+
+/// The sidecar path of a CSV: `FILE.truth.json`.
+pub fn sidecar_path(csv: &Path) -> PathBuf {
+    let mut s = csv.as_os_str().to_owned();
+    s.push(".truth.json");
+    PathBuf::from(s)
+}
+
+/// Write the CSV and its sidecar; refuses to overwrite either unless `force`.
+pub fn write(out: &RigOutput, path: &Path, force: bool) -> Result<PathBuf, RigError> {
+    let side = sidecar_path(path);
+    for f in [path, side.as_path()] {
+        if f.exists() && !force {
+            return Err(RigError::Exists(f.to_path_buf()));
+        }
+    }
+    let tr = &out.truth;
+    let comments = vec![
+        format!("stirling rig: truth model {} (n = {}), effects: {}", tr.model, tr.n, if tr.active_effects.is_empty() { "none".to_string() } else { tr.active_effects.join(", ") }),
+        format!("rate {} Hz, noise p {} Pa, x {} m, seed {}; truth in {}", tr.rate, tr.noise.p, tr.noise.x, tr.seed, side.display()),
+        "columns: t [s], p cold-side pressure [Pa], p_hot hot-side pressure [Pa], x displacer [m], y piston [m]".to_string(),
+    ];
+    write_csv(path, &out.data, &comments).map_err(|e| RigError::Io(path.to_path_buf(), e))?;
+    let json = serde_json::to_string_pretty(&out.truth).expect("serializable");
+    std::fs::write(&side, json).map_err(|e| RigError::Io(side.clone(), e))?;
+    Ok(side)
+}
