@@ -254,6 +254,8 @@ fn main() {
             }
             Err(e) => json!({"ok": false, "error": e.to_string(), "seconds": med, "runs": runs}),
         })
+    } else {
+        None
     };
 
     if as_json {

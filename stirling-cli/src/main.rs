@@ -3,6 +3,8 @@
 mod common;
 mod cmd_models;
 // <mods>
+mod cmd_rig;
+mod cmd_fit;
 mod cmd_linearize;
 mod cmd_locus;
 mod cmd_simulate;
@@ -27,6 +29,10 @@ enum Command {
         json: bool,
     },
     // <commands>
+    /// Virtual test rig: truth model plus effects, noise and offsets -> measured CSV + truth sidecar
+    Rig(cmd_rig::RigArgs),
+    /// Two-stage identification from measured data (mechanics, then gas), with intervals and fit %
+    Fit(cmd_fit::FitArgs),
     /// Equilibrium, poles, the loop broken at a pressure force, gain and phase margins
     Linearize(cmd_linearize::LinearizeArgs),
     /// Root locus: the poles over a parameter range
@@ -42,6 +48,8 @@ fn main() {
     let result = match cli.command {
         Command::Models { json } => cmd_models::run(json),
         // <dispatch>
+        Command::Rig(a) => cmd_rig::run(&a),
+        Command::Fit(a) => cmd_fit::run(&a),
         Command::Linearize(a) => cmd_linearize::run(&a),
         Command::Locus(a) => cmd_locus::run(&a),
         Command::Simulate(a) => cmd_simulate::run(&a),

@@ -18,7 +18,8 @@ pub fn rng(seed: u64) -> StdRng {
 pub enum Spread {
     /// Each pressure within +-5 % of the charge: the upwind switches are saturated.
     Wide,
-    /// Each pressure within +-1 Pa (log-uniform magnitude, 0.003 to 1 Pa) of one common level, itself within +-5 % of the charge:
+    /// Each pressure within +-1 Pa (log-uniform magnitude, 0.01 to 1 Pa; no two closer than
+    /// 0.02 Pa) of one common level, itself within +-5 % of the charge:
     /// the links' smooth upwind switches (width `mdot_eps R_link`, 0.01 to 0.5 Pa) are in
     /// their transition, while the level stays away from the bounce pressure (a level equal
     /// to it makes entries such as `d v'/d Ar = (Pb - P)/md` cancellations that finite
@@ -29,22 +30,43 @@ pub enum Spread {
 /// A random state near equilibrium: positions +-5 mm, velocities +-0.5 m/s, pressures as
 /// `spread` says around the charge, masses within +-5 % of the equilibrium `m0`.
 pub fn random_state(model: &dyn Model, p: &[f64], spread: Spread, rng: &mut StdRng) -> Vec<f64> {
-    let mut x = vec![0.0; model.n_states()];
-    model.equilibrium_guess(p, &mut x);
-    let level = 1.0 + 0.05 * rng.gen_range(-1.0..1.0);
-    for (xi, s) in x.iter_mut().zip(model.states()) {
-        let u: f64 = rng.gen_range(-1.0..1.0);
-        *xi = match s.kind {
-            StateKind::Position(_) => 5e-3 * u,
-            StateKind::Velocity(_) => 0.5 * u,
-            StateKind::Pressure(_) => match spread {
-                Spread::Wide => *xi * (1.0 + 0.05 * u),
-                Spread::Balanced => *xi * level + u * 10f64.powf(rng.gen_range(-2.5..0.0)),
-            },
-            StateKind::Mass(_) => *xi * (1.0 + 0.05 * u),
-        };
+    let mut x0 = vec![0.0; model.n_states()];
+    model.equilibrium_guess(p, &mut x0);
+    let states = model.states();
+    loop {
+        let level = 1.0 + 0.05 * rng.gen_range(-1.0..1.0);
+        let mut x = x0.clone();
+        for (xi, s) in x.iter_mut().zip(&states) {
+            let u: f64 = rng.gen_range(-1.0..1.0);
+            *xi = match s.kind {
+                StateKind::Position(_) => 5e-3 * u,
+                StateKind::Velocity(_) => 0.5 * u,
+                StateKind::Pressure(_) => match spread {
+                    Spread::Wide => *xi * (1.0 + 0.05 * u),
+                    Spread::Balanced => *xi * level + u * 10f64.powf(rng.gen_range(-2.0..0.0)),
+                },
+                StateKind::Mass(_) => *xi * (1.0 + 0.05 * u),
+            };
+        }
+        // keep central differences (pressure step 1e-3 Pa) away from the quadratic law's
+        // kink at equal pressures
+        if min_pressure_gap(model, &x) >= 0.02 {
+            return x;
+        }
     }
-    x
+}
+
+/// The smallest difference between two gas pressures of `x`.
+pub fn min_pressure_gap(model: &dyn Model, x: &[f64]) -> f64 {
+    let pressures: Vec<f64> =
+        model.states().iter().zip(x).filter(|(s, _)| matches!(s.kind, StateKind::Pressure(_))).map(|(_, &v)| v).collect();
+    let mut gap = f64::INFINITY;
+    for (i, a) in pressures.iter().enumerate() {
+        for b in &pressures[i + 1..] {
+            gap = gap.min((a - b).abs());
+        }
+    }
+    gap
 }
 
 /// Typical magnitude of each state near equilibrium: the scale of its finite-difference
@@ -74,18 +96,13 @@ pub fn state_scales(model: &dyn Model, p: &[f64]) -> Vec<f64> {
 /// `dP |dP|`), so a central difference must not straddle that point either: the pressure
 /// step is also at most 5 % of the smallest gap between two pressures of `x`.
 pub fn fd_steps(model: &dyn Model, p: &[f64], x: &[f64]) -> Vec<f64> {
-    let scales = state_scales(model, p);
+    let dp = 1e-3f64.min(0.05 * min_pressure_gap(model, x));
     let states = model.states();
-    let pressures: Vec<f64> =
-        states.iter().zip(x).filter(|(s, _)| matches!(s.kind, StateKind::Pressure(_))).map(|(_, &v)| v).collect();
-    let mut gap = f64::INFINITY;
-    for (i, a) in pressures.iter().enumerate() {
-        for b in &pressures[i + 1..] {
-            gap = gap.min((a - b).abs());
-        }
-    }
-    let dp = 1e-3f64.min(0.05 * gap);
-    states.iter().zip(scales).map(|(s, scale)| if matches!(s.kind, StateKind::Pressure(_)) { dp } else { 1e-3 * scale }).collect()
+    states
+        .iter()
+        .zip(state_scales(model, p))
+        .map(|(s, scale)| if matches!(s.kind, StateKind::Pressure(_)) { dp } else { 1e-3 * scale })
+        .collect()
 }
 
 /// Finite-difference derivatives of `f` (`m` outputs) around `x`, one column per input,

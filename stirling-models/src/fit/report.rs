@@ -91,3 +91,33 @@ pub fn stats(names: &[(String, bool)], initial: &[f64], scale: &[f64], u: &[f64]
     }
     FitStats { estimates, correlation, warnings, sigma2, samples: nr }
 }
+
+/// Measured vs model against time (the seed's Figures 4 and 5), one SVG per channel.
+pub fn plot_series(path: &std::path::Path, title: &str, s: &super::Series) -> Result<(), String> {
+    use plotters::prelude::*;
+    let root = SVGBackend::new(path, (900, 360)).into_drawing_area();
+    root.fill(&WHITE).map_err(|e| e.to_string())?;
+    let (t0, t1) = (s.t.first().copied().unwrap_or(0.0), s.t.last().copied().unwrap_or(1.0));
+    let (lo, hi) = s.measured.iter().chain(&s.model).fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), &v| (l.min(v), h.max(v)));
+    let pad = 0.05 * (hi - lo).max(1e-12);
+    let mut chart = ChartBuilder::on(&root)
+        .caption(title, ("sans-serif", 18))
+        .margin(10)
+        .x_label_area_size(35)
+        .y_label_area_size(70)
+        .build_cartesian_2d(t0..t1, (lo - pad)..(hi + pad))
+        .map_err(|e| e.to_string())?;
+    chart.configure_mesh().x_desc("t (s)").y_desc(s.channel.as_str()).draw().map_err(|e| e.to_string())?;
+    chart
+        .draw_series(s.t.iter().zip(&s.measured).map(|(&t, &v)| Circle::new((t, v), 1, RGBColor(120, 120, 120).filled())))
+        .map_err(|e| e.to_string())?
+        .label("measured")
+        .legend(|(x, y)| Circle::new((x, y), 3, RGBColor(120, 120, 120).filled()));
+    chart
+        .draw_series(LineSeries::new(s.t.iter().copied().zip(s.model.iter().copied()), RED.stroke_width(2)))
+        .map_err(|e| e.to_string())?
+        .label("model")
+        .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], RED));
+    chart.configure_series_labels().background_style(WHITE.mix(0.8)).border_style(BLACK).draw().map_err(|e| e.to_string())?;
+    root.present().map_err(|e| e.to_string())
+}

@@ -11,10 +11,10 @@
 use std::cell::{Cell, RefCell};
 
 use diffsol::{
-    op::OpStatistics, ConstantOp, FaerContext, FaerSparseMat, FaerVec, Matrix, MatrixSparsity, NalgebraContext, NalgebraMat, NalgebraVec, NonLinearOp,
-    NonLinearOpJacobian, OdeEquations, OdeEquationsRef, Op, UnitCallable, Vector,
+    op::OpStatistics, ConstantOp, FaerContext, FaerSparseMat, FaerVec, Matrix, NalgebraContext, NalgebraMat, NalgebraVec, NonLinearOp,
+    NonLinearOpJacobian, OdeEquations, OdeEquationsRef, Op, UnitCallable, Vector, VectorCommon,
 };
-use faer::sparse::SymbolicSparseColMat;
+use faer::sparse::{Pair, SymbolicSparseColMat};
 
 use super::system::OdeSystem;
 
@@ -71,7 +71,8 @@ impl Backend for SparseM {
         rc.extend((0..n).map(|i| (i, i)));
         rc.sort_unstable();
         rc.dedup();
-        Some(<SymbolicSparseColMat<usize> as MatrixSparsity<SparseM>>::try_from_indices(n, n, rc).expect("a valid Jacobian pattern"))
+        let pairs: Vec<Pair<usize, usize>> = rc.into_iter().map(|(r, c)| Pair::new(r, c)).collect();
+        Some(SymbolicSparseColMat::try_new_from_indices(n, n, &pairs).expect("a valid Jacobian pattern").0)
     }
     fn fill(eqn: &Eqn<'_, Self>, t: f64, x: &[f64], m: &mut Self) {
         let mut trip = eqn.trip.borrow_mut();

@@ -145,7 +145,7 @@ pub fn settle(
             f(t)
         }
     };
-    let hooks = Hooks { crossing: Some(iy), on_crossing: Some(&mut on_crossing), check: Some(&check), progress: Some(&mut prog) };
+    let hooks = Hooks { crossing: Some(iy), on_crossing: Some(&mut on_crossing), check: Some(&check), progress: Some(&mut prog), on_step: None };
     let tr = integrate(&ModelSystem { model, p }, x0, t_max, samples, opts, hooks)?;
     let last = tr.crossings.last().cloned();
     match (found, last) {

@@ -11,7 +11,7 @@
 //! [`OdeSystem::sparsity`] for systems of more than [`SPARSE_THRESHOLD`] states
 //! (by default; `nsection` at n = 1000, 2008 states, needs it).
 
-use diffsol::{error::OdeSolverError, DiffsolError, FaerSparseLU, NalgebraLU, OdeBuilder, OdeSolverMethod, OdeSolverStopReason, Vector};
+use diffsol::{error::OdeSolverError, DiffsolError, FaerSparseLU, NalgebraLU, OdeBuilder, OdeSolverMethod, OdeSolverStopReason};
 use serde::Serialize;
 use stirling_dsl::{Model, StateKind};
 

@@ -12,6 +12,7 @@
 mod adapter;
 pub mod cycle;
 pub mod integrate;
+pub mod monodromy;
 pub mod shooting;
 pub mod system;
 pub mod work;
@@ -20,8 +21,8 @@ use serde::Serialize;
 use stirling_dsl::Model;
 
 pub use cycle::{figures, periodic, settle, CycleFigures, Settled};
-pub use integrate::{check_physical, integrate, simulate, uniform_samples, Crossing, Hooks, SimOptions, SolverStats, Trajectory};
-pub use shooting::{floquet_multipliers, shoot, LimitCycle, ShootingOptions};
+pub use integrate::{check_physical, integrate, simulate, uniform_samples, Crossing, Hooks, LinearSolverKind, SimOptions, SolverStats, Trajectory, SPARSE_THRESHOLD};
+pub use shooting::{floquet_multipliers, flow_with_monodromy, flow_with_monodromy_by, shoot, LimitCycle, MonodromyMethod, ShootingOptions};
 pub use system::{state_scale, EnergySystem, ModelSystem, OdeSystem, VariationalSystem};
 pub use work::{cycle_work, indicated_power, CycleWork};
 

@@ -17,13 +17,18 @@
 //! direction), and with the `full` closure a second one is 1 (the conserved
 //! inventory); the cycle is orbitally stable when all others lie inside the unit circle.
 //!
-//! Cost: the variational system has `n (n + 1)` states with a dense iteration
-//! matrix, so shooting is meant for models up to a few dozen states.
+//! The monodromy comes by default from [`super::monodromy`]: one BDF run of the
+//! state and a 3-stage Radau IIA propagation of `Phi` along its steps (one LU of
+//! a `3n x 3n` stage matrix per step for all columns, sparse for large `n`).
+//! [`MonodromyMethod::Variational`] keeps the reference route: the `n (n + 1)`-state
+//! variational system under the adaptive BDF (dense iteration matrix; a few dozen
+//! states at most).
 
 use nalgebra::{DMatrix, DVector};
 use stirling_dsl::{Model, StateKind};
 
 use super::integrate::{check_physical, integrate, Hooks, SimOptions, SolverStats};
+use super::monodromy::flow_with_monodromy_radau;
 use super::system::{state_scale, ModelSystem, VariationalSystem};
 use super::SimError;
 
@@ -36,11 +41,29 @@ pub struct ShootingOptions {
     pub max_iter: usize,
     /// Integrator tolerances for the variational runs.
     pub sim: SimOptions,
+    /// How the monodromy matrix is computed.
+    pub monodromy: MonodromyMethod,
 }
 
 impl Default for ShootingOptions {
     fn default() -> Self {
-        Self { tol: 1e-7, max_iter: 12, sim: SimOptions { rtol: 1e-10, atol: 1e-10, ..SimOptions::default() } }
+        Self { tol: 1e-7, max_iter: 12, sim: SimOptions { rtol: 1e-10, atol: 1e-10, ..SimOptions::default() }, monodromy: MonodromyMethod::default() }
+    }
+}
+
+/// The monodromy route.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum MonodromyMethod {
+    /// State by the adaptive BDF; `Phi` by 3-stage Radau IIA along its steps,
+    /// each step split into `substeps` equal parts.
+    Radau { substeps: usize },
+    /// The `n (n + 1)`-state variational system under the adaptive BDF (reference).
+    Variational,
+}
+
+impl Default for MonodromyMethod {
+    fn default() -> Self {
+        MonodromyMethod::Radau { substeps: 1 }
     }
 }
 
@@ -69,8 +92,21 @@ impl LimitCycle {
     }
 }
 
-/// The flow `phi(x0, T)` and its monodromy matrix.
+/// The flow `phi(x0, T)` and its monodromy matrix by `method`.
+pub fn flow_with_monodromy_by(model: &dyn Model, p: &[f64], x0: &[f64], period: f64, opts: &SimOptions, method: MonodromyMethod) -> Result<(Vec<f64>, Vec<f64>, SolverStats), SimError> {
+    match method {
+        MonodromyMethod::Radau { substeps } => flow_with_monodromy_radau(model, p, x0, period, opts, substeps),
+        MonodromyMethod::Variational => flow_with_monodromy_variational(model, p, x0, period, opts),
+    }
+}
+
+/// The flow `phi(x0, T)` and its monodromy matrix (the default route).
 pub fn flow_with_monodromy(model: &dyn Model, p: &[f64], x0: &[f64], period: f64, opts: &SimOptions) -> Result<(Vec<f64>, Vec<f64>, SolverStats), SimError> {
+    flow_with_monodromy_by(model, p, x0, period, opts, MonodromyMethod::default())
+}
+
+/// The flow `phi(x0, T)` and its monodromy matrix from the variational system.
+pub fn flow_with_monodromy_variational(model: &dyn Model, p: &[f64], x0: &[f64], period: f64, opts: &SimOptions) -> Result<(Vec<f64>, Vec<f64>, SolverStats), SimError> {
     let n = model.n_states();
     let sys = VariationalSystem { inner: ModelSystem { model, p } };
     let mut z0 = x0.to_vec();
@@ -101,7 +137,7 @@ pub fn shoot(model: &dyn Model, p: &[f64], x0: &[f64], period: f64, opts: &Shoot
     let mut stats = SolverStats::default();
     let mut f = vec![0.0; n];
     for it in 1..=opts.max_iter {
-        let (phi, mono, st) = flow_with_monodromy(model, p, &x, t_per, &opts.sim)?;
+        let (phi, mono, st) = flow_with_monodromy_by(model, p, &x, t_per, &opts.sim, opts.monodromy)?;
         stats.add(&st);
         let r: Vec<f64> = (0..n).map(|i| (phi[i] - x[i]) / s[i]).collect();
         let res = r.iter().fold(0.0f64, |a, v| a.max(v.abs()));
@@ -139,7 +175,7 @@ pub fn shoot(model: &dyn Model, p: &[f64], x0: &[f64], period: f64, opts: &Shoot
             return Err(SimError::ShootingFailed { iterations: it, residual: res, why: "the period became non-positive".into() });
         }
     }
-    let (phi, _, _) = flow_with_monodromy(model, p, &x, t_per, &opts.sim)?;
+    let (phi, _, _) = flow_with_monodromy_by(model, p, &x, t_per, &opts.sim, opts.monodromy)?;
     let res = (0..n).map(|i| ((phi[i] - x[i]) / s[i]).abs()).fold(0.0, f64::max);
     Err(SimError::ShootingFailed { iterations: opts.max_iter, residual: res, why: "Newton did not converge".into() })
 }
