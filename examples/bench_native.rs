@@ -27,7 +27,7 @@ use serde_json::json;
 use stirling::dsl::{Closure, JacSink, Model};
 use stirling::models::family::NSection;
 use stirling::models::linear::{dynamic_poles, NewtonOptions};
-use stirling::models::sim::{simulate, state_scale, SimOptions};
+use stirling::models::sim::{integrate, simulate, state_scale, Hooks, ModelSystem, SimOptions};
 
 /// The fairness state: the rest state moved off equilibrium in every kind of state
 /// (same recipe as `benches/rhs_jacobian.rs`), so every term of the RHS is active.
@@ -225,6 +225,27 @@ fn main() {
         None
     };
 
+    // --- the same run without the per-step nonphysical-state check (to size its overhead)
+    let sim_nocheck = if do_sim {
+        let mut times = Vec::new();
+        let mut steps = 0;
+        for _ in 0..3 {
+            let t = Instant::now();
+            let r = integrate(&ModelSystem { model: &m, p: &p }, &x0, t_end, &[t_end], &opts, Hooks::default());
+            times.push(t.elapsed().as_secs_f64());
+            match r {
+                Ok(tr) => steps = tr.stats.steps,
+                Err(_) => break,
+            }
+            if times[0] > 20.0 {
+                break;
+            }
+        }
+        Some(json!({"seconds": median(&mut times), "steps": steps}))
+    } else {
+        None
+    };
+
     // --- linearization with all poles
     let poles = if do_poles {
         let newton = NewtonOptions::default();
@@ -275,7 +296,7 @@ fn main() {
                 "jac_dense": t_jac_dense,
                 "jac_fd": t_fd, "jac_fd_max_rel_err": fd_err,
             },
-            "sim": sim, "poles": poles,
+            "sim": sim, "sim_nocheck": sim_nocheck, "poles": poles,
         });
         println!("{}", serde_json::to_string(&doc).unwrap());
     } else {

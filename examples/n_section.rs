@@ -173,10 +173,12 @@ fn pv_loops(model: &dyn Model, p: &[f64], lc: &LimitCycleReport) -> (Vec<String>
             loops[i].push((vo[i], pr[i]));
         }
     }
-    let moving = |l: &Vec<(f64, f64)>| {
-        let (lo, hi) = l.iter().fold((f64::MAX, f64::MIN), |(a, b), &(v, _)| (a.min(v), b.max(v)));
-        hi - lo > 1e-12
+    // a loop needs both the volume and the pressure to change (not a section, not the fixed bounce space)
+    let span = |l: &Vec<(f64, f64)>, f: fn(&(f64, f64)) -> f64| {
+        let (lo, hi) = l.iter().map(f).fold((f64::MAX, f64::MIN), |(a, b), v| (a.min(v), b.max(v)));
+        hi - lo
     };
+    let moving = |l: &Vec<(f64, f64)>| span(l, |q| q.0) > 1e-12 && span(l, |q| q.1) > 1e-6;
     let keep: Vec<usize> = (0..k).filter(|&i| moving(&loops[i])).collect();
     let work = keep.iter().map(|&i| lc.work.per_vessel.get(i).copied().unwrap_or(0.0)).collect();
     (keep.iter().map(|&i| names[i].clone()).collect(), keep.iter().map(|&i| loops[i].clone()).collect(), work)
@@ -204,8 +206,14 @@ fn print_summary(s: &Summary, lin: &Linearization, lc: &LimitCycleReport) {
 fn print_margins(lin: &Linearization) {
     let m = &lin.margins;
     let opt = |v: Option<f64>| v.map_or("-".to_string(), |v| format!("{v:.3}"));
-    println!("\nloop broken at `{}`: gain margin {} dB at {} rad/s, phase margin {} deg at {} rad/s",
+    println!("\nloop broken at `{}` (MATLAB `margin` selection): gain margin {} dB at {} rad/s, phase margin {} deg at {} rad/s",
         lin.open_loop.full.name, opt(m.gain_db), opt(m.phase_crossover_rad_s), opt(m.phase_deg), opt(m.gain_crossover_rad_s));
+    let gains: Vec<String> = m.all_gain.iter().map(|g| format!("{:.3} dB at {:.2} rad/s", g.gain_db, g.phase_crossover_rad_s)).collect();
+    let phases: Vec<String> = m.all_phase.iter().map(|g| format!("{:.2} deg at {:.2} rad/s", g.phase_deg, g.gain_crossover_rad_s)).collect();
+    println!("  all crossovers: gain {}; phase {}", gains.join(", "), phases.join(", "));
+    let rhp = lin.open_loop.poles.iter().filter(|p| p.rhp).count();
+    println!("  open loop has {rhp} RHP poles; closed loop has {} (the engine runs because the closed loop is unstable)",
+        lin.dynamics.poles.iter().filter(|p| p.rhp).count());
 }
 
 fn print_cycle(c: &SimSummary, lc: &LimitCycleReport) {

@@ -20,8 +20,9 @@ fn state(m: &dyn Model, p: &[f64]) -> Vec<f64> {
     x
 }
 
-/// rhs of the augmented model (its states by name) equals the base model's, bitwise.
-fn compare(base: &dyn Model, fx: &dyn Model) {
+/// rhs of the augmented model (its states by name) equals the base model's to `tol` relative
+/// (0: bitwise).
+fn compare(base: &dyn Model, fx: &dyn Model, tol: f64) {
     let pb = base.default_params();
     let pf = effects::nominal_params(fx);
     assert_eq!(pf, fx.default_params(), "defaults are the nulls");
@@ -56,7 +57,7 @@ fn compare(base: &dyn Model, fx: &dyn Model) {
         let rel = (fb[i] - ff[j]).abs() / fb[i].abs().max(1e-300);
         max_rel = max_rel.max(rel);
         eprintln!("{:>10} base {:+.17e} fx {:+.17e}", n, fb[i], ff[j]);
-        assert!(rel <= 1e-15 || fb[i] == ff[j], "state {n}: {} vs {}", fb[i], ff[j]);
+        assert!(rel <= tol || fb[i] == ff[j], "state {n}: {} vs {}", fb[i], ff[j]);
     }
     for (j, n) in fnames.iter().enumerate() {
         if !bnames.contains(n) {
@@ -68,7 +69,9 @@ fn compare(base: &dyn Model, fx: &dyn Model) {
 
 #[test]
 fn nominal_cv1_is_the_base_cv1() {
-    compare(&Cv1::new(1, Closure::Full).unwrap(), &Cv1Fx::new(1, Closure::Full).unwrap());
+    // cv1_fx has the CV mass as a state (its leak link) and a differently ordered force sum:
+    // equal to a few ulp, not bitwise
+    compare(&Cv1::new(1, Closure::Full).unwrap(), &Cv1Fx::new(1, Closure::Full).unwrap(), 1e-14);
 }
 
 #[test]
@@ -89,7 +92,7 @@ fn nominal_nsection_is_the_base_nsection_bitwise() {
         let dj = jb.iter().zip(&jf).map(|(a, b)| (a - b).abs() / a.abs().max(1e-300)).fold(0.0, f64::max);
         assert!(dj < 1e-14, "n = {n}: Jacobian differs by {dj:e}");
     }
-    compare(&NSection::new(2, Closure::Full).unwrap(), &NSectionFx::new(2, Closure::Full).unwrap());
+    compare(&NSection::new(2, Closure::Full).unwrap(), &NSectionFx::new(2, Closure::Full).unwrap(), 0.0);
 }
 
 #[test]
@@ -119,7 +122,7 @@ fn each_model_effect_changes_the_rhs() {
 fn registry_maps_names() {
     assert_eq!(effects::augmented("cv1", None, Closure::Full).unwrap().name(), "cv1_fx");
     assert_eq!(effects::augmented("order8", None, Closure::Full).unwrap().n(), 2);
-    assert!(effects::augmented("schmidt", None, Closure::Full).unwrap_err().to_string().contains("no augmented member"));
+    assert!(effects::augmented("schmidt", None, Closure::Full).err().unwrap().to_string().contains("no augmented member"));
     let e = EffectSettings::parse("cv1", &["regen_quadratic=1e9".into()]).unwrap_err().to_string();
     assert!(e.contains("does not apply to model `cv1`"), "{e}");
     let e = EffectSettings::parse("cv1", &["friction=1".into()]).unwrap_err().to_string();

@@ -47,3 +47,42 @@ fn nsection2_full_grows_and_settles_on_a_limit_cycle() {
     assert!(f.x_amp > 1e-3 && f.x_amp < 5e-2);
     assert!(lc.work.total > 0.0, "the engine does work");
 }
+
+/// Wall time of `limit_cycle` on larger sections (release: `cargo test --release
+/// --test sim_limit_cycle -- --ignored --nocapture`).
+fn larger(n: usize) {
+    let model = NSection::new(n, Closure::Full).unwrap();
+    let p = model.default_params();
+    let x0 = start(&model, &p, 5e-3);
+    let t0 = std::time::Instant::now();
+    let lc = sim::limit_cycle(&model, &p, &x0, 20.0, &[], &SimOptions::default(), None).unwrap();
+    eprintln!(
+        "nsection {n} ({} states): settled at t = {:.3} s, f = {:.4} Hz, work {:.5e} J; floquet (first 6) {:?}; iterations {}, residual {:.2e}; stats {:?}; wall {:?}",
+        model.n_states(),
+        lc.settled.t,
+        lc.figures.frequency_hz,
+        lc.work.total,
+        &lc.cycle.floquet[..lc.cycle.floquet.len().min(6)],
+        lc.cycle.iterations,
+        lc.cycle.residual,
+        lc.stats,
+        t0.elapsed()
+    );
+    if !lc.cycle.floquet.is_empty() {
+        let ones = lc.cycle.floquet.iter().filter(|&&(re, im)| ((re - 1.0).powi(2) + im * im).sqrt() < 1e-5).count();
+        assert!(ones >= 2, "trivial and inventory multipliers: {:?}", lc.cycle.floquet);
+    }
+    assert!(lc.work.total > 0.0);
+}
+
+#[test]
+#[ignore = "release timing"]
+fn nsection10_limit_cycle() {
+    larger(10);
+}
+
+#[test]
+#[ignore = "release timing"]
+fn nsection100_limit_cycle() {
+    larger(100);
+}

@@ -74,7 +74,8 @@ pub fn run(args: &SimulateArgs) -> anyhow::Result<()> {
         let s = SimSummary::from_run(model, &tr).with_cycle(&lc);
         (tr, s, Some(lc))
     } else {
-        let check = |t: f64, x: &[f64]| sim::check_physical(model, &p, t, x);
+        let checker = sim::PhysicalCheck::new(model, &p);
+        let check = |t: f64, x: &[f64]| checker.check(t, x);
         let hooks = sim::Hooks { check: Some(&check), progress: Some(&mut progress), ..Default::default() };
         let tr = sim::integrate(&sim::ModelSystem { model, p: &p }, &x0, args.t_end, &samples, &opts, hooks)
             .with_context(|| format!("simulation of `{}`", model.name()))?;

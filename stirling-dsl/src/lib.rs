@@ -6,17 +6,109 @@
 //! them symbolically and emits Rust: the right-hand side, the analytic Jacobian and
 //! the parameter Jacobian, for any number `n` of array sections chosen at run time.
 //!
-//! - [`expr`]: the hash-consed expression arena (folding constructors, differentiation,
-//!   substitution, evaluation, text/LaTeX printers, Rust emission with CSE).
-//! - [`topology`]: the declaration ([`Topology`]) and its assembly ([`assemble`]).
+//! ## Map of the crate
+//!
+//! - [`expr`]: the hash-consed expression [`Arena`] (folding constructors, [`Arena::diff`],
+//!   substitution, [`Arena::eval`], text/LaTeX [`expr::Printer`], Rust emission with CSE).
+//! - [`topology`]: the declaration ([`Topology`]) and its assembly ([`assemble`]) into
+//!   equations: faces give both `dV/dt` and the pressure forces, ports the heat, links the
+//!   mass and enthalpy flows (PHYSICS.md sections 1, 2, 4).
 //! - [`codegen`]: emission of a whole model ([`codegen::generate`]), used by the
 //!   `stirling_model!` macro at compile time.
 //! - The run-time interface every generated model implements: [`Model`], with
-//!   [`ParamInfo`], [`StateInfo`], [`JacSink`], [`PowerTerms`], [`TopologyInfo`] and
-//!   the bond-graph view [`to_dot`].
+//!   [`ParamInfo`], [`StateInfo`]/[`StateKind`], [`JacSink`], [`PowerTerms`], [`TopologyInfo`]
+//!   and the bond-graph view [`to_dot`]. The analyses of `stirling-models` take `&dyn Model`.
 //!
-//! Users declare models with `stirling_macros::stirling_model!`; the generated code
-//! refers to this crate as `::stirling_dsl`, so depend on both.
+//! ## Declaring a model (the usual entry point)
+//!
+//! Users do not call this crate's builders directly: they write a `stirling_model!`
+//! declaration (crate `stirling-macros`, re-exported as `stirling::stirling_model`) in their
+//! own crate. The macro checks the topology (unknown bodies or volumes, chain links that run
+//! past the end of an array, missing ports, ... are compile errors at the user's tokens),
+//! assembles it with this crate and emits a type `Name` with `Name::new(n, closure)` that
+//! implements [`Model`]. The generated code names this crate `::stirling_dsl`, so a crate
+//! that declares models depends on `stirling-dsl` as well (the facade `stirling` does).
+//! The declaration syntax and a complete worked example are in the `stirling` crate root and
+//! in `docs/custom-topologies.md`; what a generated model offers at run time:
+//!
+//! | [`Model`] method | what |
+//! |---|---|
+//! | `rhs`, `jacobian`, `param_jacobian` | `f(x, p)`, `df/dx`, `df/dp` (analytic) |
+//! | `states`, `params`, `bodies`, `vessel_names` | the layout `[x, v, y, w, P_1.., m_1..]` and its meaning |
+//! | `equilibrium_guess` | the rest state of PHYSICS.md section 6 |
+//! | `pv`, `temperatures`, `gas_mass` | derived quantities per vessel |
+//! | `energy`, `power` | `E` and `dE/dt = heat + boundary + mechanical` (section 10) |
+//! | `pressure_forces`, `pressure_force_gradient`, `body_masses` | where the loop is broken |
+//! | `equations(Style::Text / Style::Latex)`, `topology` | the equations as text and the bond graph |
+//!
+//! ## The symbolic core by hand
+//!
+//! The expression arena is usable on its own. Expressions are hash-consed (equal
+//! subexpressions share one node), constructors fold constants, and [`Arena::diff`]
+//! differentiates with respect to any symbol. Here the heat flow of a port,
+//! `Q = h Aw (Tw - T)` with the gas temperature `T = P V / (m R)` (PHYSICS.md section 4),
+//! and its derivative with respect to the pressure, which is what the generated Jacobian
+//! holds in the row of `P'`:
+//!
+//! ```
+//! use stirling_dsl::expr::Printer;
+//! use stirling_dsl::{Arena, Style, Sym};
+//!
+//! let names = ["h", "Aw", "Tw", "R", "P", "V", "m"];
+//! let mut a = Arena::new();
+//! let s: Vec<_> = (0..names.len() as u32).map(|k| a.sym(Sym::Param(k))).collect();
+//! let (h, aw, tw, r, p, v, m) = (s[0], s[1], s[2], s[3], s[4], s[5], s[6]);
+//! // T = P V / (m R), named so that the printers show it as a definition
+//! let pv = a.mul(p, v);
+//! let mr = a.mul(m, r);
+//! let t = a.div(pv, mr);
+//! let t = a.named("T", t);
+//! // Q = h Aw (Tw - T)
+//! let hw = a.mul(h, aw);
+//! let dt = a.sub(tw, t);
+//! let q = a.mul(hw, dt);
+//! let dq_dp = a.diff(q, Sym::Param(4));
+//!
+//! // evaluate at a state: dQ/dP = -h Aw V / (m R)
+//! let values = [500.0, 0.0128, 600.0, 287.05, 101325.0, 1.5e-4, 8.8e-5];
+//! let mut at = |sym: Sym| match sym {
+//!     Sym::Param(k) => values[k as usize],
+//!     _ => unreachable!(),
+//! };
+//! let expected = -500.0 * 0.0128 * 1.5e-4 / (8.8e-5 * 287.05);
+//! assert!((a.eval(dq_dp, &mut at) - expected).abs() < 1e-12 * expected.abs());
+//!
+//! // the derivative with respect to a symbol it does not contain folds to the constant 0
+//! let zero = a.diff(q, Sym::Count);
+//! assert_eq!(a.as_const(zero), Some(0.0));
+//! // hash-consing: building the same expression again gives the same node
+//! let pv_again = a.mul(p, v);
+//! assert_eq!(pv, pv_again);
+//!
+//! // print as text and as LaTeX, with the named intermediate as a definition
+//! let namer = |sym: Sym| match sym {
+//!     Sym::Param(k) => names[k as usize].to_string(),
+//!     other => format!("{other:?}"),
+//! };
+//! let text = Printer::new(&a, Style::Text, &namer);
+//! for (name, body) in text.definitions(&[q]) {
+//!     println!("{name} = {body}");
+//! }
+//! println!("Q = {}", text.expr(q));
+//! println!("dQ/dP = {}", text.expr(dq_dp));
+//! let latex = Printer::new(&a, Style::Latex, &namer).expr(dq_dp);
+//! println!("LaTeX: {latex}");
+//! assert!(text.expr(q).contains('T'));
+//! ```
+//!
+//! ## Invariants the generated code keeps
+//!
+//! - one face declaration `a_ik` yields both `dV_i/dt` and the force `a_ik P_i` on body `k`,
+//!   so the gas's `P dV` work enters the bodies exactly (an energy-conserving transformer);
+//! - with the `full` [`Closure`] the masses of linked CVs are states and `sum m_i` is
+//!   conserved; `frozen` drops them (the seed's orders);
+//! - the Jacobians are exact derivatives of the right-hand side (the smooth upwind switch
+//!   `tanh(mdot/mdot_eps)` makes them exist everywhere).
 
 mod closure;
 pub mod codegen;

@@ -18,42 +18,39 @@ pub fn rng(seed: u64) -> StdRng {
 pub enum Spread {
     /// Each pressure within +-5 % of the charge: the upwind switches are saturated.
     Wide,
-    /// Each pressure within +-1 Pa (log-uniform magnitude, 0.01 to 1 Pa; no two closer than
-    /// 0.02 Pa) of one common level, itself within +-5 % of the charge:
-    /// the links' smooth upwind switches (width `mdot_eps R_link`, 0.01 to 0.5 Pa) are in
-    /// their transition, while the level stays away from the bounce pressure (a level equal
-    /// to it makes entries such as `d v'/d Ar = (Pb - P)/md` cancellations that finite
-    /// differences cannot resolve to 1e-6).
+    /// Pressures a few Pa apart around one common level within +-5 % of the charge: each
+    /// differs from the previous one by 0.02 to 1 Pa (log-uniform, one direction, so no two are
+    /// closer than 0.02 Pa), so the links' smooth upwind switches (width `mdot_eps R_link`,
+    /// 0.01 to 0.5 Pa) are in their transition, while the level stays away from the bounce
+    /// pressure (a level equal to it makes entries such as `d v'/d Ar = (Pb - P)/md`
+    /// cancellations that finite differences cannot resolve to 1e-6).
     Balanced,
 }
 
 /// A random state near equilibrium: positions +-5 mm, velocities +-0.5 m/s, pressures as
 /// `spread` says around the charge, masses within +-5 % of the equilibrium `m0`.
 pub fn random_state(model: &dyn Model, p: &[f64], spread: Spread, rng: &mut StdRng) -> Vec<f64> {
-    let mut x0 = vec![0.0; model.n_states()];
-    model.equilibrium_guess(p, &mut x0);
-    let states = model.states();
-    loop {
-        let level = 1.0 + 0.05 * rng.gen_range(-1.0..1.0);
-        let mut x = x0.clone();
-        for (xi, s) in x.iter_mut().zip(&states) {
-            let u: f64 = rng.gen_range(-1.0..1.0);
-            *xi = match s.kind {
-                StateKind::Position(_) => 5e-3 * u,
-                StateKind::Velocity(_) => 0.5 * u,
-                StateKind::Pressure(_) => match spread {
-                    Spread::Wide => *xi * (1.0 + 0.05 * u),
-                    Spread::Balanced => *xi * level + u * 10f64.powf(rng.gen_range(-2.0..0.0)),
-                },
-                StateKind::Mass(_) => *xi * (1.0 + 0.05 * u),
-            };
-        }
-        // keep central differences (pressure step 1e-3 Pa) away from the quadratic law's
-        // kink at equal pressures
-        if min_pressure_gap(model, &x) >= 0.02 {
-            return x;
-        }
+    let mut x = vec![0.0; model.n_states()];
+    model.equilibrium_guess(p, &mut x);
+    let level = 1.0 + 0.05 * rng.gen_range(-1.0..1.0);
+    let direction = if rng.gen_bool(0.5) { 1.0 } else { -1.0 };
+    let mut offset = 0.0;
+    for (xi, s) in x.iter_mut().zip(model.states()) {
+        let u: f64 = rng.gen_range(-1.0..1.0);
+        *xi = match s.kind {
+            StateKind::Position(_) => 5e-3 * u,
+            StateKind::Velocity(_) => 0.5 * u,
+            StateKind::Pressure(_) => match spread {
+                Spread::Wide => *xi * (1.0 + 0.05 * u),
+                Spread::Balanced => {
+                    offset += direction * 10f64.powf(rng.gen_range(-1.7..0.0));
+                    *xi * level + offset
+                }
+            },
+            StateKind::Mass(_) => *xi * (1.0 + 0.05 * u),
+        };
     }
+    x
 }
 
 /// The smallest difference between two gas pressures of `x`.

@@ -266,6 +266,9 @@ pub fn identify(model: &dyn Model, p0: &[f64], data: &Measured, opts: &FitOption
     let mut x_off = [x_meas.map(|v| cycle_mean(v)).unwrap_or(0.0), y_meas.map(|v| cycle_mean(v)).unwrap_or(0.0)];
     let mut stage1 = None;
     let sim = opts.sim;
+    // pressure-offset guesses: the whole-cycle mean minus the charge pressure (refined in stage 2)
+    let p_off0 = data.p.as_ref().map(|v| cycle_mean(v) - pmean).unwrap_or(0.0);
+    let ph_off0 = data.p_hot.as_ref().map(|v| cycle_mean(v) - pmean).unwrap_or(0.0);
     let sig_p = data.p.as_ref().map(|v| signal(t0, dt, v, (h / 2).max(3)));
     let sig_ph = data.p_hot.as_ref().map(|v| signal(t0, dt, v, (h / 2).max(3)));
 
@@ -289,7 +292,7 @@ pub fn identify(model: &dyn Model, p0: &[f64], data: &Measured, opts: &FitOption
                 if have_hot {
                     terms.push((1, 1.0 - wc, false));
                 }
-                Given { state: s, terms, constant: 0.0 }
+                Given { state: s, terms, constant: -wc * p_off0 - if have_hot { (1.0 - wc) * ph_off0 } else { 0.0 } }
             })
             .collect();
         let sx = signal(t0, dt, xm, h);
@@ -330,16 +333,17 @@ pub fn identify(model: &dyn Model, p0: &[f64], data: &Measured, opts: &FitOption
         let sy = signal(t0, dt, ym, h);
         let signals = vec![sx.clone(), sy.clone()];
         let vel_states: Vec<usize> = bodies.iter().copied().filter(|&i| matches!(model.states()[i].kind, StateKind::Velocity(_))).collect();
+        // stage 1 ran with the pressure offsets (p_off0, ph_off0); an offset `off` moves the
+        // true positions by -dq (off - off0) relative to the stage-1 offsets
+        let used = [shift[0][0] * p_off0 + shift[1][0] * ph_off0, shift[0][1] * p_off0 + shift[1][1] * ph_off0];
         let given = vec![
-            Given { state: pos_states[0], terms: vec![(0, 1.0, false)], constant: -x_off[0] },
+            Given { state: pos_states[0], terms: vec![(0, 1.0, false)], constant: -x_off[0] + used[0] },
             Given { state: vel_states[0], terms: vec![(0, 1.0, true)], constant: 0.0 },
-            Given { state: pos_states[1], terms: vec![(1, 1.0, false)], constant: -x_off[1] },
+            Given { state: pos_states[1], terms: vec![(1, 1.0, false)], constant: -x_off[1] + used[1] },
             Given { state: vel_states[1], terms: vec![(1, 1.0, true)], constant: 0.0 },
         ];
         let du = |ch: usize| vec![-shift[ch][0], 0.0, -shift[ch][1], 0.0];
         let pm = data.p.as_ref().expect("checked");
-        let p_off0 = cycle_mean(pm) - pmean;
-        let ph_off0 = data.p_hot.as_ref().map(|v| cycle_mean(v) - pmean).unwrap_or(0.0);
         let cold_pos = gas_states.iter().position(|&i| i == *ps.last().expect("CVs")).expect("pressure is a gas state");
         let hot_pos = gas_states.iter().position(|&i| i == ps[0]).expect("pressure is a gas state");
         let mut vars: Vec<Var> = gas.iter().map(|&j| Var { name: model.params()[j].name.into(), initial: p[j], scale: p[j].abs().max(1e-12), kind: VarKind::Param(j) }).collect();
@@ -354,11 +358,9 @@ pub fn identify(model: &dyn Model, p0: &[f64], data: &Measured, opts: &FitOption
         // model's inventory in proportion to P V / T_rest
         let mut x_start = eq.clone();
         let ta = tr.0;
-        let d_x = shift[0][0] * p_off0 + shift[1][0] * ph_off0;
-        let d_y = shift[0][1] * p_off0 + shift[1][1] * ph_off0;
-        x_start[pos_states[0]] = sx.val[ta] - x_off[0] - d_x;
+        x_start[pos_states[0]] = sx.val[ta] - x_off[0];
         x_start[vel_states[0]] = sx.der[ta];
-        x_start[pos_states[1]] = sy.val[ta] - x_off[1] - d_y;
+        x_start[pos_states[1]] = sy.val[ta] - x_off[1];
         x_start[vel_states[1]] = sy.der[ta];
         let ncv = ps.len();
         let mut t_rest = vec![0.0; ncv];

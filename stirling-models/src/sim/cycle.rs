@@ -126,7 +126,7 @@ pub fn settle(
     opts: &super::integrate::SimOptions,
     mut progress: Option<&mut dyn FnMut(f64)>,
 ) -> Result<Settled, super::SimError> {
-    use super::integrate::{check_physical, integrate, Hooks};
+    use super::integrate::{integrate, Hooks};
     use super::system::{state_scale, ModelSystem};
     let iy = model
         .states()
@@ -139,7 +139,8 @@ pub fn settle(
         found = periodic(c, &scale, cycles, tol);
         found.is_some()
     };
-    let check = |t: f64, x: &[f64]| check_physical(model, p, t, x);
+    let checker = super::physical::PhysicalCheck::new(model, p);
+    let check = |t: f64, x: &[f64]| checker.check(t, x);
     let mut prog = |t: f64| {
         if let Some(f) = progress.as_mut() {
             f(t)

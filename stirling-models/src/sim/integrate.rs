@@ -13,7 +13,7 @@
 
 use diffsol::{error::OdeSolverError, DiffsolError, FaerSparseLU, NalgebraLU, OdeBuilder, OdeSolverMethod, OdeSolverStopReason};
 use serde::Serialize;
-use stirling_dsl::{Model, StateKind};
+use stirling_dsl::Model;
 
 use super::adapter::{Backend, DenseM, Eqn, SparseM};
 use super::system::{ModelSystem, OdeSystem};
@@ -136,7 +136,8 @@ pub fn uniform_samples(t_end: f64, count: usize) -> Vec<f64> {
 
 /// Simulate a model from `x0` to `t_end`, sampling at `samples`, rejecting nonphysical states.
 pub fn simulate(model: &dyn Model, p: &[f64], x0: &[f64], t_end: f64, samples: &[f64], opts: &SimOptions) -> Result<Trajectory, SimError> {
-    let check = |t: f64, x: &[f64]| check_physical(model, p, t, x);
+    let checker = super::physical::PhysicalCheck::new(model, p);
+    let check = |t: f64, x: &[f64]| checker.check(t, x);
     let hooks = Hooks { check: Some(&check), ..Default::default() };
     integrate(&ModelSystem { model, p }, x0, t_end, samples, opts, hooks)
 }
@@ -295,49 +296,4 @@ fn map_err(e: DiffsolError, t: f64) -> SimError {
     }
 }
 
-fn rest_volumes(model: &dyn Model, p: &[f64]) -> Vec<f64> {
-    let nv = model.vessel_names().len();
-    let mut eq = vec![0.0; model.n_states()];
-    model.equilibrium_guess(p, &mut eq);
-    let (mut pr, mut vol) = (vec![0.0; nv], vec![0.0; nv]);
-    model.pv(p, &eq, &mut pr, &mut vol);
-    vol
-}
-
-/// Reject a nonphysical state: non-finite entries, non-positive volume (of every
-/// vessel with a positive rest volume), pressure,
-/// temperature or mass (the error names the time and the quantity).
-pub fn check_physical(model: &dyn Model, p: &[f64], t: f64, x: &[f64]) -> Result<(), SimError> {
-    let names = model.state_names();
-    if let Some(i) = x.iter().position(|v| !v.is_finite()) {
-        return Err(SimError::Nonphysical { t, quantity: format!("state `{}`", names[i]), value: x[i] });
-    }
-    let vessels = model.vessel_names();
-    let (mut pr, mut vol) = (vec![0.0; vessels.len()], vec![0.0; vessels.len()]);
-    model.pv(p, x, &mut pr, &mut vol);
-    let rest = rest_volumes(model, p);
-    for (i, name) in vessels.iter().enumerate() {
-        // a space declared without a rest volume (the bounce space) only counts displacement
-        if rest[i] > 0.0 && !(vol[i] > 0.0) {
-            return Err(SimError::Nonphysical { t, quantity: format!("volume of `{name}` (m^3)"), value: vol[i] });
-        }
-        if !(pr[i] > 0.0) {
-            return Err(SimError::Nonphysical { t, quantity: format!("pressure of `{name}` (Pa)"), value: pr[i] });
-        }
-    }
-    for (s, &v) in model.states().iter().zip(x) {
-        if matches!(s.kind, StateKind::Mass(_)) && !(v > 0.0) {
-            return Err(SimError::Nonphysical { t, quantity: format!("gas mass `{}` (kg)", s.name), value: v });
-        }
-    }
-    let ncv = model.states().iter().filter(|s| matches!(s.kind, StateKind::Pressure(_))).count();
-    let mut temp = vec![0.0; ncv];
-    if ncv > 0 {
-        model.temperatures(p, x, &mut temp);
-    }
-    if let Some(i) = temp.iter().position(|v| !(*v > 0.0)) {
-        let name = vessels.get(i).cloned().unwrap_or_else(|| format!("CV {i}"));
-        return Err(SimError::Nonphysical { t, quantity: format!("temperature of `{name}` (K)"), value: temp[i] });
-    }
-    Ok(())
-}
+pub use super::physical::check_physical;

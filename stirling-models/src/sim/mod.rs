@@ -7,11 +7,16 @@
 //! - [`shooting`]: Newton on the return map, monodromy matrix, Floquet multipliers.
 //! - [`work`]: `closed-integral P dV` per vessel, indicated power.
 //!
-//! [`limit_cycle`] chains them: settle from a perturbed state, shoot, measure.
+//! [`limit_cycle`] chains them: settle from a perturbed state, shoot, measure
+//! (above [`SHOOTING_MAX_STATES`] states it measures the settled cycle without
+//! shooting; [`limit_cycle_with`] chooses).
+//!
+//! - [`monodromy`]: the monodromy by Radau IIA along the BDF trajectory.
 
 mod adapter;
 pub mod cycle;
 pub mod integrate;
+pub mod physical;
 pub mod monodromy;
 pub mod shooting;
 pub mod system;
@@ -21,8 +26,9 @@ use serde::Serialize;
 use stirling_dsl::Model;
 
 pub use cycle::{figures, periodic, settle, CycleFigures, Settled};
+pub use physical::PhysicalCheck;
 pub use integrate::{check_physical, integrate, simulate, uniform_samples, Crossing, Hooks, LinearSolverKind, SimOptions, SolverStats, Trajectory, SPARSE_THRESHOLD};
-pub use shooting::{floquet_multipliers, flow_with_monodromy, flow_with_monodromy_by, shoot, LimitCycle, MonodromyMethod, ShootingOptions};
+pub use shooting::{floquet_multipliers, floquet_multipliers_scaled, flow_with_monodromy, flow_with_monodromy_by, shoot, LimitCycle, MonodromyMethod, ShootingOptions};
 pub use system::{state_scale, EnergySystem, ModelSystem, OdeSystem, VariationalSystem};
 pub use work::{cycle_work, indicated_power, CycleWork};
 
@@ -60,13 +66,63 @@ pub struct LimitCycleReport {
     pub stats: SolverStats,
 }
 
+/// Above this many states [`Shooting::Auto`] skips shooting: the monodromy is
+/// dense `n x n` and each Radau step solves for all `n` columns (nsection n = 100,
+/// 208 states: about 16 s for the whole `limit_cycle` in release; n = 1000 would
+/// take hours).
+pub const SHOOTING_MAX_STATES: usize = 400;
+
+/// Whether [`limit_cycle_with`] refines the settled cycle by shooting (and so
+/// reports Floquet multipliers).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Shooting {
+    /// Shoot up to [`SHOOTING_MAX_STATES`] states, measure the settled cycle above.
+    #[default]
+    Auto,
+    Always,
+    /// Measure the cycle from the last simulated period (no Floquet multipliers).
+    Never,
+}
+
 /// Settle from `x0` (at most `t_max`), refine by shooting, and measure the cycle.
 pub fn limit_cycle(model: &dyn Model, p: &[f64], x0: &[f64], t_max: f64, samples: &[f64], opts: &SimOptions, progress: Option<&mut dyn FnMut(f64)>) -> Result<LimitCycleReport, SimError> {
+    limit_cycle_with(model, p, x0, t_max, samples, opts, Shooting::Auto, progress)
+}
+
+/// [`limit_cycle`] with a choice of shooting. Without shooting the cycle is the
+/// settled one (periods agreeing to 1e-3), `floquet` and `monodromy` are empty,
+/// and `residual` is the scaled return-map residual of the measured period.
+pub fn limit_cycle_with(
+    model: &dyn Model,
+    p: &[f64],
+    x0: &[f64],
+    t_max: f64,
+    samples: &[f64],
+    opts: &SimOptions,
+    shooting: Shooting,
+    progress: Option<&mut dyn FnMut(f64)>,
+) -> Result<LimitCycleReport, SimError> {
     let settled = settle(model, p, x0, t_max, samples, 3, 1e-3, opts, progress)?;
-    let cycle = shoot(model, p, &settled.x0, settled.period, &ShootingOptions::default())?;
+    let do_shoot = match shooting {
+        Shooting::Auto => model.n_states() <= SHOOTING_MAX_STATES,
+        Shooting::Always => true,
+        Shooting::Never => false,
+    };
+    let sh = ShootingOptions { sim: SimOptions { linear_solver: opts.linear_solver, ..ShootingOptions::default().sim }, ..ShootingOptions::default() };
     let n_orbit = 512;
-    let orbit_t = uniform_samples(cycle.period, n_orbit);
-    let orbit_run = simulate(model, p, &cycle.x0, cycle.period, &orbit_t, &ShootingOptions::default().sim)?;
+    let (cycle, orbit_run) = if do_shoot {
+        let cycle = shoot(model, p, &settled.x0, settled.period, &sh)?;
+        let orbit_t = uniform_samples(cycle.period, n_orbit);
+        let orbit_run = simulate(model, p, &cycle.x0, cycle.period, &orbit_t, &sh.sim)?;
+        (cycle, orbit_run)
+    } else {
+        let orbit_t = uniform_samples(settled.period, n_orbit);
+        let orbit_run = simulate(model, p, &settled.x0, settled.period, &orbit_t, opts)?;
+        let s = state_scale(model, p);
+        let residual = orbit_run.x_end.iter().zip(&settled.x0).zip(&s).map(|((a, b), w)| ((a - b) / w).abs()).fold(0.0, f64::max);
+        let cycle = LimitCycle { x0: settled.x0.clone(), period: settled.period, monodromy: vec![], floquet: vec![], iterations: 0, residual, stats: SolverStats::default() };
+        (cycle, orbit_run)
+    };
     let fig = figures(model, p, cycle.period, &orbit_run.x);
     let work = cycle_work(model, p, cycle.period, &orbit_run.x);
     let mut stats = settled.trajectory.stats;
@@ -141,7 +197,7 @@ impl SimSummary {
         self.work_per_cycle_j = Some(lc.work.total);
         self.work_per_vessel_j = Some(lc.work.vessels.iter().cloned().zip(lc.work.per_vessel.iter().cloned()).collect());
         self.power_w = Some(indicated_power(lc.work.total, f.frequency_hz));
-        self.floquet = Some(lc.cycle.floquet.iter().map(|&(re, im)| [re, im]).collect());
+        self.floquet = (!lc.cycle.floquet.is_empty()).then(|| lc.cycle.floquet.iter().map(|&(re, im)| [re, im]).collect());
         self.steps = lc.stats.steps;
         self.rhs_calls = lc.stats.rhs_calls;
         self.jacobian_calls = lc.stats.jacobian_calls;

@@ -11,7 +11,7 @@
 //! ```
 //!
 //! One LU of the `3n x 3n` stage matrix per (sub)step serves all `n` columns of
-//! `Phi`: nalgebra dense LU for small `n`, faer sparse LU (symbolic analysis once,
+//! `Phi` (propagated in state-scaled form `D^-1 Phi D`): nalgebra dense LU for small `n`, faer sparse LU (symbolic analysis once,
 //! on the union of the block patterns) above [`super::SPARSE_THRESHOLD`] states
 //! (or as [`SimOptions::linear_solver`] says). L-stability makes the stiff
 //! (pressure-equalization) modes decay to ~0 as they should; the stage matrix is a
@@ -31,8 +31,8 @@ use nalgebra::DMatrix;
 use stirling_dsl::Model;
 
 use super::adapter::scatter;
-use super::integrate::{check_physical, integrate, Hooks, SimOptions, SolverStats};
-use super::system::{ModelSystem, OdeSystem};
+use super::integrate::{integrate, Hooks, SimOptions, SolverStats};
+use super::system::{state_scale, ModelSystem, OdeSystem};
 use super::SimError;
 
 /// Radau IIA, 3 stages: nodes and coefficients.
@@ -85,6 +85,9 @@ struct Propagator<'m> {
     sparse: Option<SparseStage>,
     trip: [Vec<(usize, usize, f64)>; 3],
     x: Vec<f64>,
+    /// `Phi` is propagated as `D^-1 Phi D`, `D = diag(scale)`: unscaled, the stage
+    /// matrix spans twenty orders of magnitude and the sparse LU loses the answer.
+    scale: Vec<f64>,
     jac_calls: usize,
     lu: usize,
 }
@@ -115,6 +118,9 @@ impl Propagator<'_> {
             }
             self.trip[j].clear();
             self.sys.jac_triplets(tj, &self.x, &mut self.trip[j]);
+            for e in self.trip[j].iter_mut() {
+                e.2 *= self.scale[e.1] / self.scale[e.0];
+            }
             self.jac_calls += 1;
         }
         self.lu += 1;
@@ -190,14 +196,21 @@ pub fn flow_with_monodromy_radau(model: &dyn Model, p: &[f64], x0: &[f64], perio
     for k in 0..n {
         phi[k + k * n] = 1.0;
     }
-    let mut prop = Propagator { sys: ModelSystem { model, p }, n, substeps, phi, sparse, trip: Default::default(), x: vec![0.0; n], jac_calls: 0, lu: 0 };
+    let mut prop = Propagator { sys: ModelSystem { model, p }, n, substeps, phi, sparse, trip: Default::default(), x: vec![0.0; n], scale: state_scale(model, p), jac_calls: 0, lu: 0 };
     let mut on_step = |t0: f64, t1: f64, dense: &dyn Fn(f64, &mut [f64])| prop.step(t0, t1, dense);
-    let check = |t: f64, x: &[f64]| check_physical(model, p, t, x);
+    let checker = super::physical::PhysicalCheck::new(model, p);
+    let check = |t: f64, x: &[f64]| checker.check(t, x);
     let hooks = Hooks { check: Some(&check), on_step: Some(&mut on_step), ..Default::default() };
     let tr = integrate(&sys, x0, period, &[period], opts, hooks)?;
     let x_end = tr.x.last().cloned().unwrap_or(tr.x_end);
     let mut stats = tr.stats;
     stats.jacobian_calls += prop.jac_calls;
     stats.lu_factorizations += prop.lu;
-    Ok((x_end, prop.phi, stats))
+    let mut phi = prop.phi;
+    for c in 0..n {
+        for r in 0..n {
+            phi[r + c * n] *= prop.scale[r] / prop.scale[c];
+        }
+    }
+    Ok((x_end, phi, stats))
 }

@@ -27,7 +27,7 @@
 use nalgebra::{DMatrix, DVector};
 use stirling_dsl::{Model, StateKind};
 
-use super::integrate::{check_physical, integrate, Hooks, SimOptions, SolverStats};
+use super::integrate::{integrate, Hooks, SimOptions, SolverStats};
 use super::monodromy::flow_with_monodromy_radau;
 use super::system::{state_scale, ModelSystem, VariationalSystem};
 use super::SimError;
@@ -115,7 +115,8 @@ pub fn flow_with_monodromy_variational(model: &dyn Model, p: &[f64], x0: &[f64],
             z0.push(if r == k { 1.0 } else { 0.0 });
         }
     }
-    let check = |t: f64, z: &[f64]| check_physical(model, p, t, &z[..n]);
+    let checker = super::physical::PhysicalCheck::new(model, p);
+    let check = |t: f64, z: &[f64]| checker.check(t, &z[..n]);
     let hooks = Hooks { check: Some(&check), ..Default::default() };
     let tr = integrate(&sys, &z0, period, &[period], opts, hooks)?;
     let z = tr.x.last().cloned().unwrap_or(tr.x_end);
@@ -142,7 +143,7 @@ pub fn shoot(model: &dyn Model, p: &[f64], x0: &[f64], period: f64, opts: &Shoot
         let r: Vec<f64> = (0..n).map(|i| (phi[i] - x[i]) / s[i]).collect();
         let res = r.iter().fold(0.0f64, |a, v| a.max(v.abs()));
         if res < opts.tol {
-            return Ok(finish(x, t_per, mono, it, res, stats, n));
+            return Ok(finish(x, t_per, mono, it, res, stats, n, &s));
         }
         model.rhs(p, &phi, t_per, &mut f);
         let rows = n + 1 + usize::from(!masses.is_empty());
@@ -180,8 +181,24 @@ pub fn shoot(model: &dyn Model, p: &[f64], x0: &[f64], period: f64, opts: &Shoot
     Err(SimError::ShootingFailed { iterations: opts.max_iter, residual: res, why: "Newton did not converge".into() })
 }
 
-fn finish(x: Vec<f64>, period: f64, mono: Vec<f64>, iterations: usize, residual: f64, stats: SolverStats, n: usize) -> LimitCycle {
-    LimitCycle { floquet: floquet_multipliers(&mono, n), x0: x, period, monodromy: mono, iterations, residual, stats }
+fn finish(x: Vec<f64>, period: f64, mono: Vec<f64>, iterations: usize, residual: f64, stats: SolverStats, n: usize, scale: &[f64]) -> LimitCycle {
+    LimitCycle { floquet: floquet_multipliers_scaled(&mono, n, scale), x0: x, period, monodromy: mono, iterations, residual, stats }
+}
+
+/// Eigenvalues of `D^-1 Phi D` (`D = diag(scale)`, the same spectrum as `Phi`),
+/// largest modulus first. The states span ten orders of magnitude (positions in
+/// metres, pressures in pascal, masses in kilograms); without the similarity
+/// scaling the eigen-solver's backward error, amplified by the double multiplier
+/// 1 (a Jordan block: the period depends on the inventory), splits that pair by
+/// `~sqrt(eps |Phi|)`.
+pub fn floquet_multipliers_scaled(mono: &[f64], n: usize, scale: &[f64]) -> Vec<(f64, f64)> {
+    let mut m = mono.to_vec();
+    for j in 0..n {
+        for i in 0..n {
+            m[i + j * n] *= scale[j] / scale[i];
+        }
+    }
+    floquet_multipliers(&m, n)
 }
 
 /// Eigenvalues of a column-major `n x n` monodromy matrix, largest modulus first.

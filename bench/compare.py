@@ -1,0 +1,202 @@
+"""Side-by-side benchmark of `nsection` (full closure): ours (generated Rust), CasADi (SX graph,
+generated C compiled with gcc -O3, CVODES) and SciPy (NumPy RHS, hand-written Jacobian,
+`solve_ivp` BDF).
+
+For each n: run the Rust binary (`examples/bench_native.rs`, JSON), build the CasADi and
+SciPy models on the parameters the binary printed, check that all three give the same RHS and
+Jacobian at the same state (relative 1e-9; otherwise the race is not fair and the run stops),
+then time. Prints one table, writes `results.json` and `scaling.svg` next to this file.
+
+Usage: python compare.py [--ns 2,10,100,1000] [--native PATH] [--scipy-sim-max-n 100]
+"""
+import argparse
+import json
+import os
+import subprocess
+import sys
+
+import numpy as np
+
+import casadi_model
+import scipy_model
+from common import Topology
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+ROOT = os.path.dirname(HERE)
+TOL = 1e-9
+
+
+def native(path, n, t_end):
+    cmd = [path, "--n", str(n), "--json", "--t-end", str(t_end)]
+    out = subprocess.run(cmd, check=True, capture_output=True, text=True).stdout
+    return json.loads(out)
+
+
+def dense(trip, nx):
+    J = np.zeros((nx, nx))
+    for r, c, v in trip:
+        J[int(r), int(c)] += v
+    return J
+
+
+def rel_err(a, b, groups):
+    """max over entries of |a - b| / max(|b|, 1e-12 * max|b| over the entry's group): relative,
+    with a floor for entries that cancel to round-off (e.g. mass flows near equilibrium)."""
+    a, b = np.asarray(a), np.asarray(b)
+    worst = 0.0
+    for g in groups:
+        bg, ag = b[g], a[g]
+        floor = 1e-12 * max(np.abs(bg).max(), 1e-300)
+        worst = max(worst, float(np.max(np.abs(ag - bg) / np.maximum(np.abs(bg), floor))))
+    return worst
+
+
+def fairness(ours, other, nx, ncv):
+    groups = [np.arange(0, 4), 4 + np.arange(ncv), 4 + ncv + np.arange(ncv)]
+    ex = float(np.max(np.abs(np.array(ours["x"]) - np.array(other["x"])) / np.maximum(np.abs(ours["x"]), 1e-300)))
+    ef = rel_err(other["f"], ours["f"], groups)
+    Jo, Jt = dense(ours["jac"], nx), dense(other["jac"], nx)
+    # compare entrywise on the union of both patterns, relative to each column's largest entry
+    # within the same state group as the row (so mechanical rows are not swamped by pressure rows)
+    ej = 0.0
+    for g in groups:
+        sub_o, sub_t = Jo[g, :], Jt[g, :]
+        colmax = np.maximum(np.abs(sub_o).max(axis=0), 1e-300)
+        d = np.abs(sub_t - sub_o)
+        rel = np.where(np.abs(sub_o) > 1e-12 * colmax, d / np.maximum(np.abs(sub_o), 1e-300), d / colmax)
+        ej = max(ej, float(rel.max()))
+    return {"x": ex, "f": ef, "jac": ej}
+
+
+def fmt_t(s):
+    if s is None:
+        return "-"
+    if s < 1e-6:
+        return f"{s * 1e9:.0f} ns"
+    if s < 1e-3:
+        return f"{s * 1e6:.2f} us"
+    if s < 1:
+        return f"{s * 1e3:.1f} ms"
+    return f"{s:.2f} s"
+
+
+def ratio(a, b):
+    return None if (a is None or b is None or a == 0) else b / a
+
+
+def fmt_r(r):
+    return "-" if r is None else (f"{r:.1f}x" if r < 100 else f"{r:.0f}x")
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--ns", default="2,10,100,1000")
+    ap.add_argument("--native", default=os.path.join(ROOT, "target", "release", "examples", "bench_native"))
+    ap.add_argument("--scipy-sim-max-n", type=int, default=100,
+                    help="skip the SciPy simulated second above this n (it takes minutes)")
+    ap.add_argument("--t-end", type=float, default=1.0)
+    ap.add_argument("--no-casadi-vm", action="store_true", help="skip CVODES with the SX virtual machine")
+    a = ap.parse_args()
+    ns = [int(s) for s in a.ns.split(",")]
+    rows = []
+    for n in ns:
+        print(f"--- n = {n}", file=sys.stderr, flush=True)
+        ours = native(a.native, n, a.t_end)
+        params = ours["params"]
+        nx, ncv = ours["n_states"], n + 2
+        topo = Topology(n, params)
+        assert topo.nx == nx
+        print("    casadi", file=sys.stderr, flush=True)
+        cas = casadi_model.run(n, params, t_end=a.t_end, rtol=ours["rtol"], atol=ours["atol"],
+                               vm_sim=not a.no_casadi_vm)
+        print("    scipy", file=sys.stderr, flush=True)
+        sci = scipy_model.run(n, params, do_sim=n <= a.scipy_sim_max_n, t_end=a.t_end, rtol=ours["rtol"], atol=ours["atol"])
+        # the simulation starts and scales must agree too
+        assert np.allclose(topo.sim_start(), ours["x0_sim"], rtol=1e-14, atol=0), "different sim start"
+        assert np.allclose(topo.scale(), ours["scale"], rtol=1e-14, atol=0), "different tolerance scales"
+        fair = {"casadi": fairness(ours, cas, nx, ncv), "scipy": fairness(ours, sci, nx, ncv)}
+        for who, e in fair.items():
+            bad = {k: v for k, v in e.items() if v > TOL}
+            if bad:
+                sys.exit(f"n = {n}: {who} disagrees with ours beyond {TOL}: {bad}")
+        t_o, t_c, t_s = ours["timings"], cas["timings"], sci["timings"]
+        sims_c = [s for s in cas.get("sims", []) if s.get("ok")]
+        best_c = min(sims_c, key=lambda s: s["seconds"]) if sims_c else None
+        sim_o = ours["sim"] if ours.get("sim", {}).get("ok") else None
+        sim_s = sci.get("sim") if sci.get("sim", {}).get("ok") else None
+        # end states should agree to the integration tolerance (a sanity check, not a gate)
+        def end_dev(s):
+            if not (s and sim_o):
+                return None
+            d = (np.array(s["x_end"]) - np.array(sim_o["x_end"])) / np.array(ours["scale"])
+            return float(np.abs(d).max())
+        row = {
+            "n": n, "states": nx, "fair": fair,
+            "rhs": {"ours": t_o["rhs"], "casadi": t_c["rhs"], "scipy": t_s["rhs"]},
+            "jac": {"ours": t_o["jac"], "casadi": t_c["jac"], "scipy": t_s["jac"]},
+            "jac_fd_ours": t_o["jac_fd"],
+            "sim": {"ours": sim_o and sim_o["seconds"], "casadi": best_c and best_c["seconds"],
+                    "scipy": sim_s and sim_s["seconds"]},
+            "sim_detail": {"ours": {k: v for k, v in (ours.get("sim") or {}).items() if k != "x_end"},
+                           "casadi": [{k: v for k, v in s.items() if k != "x_end"} for s in cas.get("sims", [])],
+                           "scipy": {k: v for k, v in (sci.get("sim") or {}).items() if k != "x_end"}},
+            "sim_end_dev": {"casadi": end_dev(best_c), "scipy": end_dev(sim_s)},
+            "poles_ours": ours.get("poles"),
+            "casadi_build_s": cas["build_and_compile_seconds"],
+            "casadi_python_call": {"rhs": t_c["rhs_python_call"], "jac": t_c["jac_python_call"]},
+        }
+        rows.append(row)
+        print(f"    fair: {fair}", file=sys.stderr, flush=True)
+    with open(os.path.join(HERE, "results.json"), "w") as fh:
+        json.dump(rows, fh, indent=1)
+    print_table(rows, a.t_end)
+    plot(rows)
+
+
+def print_table(rows, t_end):
+    hdr = ("| n | states | RHS ours | RHS CasADi | RHS SciPy | Jac ours | Jac CasADi | Jac SciPy | FD ours | FD/Jac "
+           "| (RHS+Jac) CasADi/ours | sim ours | sim CVODES | sim SciPy | CVODES/ours | SciPy/ours | poles ours |")
+    print(hdr)
+    print("|" + "|".join(["---"] * (hdr.count("|") - 1)) + "|")
+    for r in rows:
+        rj = r["rhs"], r["jac"]
+        sum_o = r["rhs"]["ours"] + r["jac"]["ours"]
+        sum_c = r["rhs"]["casadi"] + r["jac"]["casadi"]
+        s = r["sim"]
+        poles = r["poles_ours"]["seconds"] if r["poles_ours"] and r["poles_ours"].get("ok") else None
+        cells = [str(r["n"]), str(r["states"]),
+                 fmt_t(rj[0]["ours"]), fmt_t(rj[0]["casadi"]), fmt_t(rj[0]["scipy"]),
+                 fmt_t(rj[1]["ours"]), fmt_t(rj[1]["casadi"]), fmt_t(rj[1]["scipy"]),
+                 fmt_t(r["jac_fd_ours"]), fmt_r(ratio(r["jac"]["ours"], r["jac_fd_ours"])),
+                 fmt_r(ratio(sum_o, sum_c)),
+                 fmt_t(s["ours"]), fmt_t(s["casadi"]), fmt_t(s["scipy"]) if s["scipy"] else "skipped",
+                 fmt_r(ratio(s["ours"], s["casadi"])), fmt_r(ratio(s["ours"], s["scipy"])), fmt_t(poles)]
+        print("| " + " | ".join(cells) + " |")
+    print(f"\nsim = {t_end:g} s of engine time from rest with the displacer moved 5 mm; ratios > 1x mean ours is faster.")
+
+
+def plot(rows):
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    n = [r["n"] for r in rows]
+    fig, axs = plt.subplots(1, 3, figsize=(14, 4.2))
+    for ax, key, title in ((axs[0], "rhs", "one RHS"), (axs[1], "jac", "one Jacobian")):
+        for who, st in (("ours", "o-"), ("casadi", "s--"), ("scipy", "^:")):
+            ax.loglog(n, [r[key][who] for r in rows], st, label={"ours": "ours (Rust)", "casadi": "CasADi C -O3", "scipy": "NumPy"}[who])
+        if key == "jac":
+            ax.loglog(n, [r["jac_fd_ours"] for r in rows], "x-.", label="ours, finite differences")
+        ax.set_title(title); ax.set_xlabel("n (regenerator sections)"); ax.set_ylabel("seconds"); ax.grid(True, which="both", alpha=.3); ax.legend()
+    ax = axs[2]
+    for who, st, lab in (("ours", "o-", "ours (diffsol BDF)"), ("casadi", "s--", "CasADi CVODES"), ("scipy", "^:", "SciPy BDF")):
+        pts = [(r["n"], r["sim"][who]) for r in rows if r["sim"][who]]
+        if pts:
+            ax.loglog(*zip(*pts), st, label=lab)
+    ax.set_title("one simulated second"); ax.set_xlabel("n (regenerator sections)"); ax.set_ylabel("seconds"); ax.grid(True, which="both", alpha=.3); ax.legend()
+    fig.suptitle("nsection (full closure): time per call / per simulated second")
+    fig.tight_layout()
+    fig.savefig(os.path.join(HERE, "scaling.svg"))
+
+
+if __name__ == "__main__":
+    main()
