@@ -23,7 +23,13 @@ fn state(m: &dyn Model, p: &[f64]) -> Vec<f64> {
 }
 
 /// Forward differences, one RHS per column: the baseline an analytic Jacobian replaces.
-fn fd_jacobian(m: &dyn Model, p: &[f64], x: &[f64], f0: &[f64], out: &mut Vec<(usize, usize, f64)>) {
+fn fd_jacobian(
+    m: &dyn Model,
+    p: &[f64],
+    x: &[f64],
+    f0: &[f64],
+    out: &mut Vec<(usize, usize, f64)>,
+) {
     let n = x.len();
     let mut xp = x.to_vec();
     let mut f = vec![0.0; n];
@@ -57,7 +63,12 @@ fn bench(c: &mut Criterion) {
         g.bench_with_input(BenchmarkId::new("jacobian_analytic", n), &n, |b, _| {
             b.iter(|| {
                 trip.clear();
-                m.jacobian(black_box(&p), black_box(&x), 0.0, &mut JacSink::Triplets(&mut trip))
+                m.jacobian(
+                    black_box(&p),
+                    black_box(&x),
+                    0.0,
+                    &mut JacSink::Triplets(&mut trip),
+                )
             })
         });
         if n <= 100 {

@@ -47,7 +47,15 @@ fn fairness_state(m: &dyn Model, p: &[f64]) -> Vec<f64> {
 }
 
 /// Forward differences, one RHS per column, nonzeros kept as triplets.
-fn fd_jacobian(m: &dyn Model, p: &[f64], x: &[f64], base: &mut [f64], xp: &mut [f64], f: &mut [f64], out: &mut Vec<(usize, usize, f64)>) {
+fn fd_jacobian(
+    m: &dyn Model,
+    p: &[f64],
+    x: &[f64],
+    base: &mut [f64],
+    xp: &mut [f64],
+    f: &mut [f64],
+    out: &mut Vec<(usize, usize, f64)>,
+) {
     let n = x.len();
     out.clear();
     m.rhs(p, x, 0.0, base); // f(x) is part of the cost of a finite-difference Jacobian
@@ -73,7 +81,9 @@ fn time_per_call(mut f: impl FnMut(), batch_s: f64, reps: usize, budget_s: f64) 
     f();
     let one = t0.elapsed().as_secs_f64().max(1e-9);
     let k = ((batch_s / one).ceil() as usize).max(1);
-    let reps = reps.min(((budget_s / (one * k as f64)).floor() as usize).max(1)).max(1);
+    let reps = reps
+        .min(((budget_s / (one * k as f64)).floor() as usize).max(1))
+        .max(1);
     let mut v = Vec::with_capacity(reps);
     for _ in 0..reps {
         let t = Instant::now();
@@ -117,7 +127,9 @@ fn main() {
             "--no-sim" => do_sim = false,
             "--no-poles" => do_poles = false,
             "-h" | "--help" => {
-                eprintln!("usage: bench_native [--n N] [--json] [--no-sim] [--no-poles] [--t-end T]");
+                eprintln!(
+                    "usage: bench_native [--n N] [--json] [--no-sim] [--no-poles] [--t-end T]"
+                );
                 return;
             }
             other => panic!("unknown argument `{other}`"),
@@ -137,12 +149,22 @@ fn main() {
 
     // --- RHS
     let mut out = vec![0.0; ns];
-    let (t_rhs, n_rhs) = time_per_call(|| m.rhs(black_box(&p), black_box(&x), 0.0, black_box(&mut out)), 2e-3, 51, 2.0);
+    let (t_rhs, n_rhs) = time_per_call(
+        || m.rhs(black_box(&p), black_box(&x), 0.0, black_box(&mut out)),
+        2e-3,
+        51,
+        2.0,
+    );
     // --- analytic Jacobian (triplets)
     let (t_jac, n_jac) = time_per_call(
         || {
             trip.clear();
-            m.jacobian(black_box(&p), black_box(&x), 0.0, &mut JacSink::Triplets(&mut trip));
+            m.jacobian(
+                black_box(&p),
+                black_box(&x),
+                0.0,
+                &mut JacSink::Triplets(&mut trip),
+            );
             black_box(&trip);
         },
         2e-3,
@@ -154,7 +176,15 @@ fn main() {
     let (t_jac_dense, _) = time_per_call(
         || {
             dense.iter_mut().for_each(|v| *v = 0.0);
-            m.jacobian(black_box(&p), black_box(&x), 0.0, &mut JacSink::Dense { data: &mut dense, nrows: ns });
+            m.jacobian(
+                black_box(&p),
+                black_box(&x),
+                0.0,
+                &mut JacSink::Dense {
+                    data: &mut dense,
+                    nrows: ns,
+                },
+            );
             black_box(&dense);
         },
         2e-3,
@@ -166,7 +196,22 @@ fn main() {
     let mut ff = vec![0.0; ns];
     let mut fbase = vec![0.0; ns];
     let mut fd_trip = Vec::with_capacity(16 * ns);
-    let (t_fd, _) = time_per_call(|| fd_jacobian(&m, black_box(&p), black_box(&x), &mut fbase, &mut xp, &mut ff, &mut fd_trip), 2e-3, 21, 3.0);
+    let (t_fd, _) = time_per_call(
+        || {
+            fd_jacobian(
+                &m,
+                black_box(&p),
+                black_box(&x),
+                &mut fbase,
+                &mut xp,
+                &mut ff,
+                &mut fd_trip,
+            )
+        },
+        2e-3,
+        21,
+        3.0,
+    );
     // FD accuracy against the analytic Jacobian (relative to the column scale), for the record
     let fd_err = {
         let mut a = vec![0.0; ns * ns];
@@ -179,7 +224,10 @@ fn main() {
         }
         let mut worst: f64 = 0.0;
         for c in 0..ns {
-            let col_max = (0..ns).map(|r| a[r + c * ns].abs()).fold(0.0, f64::max).max(1e-300);
+            let col_max = (0..ns)
+                .map(|r| a[r + c * ns].abs())
+                .fold(0.0, f64::max)
+                .max(1e-300);
             for r in 0..ns {
                 worst = worst.max((a[r + c * ns] - d[r + c * ns]).abs() / col_max);
             }
@@ -231,7 +279,14 @@ fn main() {
         let mut steps = 0;
         for _ in 0..3 {
             let t = Instant::now();
-            let r = integrate(&ModelSystem { model: &m, p: &p }, &x0, t_end, &[t_end], &opts, Hooks::default());
+            let r = integrate(
+                &ModelSystem { model: &m, p: &p },
+                &x0,
+                t_end,
+                &[t_end],
+                &opts,
+                Hooks::default(),
+            );
             times.push(t.elapsed().as_secs_f64());
             match r {
                 Ok(tr) => steps = tr.stats.steps,
@@ -302,9 +357,18 @@ fn main() {
     } else {
         println!("nsection n = {n} (full, {ns} states)");
         println!("  rhs          {:>12.3} us", t_rhs * 1e6);
-        println!("  jac analytic {:>12.3} us ({} nonzeros)", t_jac * 1e6, jac_at_x.len());
+        println!(
+            "  jac analytic {:>12.3} us ({} nonzeros)",
+            t_jac * 1e6,
+            jac_at_x.len()
+        );
         println!("  jac dense    {:>12.3} us", t_jac_dense * 1e6);
-        println!("  jac FD       {:>12.3} us (x{:.1}, max rel err {:.1e})", t_fd * 1e6, t_fd / t_jac, fd_err);
+        println!(
+            "  jac FD       {:>12.3} us (x{:.1}, max rel err {:.1e})",
+            t_fd * 1e6,
+            t_fd / t_jac,
+            fd_err
+        );
         if let Some(s) = &sim {
             println!("  sim {t_end} s     {}", s);
         }

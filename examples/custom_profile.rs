@@ -126,7 +126,11 @@ pub struct Args {
 
 impl Default for Args {
     fn default() -> Self {
-        Self { n: 8, kappa: 2.0, json: false }
+        Self {
+            n: 8,
+            kappa: 2.0,
+            json: false,
+        }
     }
 }
 
@@ -137,10 +141,21 @@ pub fn parse_args<I: IntoIterator<Item = String>>(args: I) -> Result<Args, Strin
     let mut a = Args::default();
     let mut it = args.into_iter();
     while let Some(flag) = it.next() {
-        let mut value = |name: &str| it.next().ok_or_else(|| format!("{name} needs a value\n{USAGE}"));
+        let mut value = |name: &str| {
+            it.next()
+                .ok_or_else(|| format!("{name} needs a value\n{USAGE}"))
+        };
         match flag.as_str() {
-            "--n" => a.n = value("--n")?.parse().map_err(|e| format!("--n: {e}\n{USAGE}"))?,
-            "--kappa" => a.kappa = value("--kappa")?.parse().map_err(|e| format!("--kappa: {e}\n{USAGE}"))?,
+            "--n" => {
+                a.n = value("--n")?
+                    .parse()
+                    .map_err(|e| format!("--n: {e}\n{USAGE}"))?
+            }
+            "--kappa" => {
+                a.kappa = value("--kappa")?
+                    .parse()
+                    .map_err(|e| format!("--kappa: {e}\n{USAGE}"))?
+            }
             "--json" => a.json = true,
             "-h" | "--help" => return Err(USAGE.to_string()),
             other => return Err(format!("unknown argument `{other}`\n{USAGE}")),
@@ -175,7 +190,9 @@ pub struct Summary {
 
 /// The profile as declared, evaluated in Rust (for printing and for the tests).
 pub fn wall_profile(th: f64, tk: f64, kappa: f64, n: usize) -> Vec<f64> {
-    (0..n).map(|j| tk + (th - tk) * ((n as f64 - j as f64 - 0.5) / n as f64).powf(kappa)).collect()
+    (0..n)
+        .map(|j| tk + (th - tk) * ((n as f64 - j as f64 - 0.5) / n as f64).powf(kappa))
+        .collect()
 }
 
 /// Equilibrium, poles and margins of `model` at exponent `kappa`.
@@ -183,12 +200,25 @@ pub fn case(model: &ProfiledRegenerator, kappa: f64) -> Result<Case, Box<dyn Err
     let mut p = model.default_params();
     let ik = model.param_index("kappa").ok_or("no parameter kappa")?;
     p[ik] = kappa;
-    let (th, tk) = (p[model.param_index("Th").ok_or("Th")?], p[model.param_index("Tk").ok_or("Tk")?]);
+    let (th, tk) = (
+        p[model.param_index("Th").ok_or("Th")?],
+        p[model.param_index("Tk").ok_or("Tk")?],
+    );
     let linear = linear::linearize(model, &p, &LinearOptions::default())?;
-    let n_cv = model.states().iter().filter(|s| matches!(s.kind, StateKind::Pressure(_))).count();
+    let n_cv = model
+        .states()
+        .iter()
+        .filter(|s| matches!(s.kind, StateKind::Pressure(_)))
+        .count();
     let mut gas = vec![0.0; n_cv];
     model.temperatures(&p, &linear.dynamics.equilibrium.x, &mut gas);
-    Ok(Case { kappa, wall: wall_profile(th, tk, kappa, model.n()), gas, p, linear })
+    Ok(Case {
+        kappa,
+        wall: wall_profile(th, tk, kappa, model.n()),
+        gas,
+        p,
+        linear,
+    })
 }
 
 /// Build at `n` and analyse the chosen and the linear profile.
@@ -196,23 +226,50 @@ pub fn run(args: &Args) -> Result<Summary, Box<dyn Error>> {
     let model = ProfiledRegenerator::new(args.n, Closure::Full)?;
     let chosen = case(&model, args.kappa)?;
     let linear_profile = case(&model, 1.0)?;
-    Ok(Summary { model, chosen, linear_profile })
+    Ok(Summary {
+        model,
+        chosen,
+        linear_profile,
+    })
 }
 
 fn print_case(c: &Case) {
     let eq = &c.linear.dynamics.equilibrium;
-    println!("kappa = {}: equilibrium in {} Newton iterations (scaled residual {:.2e} 1/s)", c.kappa, eq.iterations, eq.scaled_residual);
+    println!(
+        "kappa = {}: equilibrium in {} Newton iterations (scaled residual {:.2e} 1/s)",
+        c.kappa, eq.iterations, eq.scaled_residual
+    );
     println!("  {:>8} {:>10} {:>10}", "section", "wall (K)", "gas (K)");
     for (j, (tw, tg)) in c.wall.iter().zip(&c.gas[1..]).enumerate() {
         println!("  {j:>8} {tw:>10.2} {tg:>10.2}");
     }
-    println!("  hot gas {:.2} K, cold gas {:.2} K", c.gas[0], c.gas[c.gas.len() - 1]);
+    println!(
+        "  hot gas {:.2} K, cold gas {:.2} K",
+        c.gas[0],
+        c.gas[c.gas.len() - 1]
+    );
     println!("  dynamic poles (1/s):");
-    for pole in c.linear.dynamics.poles.iter().filter(|p| p.im >= 0.0).take(6) {
-        println!("    {:>12.4} {:+12.4}j ({:7.3} Hz){}", pole.re, pole.im, pole.freq_hz, if pole.rhp { "  unstable" } else { "" });
+    for pole in c
+        .linear
+        .dynamics
+        .poles
+        .iter()
+        .filter(|p| p.im >= 0.0)
+        .take(6)
+    {
+        println!(
+            "    {:>12.4} {:+12.4}j ({:7.3} Hz){}",
+            pole.re,
+            pole.im,
+            pole.freq_hz,
+            if pole.rhp { "  unstable" } else { "" }
+        );
     }
     let mg = &c.linear.margins;
-    let fmt = |v: Option<f64>, unit: &str| v.map(|v| format!("{v:.3} {unit}")).unwrap_or_else(|| "none".into());
+    let fmt = |v: Option<f64>, unit: &str| {
+        v.map(|v| format!("{v:.3} {unit}"))
+            .unwrap_or_else(|| "none".into())
+    };
     println!(
         "  loop at `{}`: Gm = {} at {}, Pm = {} at {}",
         c.linear.open_loop.full.name,
@@ -226,10 +283,23 @@ fn print_case(c: &Case) {
 /// The text report.
 pub fn print(s: &Summary) {
     let m = &s.model;
-    println!("model {} (n = {}, closure {}, {} states)", m.name(), m.n(), m.closure(), m.n_states());
+    println!(
+        "model {} (n = {}, closure {}, {} states)",
+        m.name(),
+        m.n(),
+        m.closure(),
+        m.n_states()
+    );
     print_case(&s.chosen);
     print_case(&s.linear_profile);
-    let growth = |c: &Case| c.linear.dynamics.poles.first().map(|p| p.re).unwrap_or(f64::NAN);
+    let growth = |c: &Case| {
+        c.linear
+            .dynamics
+            .poles
+            .first()
+            .map(|p| p.re)
+            .unwrap_or(f64::NAN)
+    };
     println!(
         "growth rate of the leading pair: {:.4} 1/s (kappa = {}) vs {:.4} 1/s (linear profile)",
         growth(&s.chosen),
@@ -261,7 +331,10 @@ fn main() {
         }
     };
     match run(&args) {
-        Ok(s) if args.json => println!("{}", serde_json::to_string_pretty(&json(&s)).unwrap_or_default()),
+        Ok(s) if args.json => println!(
+            "{}",
+            serde_json::to_string_pretty(&json(&s)).unwrap_or_default()
+        ),
         Ok(s) => print(&s),
         Err(e) => {
             eprintln!("custom_profile: {e}");

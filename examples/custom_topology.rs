@@ -146,24 +146,42 @@ pub struct Args {
 
 impl Default for Args {
     fn default() -> Self {
-        Self { n: 2, out: Some(PathBuf::from("target/custom_topology")), json: false, t_max: 20.0, quiet: false }
+        Self {
+            n: 2,
+            out: Some(PathBuf::from("target/custom_topology")),
+            json: false,
+            t_max: 20.0,
+            quiet: false,
+        }
     }
 }
 
-const USAGE: &str = "usage: custom_topology [--n N] [--out DIR | --no-plots] [--json] [--t-max SECONDS]";
+const USAGE: &str =
+    "usage: custom_topology [--n N] [--out DIR | --no-plots] [--json] [--t-max SECONDS]";
 
 /// Parse `--n N`, `--out DIR`, `--no-plots`, `--json`, `--t-max T`.
 pub fn parse_args<I: IntoIterator<Item = String>>(args: I) -> Result<Args, String> {
     let mut a = Args::default();
     let mut it = args.into_iter();
     while let Some(flag) = it.next() {
-        let mut value = |name: &str| it.next().ok_or_else(|| format!("{name} needs a value\n{USAGE}"));
+        let mut value = |name: &str| {
+            it.next()
+                .ok_or_else(|| format!("{name} needs a value\n{USAGE}"))
+        };
         match flag.as_str() {
-            "--n" => a.n = value("--n")?.parse().map_err(|e| format!("--n: {e}\n{USAGE}"))?,
+            "--n" => {
+                a.n = value("--n")?
+                    .parse()
+                    .map_err(|e| format!("--n: {e}\n{USAGE}"))?
+            }
             "--out" => a.out = Some(PathBuf::from(value("--out")?)),
             "--no-plots" => a.out = None,
             "--json" => a.json = true,
-            "--t-max" => a.t_max = value("--t-max")?.parse().map_err(|e| format!("--t-max: {e}\n{USAGE}"))?,
+            "--t-max" => {
+                a.t_max = value("--t-max")?
+                    .parse()
+                    .map_err(|e| format!("--t-max: {e}\n{USAGE}"))?
+            }
             "-h" | "--help" => return Err(USAGE.to_string()),
             other => return Err(format!("unknown argument `{other}`\n{USAGE}")),
         }
@@ -192,17 +210,30 @@ pub struct Summary {
 pub fn perturbed(model: &dyn Model, p: &[f64]) -> Vec<f64> {
     let mut x = vec![0.0; model.n_states()];
     model.equilibrium_guess(p, &mut x);
-    let ix = model.states().iter().position(|s| s.kind == StateKind::Position(0)).expect("displacer");
+    let ix = model
+        .states()
+        .iter()
+        .position(|s| s.kind == StateKind::Position(0))
+        .expect("displacer");
     x[ix] += 5e-3;
     x
 }
 
 /// Mean of `c_alt w^2` over uniform orbit samples (last = first).
 pub fn electric_power(model: &dyn Model, p: &[f64], orbit: &[Vec<f64>]) -> f64 {
-    let iw = model.states().iter().position(|s| s.kind == StateKind::Velocity(1)).expect("piston velocity");
+    let iw = model
+        .states()
+        .iter()
+        .position(|s| s.kind == StateKind::Velocity(1))
+        .expect("piston velocity");
     let c_alt = p[model.param_index("c_alt").expect("c_alt")];
     let k = orbit.len().saturating_sub(1).max(1);
-    orbit.iter().take(k).map(|x| c_alt * x[iw] * x[iw]).sum::<f64>() / k as f64
+    orbit
+        .iter()
+        .take(k)
+        .map(|x| c_alt * x[iw] * x[iw])
+        .sum::<f64>()
+        / k as f64
 }
 
 /// Build the model, run the analyses, write the figures.
@@ -212,28 +243,67 @@ pub fn run(args: &Args) -> Result<Summary, Box<dyn Error>> {
     let lin = linear::linearize(&model, &p, &LinearOptions::default())?;
     let x0 = perturbed(&model, &p);
     let samples = sim::uniform_samples(args.t_max.min(1.0), 2000);
-    let cycle = sim::limit_cycle(&model, &p, &x0, args.t_max, &samples, &SimOptions::default(), None)?;
+    let cycle = sim::limit_cycle(
+        &model,
+        &p,
+        &x0,
+        args.t_max,
+        &samples,
+        &SimOptions::default(),
+        None,
+    )?;
     let electric_power_w = electric_power(&model, &p, &cycle.orbit);
     let indicated_power_w = sim::indicated_power(cycle.work.total, cycle.figures.frequency_hz);
     let files = match &args.out {
         Some(dir) => figures(dir, &model, &p, &lin, &cycle)?,
         None => Vec::new(),
     };
-    Ok(Summary { model, p, linear: lin, cycle, electric_power_w, indicated_power_w, files })
+    Ok(Summary {
+        model,
+        p,
+        linear: lin,
+        cycle,
+        electric_power_w,
+        indicated_power_w,
+        files,
+    })
 }
 
-fn figures(dir: &Path, model: &dyn Model, p: &[f64], lin: &Linearization, lc: &LimitCycleReport) -> Result<Vec<PathBuf>, Box<dyn Error>> {
+fn figures(
+    dir: &Path,
+    model: &dyn Model,
+    p: &[f64],
+    lin: &Linearization,
+    lc: &LimitCycleReport,
+) -> Result<Vec<PathBuf>, Box<dyn Error>> {
     std::fs::create_dir_all(dir)?;
     let title = format!("{} (n = {})", model.name(), model.n());
     let states = model.states();
     let find = |k: StateKind| states.iter().position(|s| s.kind == k).unwrap_or(0);
-    let pressures: Vec<(String, usize)> =
-        states.iter().enumerate().filter(|(_, s)| matches!(s.kind, StateKind::Pressure(_))).map(|(i, s)| (s.name.clone(), i)).collect();
-    let files = [dir.join("poles.svg"), dir.join("bode.svg"), dir.join("startup.svg"), dir.join("pv.svg")];
+    let pressures: Vec<(String, usize)> = states
+        .iter()
+        .enumerate()
+        .filter(|(_, s)| matches!(s.kind, StateKind::Pressure(_)))
+        .map(|(i, s)| (s.name.clone(), i))
+        .collect();
+    let files = [
+        dir.join("poles.svg"),
+        dir.join("bode.svg"),
+        dir.join("startup.svg"),
+        dir.join("pv.svg"),
+    ];
     plot::poles::pole_map(&files[0], &title, &lin.dynamics.poles, &lin.open_loop.poles)?;
     plot::bode::bode_diagram(&files[1], &title, &lin.bode(), &lin.margins)?;
     let tr = &lc.settled.trajectory;
-    plot::timeseries::startup_svg(&files[2], &title, &tr.t, &tr.x, find(StateKind::Position(0)), find(StateKind::Position(1)), &pressures)?;
+    plot::timeseries::startup_svg(
+        &files[2],
+        &title,
+        &tr.t,
+        &tr.x,
+        find(StateKind::Position(0)),
+        find(StateKind::Position(1)),
+        &pressures,
+    )?;
     let nv = model.vessel_names().len();
     let mut loops = vec![Vec::new(); nv];
     let (mut pr, mut v) = (vec![0.0; nv], vec![0.0; nv]);
@@ -243,7 +313,13 @@ fn figures(dir: &Path, model: &dyn Model, p: &[f64], lin: &Linearization, lc: &L
             loops[i].push((v[i], pr[i]));
         }
     }
-    plot::pv::pv_svg(&files[3], &title, &lc.work.vessels, &loops, &lc.work.per_vessel)?;
+    plot::pv::pv_svg(
+        &files[3],
+        &title,
+        &lc.work.vessels,
+        &loops,
+        &lc.work.per_vessel,
+    )?;
     Ok(files.to_vec())
 }
 
@@ -252,37 +328,90 @@ pub fn print(s: &Summary) {
     let m = &s.model;
     let lin = &s.linear;
     let eq = &lin.dynamics.equilibrium;
-    println!("model {} (n = {}, closure {}, {} states)", m.name(), m.n(), m.closure(), m.n_states());
-    println!("equilibrium: {} Newton iterations, scaled residual {:.2e} 1/s", eq.iterations, eq.scaled_residual);
+    println!(
+        "model {} (n = {}, closure {}, {} states)",
+        m.name(),
+        m.n(),
+        m.closure(),
+        m.n_states()
+    );
+    println!(
+        "equilibrium: {} Newton iterations, scaled residual {:.2e} 1/s",
+        eq.iterations, eq.scaled_residual
+    );
     for (name, v) in m.state_names().iter().zip(&eq.x) {
         println!("  {name:>12} = {v:.6e}");
     }
     if let Some(inv) = &lin.dynamics.reduction.inventory {
-        println!("inventory mode: eigenvalue {:.2e} 1/s, conservation defect {:.2e}", inv.eigenvalue, inv.conservation_defect);
+        println!(
+            "inventory mode: eigenvalue {:.2e} 1/s, conservation defect {:.2e}",
+            inv.eigenvalue, inv.conservation_defect
+        );
     }
     println!("dynamic poles (1/s):");
     for pole in &lin.dynamics.poles {
-        println!("  {:>12.4} {:+12.4}j  ({:7.3} Hz, zeta {:+.4}){}", pole.re, pole.im, pole.freq_hz, pole.damping_ratio, if pole.rhp { "  unstable" } else { "" });
+        println!(
+            "  {:>12.4} {:+12.4}j  ({:7.3} Hz, zeta {:+.4}){}",
+            pole.re,
+            pole.im,
+            pole.freq_hz,
+            pole.damping_ratio,
+            if pole.rhp { "  unstable" } else { "" }
+        );
     }
     let mg = &lin.margins;
-    let fmt = |v: Option<f64>, unit: &str| v.map(|v| format!("{v:.3} {unit}")).unwrap_or_else(|| "none".into());
-    println!("loop broken at `{}` ({}):", lin.open_loop.full.name, lin.open_loop.full.unit);
-    println!("  Gm = {} at {}, Pm = {} at {}", fmt(mg.gain_db, "dB"), fmt(mg.phase_crossover_rad_s, "rad/s"), fmt(mg.phase_deg, "deg"), fmt(mg.gain_crossover_rad_s, "rad/s"));
+    let fmt = |v: Option<f64>, unit: &str| {
+        v.map(|v| format!("{v:.3} {unit}"))
+            .unwrap_or_else(|| "none".into())
+    };
+    println!(
+        "loop broken at `{}` ({}):",
+        lin.open_loop.full.name, lin.open_loop.full.unit
+    );
+    println!(
+        "  Gm = {} at {}, Pm = {} at {}",
+        fmt(mg.gain_db, "dB"),
+        fmt(mg.phase_crossover_rad_s, "rad/s"),
+        fmt(mg.phase_deg, "deg"),
+        fmt(mg.gain_crossover_rad_s, "rad/s")
+    );
     let lc = &s.cycle;
     let f = &lc.figures;
-    println!("limit cycle (settled at t = {:.3} s, shooting {} iterations, residual {:.2e}):", lc.settled.t, lc.cycle.iterations, lc.cycle.residual);
-    println!("  f = {:.4} Hz ({:.3} rad/s), x_amp = {:.3} mm, y_amp = {:.3} mm, phase x-y = {:.2} deg", f.frequency_hz, 2.0 * std::f64::consts::PI * f.frequency_hz, 1e3 * f.x_amp, 1e3 * f.y_amp, f.phase_deg);
+    println!(
+        "limit cycle (settled at t = {:.3} s, shooting {} iterations, residual {:.2e}):",
+        lc.settled.t, lc.cycle.iterations, lc.cycle.residual
+    );
+    println!(
+        "  f = {:.4} Hz ({:.3} rad/s), x_amp = {:.3} mm, y_amp = {:.3} mm, phase x-y = {:.2} deg",
+        f.frequency_hz,
+        2.0 * std::f64::consts::PI * f.frequency_hz,
+        1e3 * f.x_amp,
+        1e3 * f.y_amp,
+        f.phase_deg
+    );
     let names = m.vessel_names();
-    let pa: Vec<String> = names.iter().zip(&f.p_amp).map(|(n, a)| format!("{n} {:.3} kPa", 1e-3 * a)).collect();
+    let pa: Vec<String> = names
+        .iter()
+        .zip(&f.p_amp)
+        .map(|(n, a)| format!("{n} {:.3} kPa", 1e-3 * a))
+        .collect();
     println!("  pressure amplitudes: {}", pa.join(", "));
-    let moduli: Vec<String> = lc.cycle.floquet.iter().map(|(re, im)| format!("{:.4}", re.hypot(*im))).collect();
+    let moduli: Vec<String> = lc
+        .cycle
+        .floquet
+        .iter()
+        .map(|(re, im)| format!("{:.4}", re.hypot(*im)))
+        .collect();
     println!("  Floquet |mu|: {}", moduli.join(" "));
     println!("work per cycle (closed-integral P dV, J):");
     for (n, w) in lc.work.vessels.iter().zip(&lc.work.per_vessel) {
         println!("  {n:>12} {w:+.5e}");
     }
     println!("  {:>12} {:+.5e}", "total", lc.work.total);
-    println!("indicated power {:.4} W, electric (alternator) power {:.4} W", s.indicated_power_w, s.electric_power_w);
+    println!(
+        "indicated power {:.4} W, electric (alternator) power {:.4} W",
+        s.indicated_power_w, s.electric_power_w
+    );
     for file in &s.files {
         println!("wrote {}", file.display());
     }
@@ -310,7 +439,10 @@ fn main() {
         }
     };
     match run(&args) {
-        Ok(s) if args.json => println!("{}", serde_json::to_string_pretty(&json(&s)).unwrap_or_default()),
+        Ok(s) if args.json => println!(
+            "{}",
+            serde_json::to_string_pretty(&json(&s)).unwrap_or_default()
+        ),
         Ok(s) => print(&s),
         Err(e) => {
             eprintln!("custom_topology: {e}");

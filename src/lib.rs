@@ -36,9 +36,11 @@
 //! model.rhs(&p, &x, 0.0, &mut f);
 //! assert!(f.iter().all(|v| v.abs() < 1e-9)); // at rest
 //! let j = model.jacobian_dense(&p, &x, 0.0);
-//! // the gas spring stiffens the piston: d(w')/dy = -(k + gamma P0 A^2 / V0) / m
-//! let stiff = -(50.0 + 1.4 * 1e5 * 1e-6 / 1e-4) / 1.0;
-//! assert!((j[1 + 3 * 0] - stiff).abs() < 1e-9 * stiff.abs());
+//! let n = x.len(); // column-major: J[r + n c] = d f_r / d x_c
+//! assert!((j[1 + n * 0] + 50.0).abs() < 1e-12); // d(w')/dy = -k/m: the spring
+//! // the gas spring acts through the pressure state: d(P')/dw = gamma P0 A / V0
+//! let gas_spring = 1.4 * 1e5 * 1e-3 / 1e-4;
+//! assert!((j[2 + n * 1] - gas_spring).abs() < 1e-9 * gas_spring);
 //! println!("{}", model.equations(Style::Text));
 //! ```
 

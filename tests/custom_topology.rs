@@ -4,10 +4,10 @@
 //! trajectory with the bounce-space terms, it is linearly unstable, and it settles on a
 //! limit cycle that delivers electric power.
 
+mod common;
 #[path = "../examples/custom_topology.rs"]
 #[allow(dead_code)]
 mod ex;
-mod common;
 
 use ex::AlternatorEngine;
 use stirling::dsl::{Closure, Model, StateKind};
@@ -18,7 +18,8 @@ fn model(n: usize) -> AlternatorEngine {
 }
 
 fn value(m: &dyn Model, p: &[f64], name: &str) -> f64 {
-    p[m.param_index(name).unwrap_or_else(|| panic!("no parameter {name}"))]
+    p[m.param_index(name)
+        .unwrap_or_else(|| panic!("no parameter {name}"))]
 }
 
 #[test]
@@ -27,10 +28,21 @@ fn the_closed_bounce_space_is_a_control_volume() {
     // [x, v, y, w] + P of hot, regen[0], regen[1], cold, bounce + m of the four linked CVs
     assert_eq!(m.n_states(), 4 + 5 + 4, "{:?}", m.state_names());
     let vessels = m.vessel_names();
-    assert_eq!(vessels.len(), 5, "no given-pressure space is left: {vessels:?}");
+    assert_eq!(
+        vessels.len(),
+        5,
+        "no given-pressure space is left: {vessels:?}"
+    );
     assert!(vessels.iter().any(|v| v.contains("bounce")), "{vessels:?}");
-    let masses = m.states().iter().filter(|s| matches!(s.kind, StateKind::Mass(_))).count();
-    assert_eq!(masses, 4, "the bounce gas has no link, so its mass is a constant");
+    let masses = m
+        .states()
+        .iter()
+        .filter(|s| matches!(s.kind, StateKind::Mass(_)))
+        .count();
+    assert_eq!(
+        masses, 4,
+        "the bounce gas has no link, so its mass is a constant"
+    );
 }
 
 /// The shared checker (`tests/common`) at random states, with one adjustment: its pressure
@@ -45,28 +57,53 @@ fn jacobians_match_finite_differences() {
         let m = model(n);
         let p = m.default_params();
         let names = m.state_names();
-        let ib = names.iter().position(|s| s == "P_bounce").expect("P_bounce state");
+        let ib = names
+            .iter()
+            .position(|s| s == "P_bounce")
+            .expect("P_bounce state");
         let scales = common::state_scales(&m, &p);
         let mut rng = common::rng(90 + n as u64);
         let mut report = Vec::new();
         for spread in [common::Spread::Wide, common::Spread::Balanced] {
             for k in 0..3 {
                 let x = common::random_state(&m, &p, spread, &mut rng);
-                let mut bad: Vec<common::Mismatch> = common::check_jacobians(&m, &p, &x).into_iter().filter(|b| b.col != names[ib]).collect();
+                let mut bad: Vec<common::Mismatch> = common::check_jacobians(&m, &p, &x)
+                    .into_iter()
+                    .filter(|b| b.col != names[ib])
+                    .collect();
                 let mut steps = common::fd_steps(&m, &p, &x);
                 steps[ib] = 1.0;
                 let f = |xx: &[f64], out: &mut [f64]| m.rhs(&p, xx, 0.0, out);
                 let fd = common::fd_jacobian(&f, &x, x.len(), &steps);
                 let jac = m.jacobian_dense(&p, &x, 0.0);
                 bad.extend(
-                    common::compare(&jac, &fd, &names, &names, &scales, &scales, common::REL, common::TINY).into_iter().filter(|b| b.col == names[ib]),
+                    common::compare(
+                        &jac,
+                        &fd,
+                        &names,
+                        &names,
+                        &scales,
+                        &scales,
+                        common::REL,
+                        common::TINY,
+                    )
+                    .into_iter()
+                    .filter(|b| b.col == names[ib]),
                 );
                 for b in bad {
-                    report.push(format!("  n = {n}, {spread:?} state {k}: d {}/d {}: analytic {:.12e}, fd {:.12e}", b.row, b.col, b.analytic, b.fd));
+                    report.push(format!(
+                        "  n = {n}, {spread:?} state {k}: d {}/d {}: analytic {:.12e}, fd {:.12e}",
+                        b.row, b.col, b.analytic, b.fd
+                    ));
                 }
             }
         }
-        assert!(report.is_empty(), "{} Jacobian entries disagree:\n{}", report.len(), report.join("\n"));
+        assert!(
+            report.is_empty(),
+            "{} Jacobian entries disagree:\n{}",
+            report.len(),
+            report.join("\n")
+        );
     }
 }
 
@@ -87,20 +124,48 @@ fn power_terms_hold_the_bounce_and_alternator_terms() {
         let d = (4.0 * v("A") / std::f64::consts::PI).sqrt();
         let pi = std::f64::consts::PI;
         let heat = v("hh") * (v("Awh0") - pi * d * xd) * (v("Th") - t[0])
-            + (0..2).map(|j| v("hr") * v("Awr") / 2.0 * (v("Th") - (j as f64 + 0.5) * (v("Th") - v("Tk")) / 2.0 - t[1 + j])).sum::<f64>()
+            + (0..2)
+                .map(|j| {
+                    v("hr") * v("Awr") / 2.0
+                        * (v("Th") - (j as f64 + 0.5) * (v("Th") - v("Tk")) / 2.0 - t[1 + j])
+                })
+                .sum::<f64>()
             + v("hk") * (v("Awc0") + pi * d * (xd - y)) * (v("Tk") - t[3])
             + v("hb") * v("Awb") * (v("Tb") - t[4]);
-        let mech = -v("bd") * vd * vd - (v("bp") + v("c_alt")) * w * w - v("b") * (vd - w).powi(2) - v("bqd") * vd.abs().powi(3) - v("bqp") * w.abs().powi(3);
+        let mech = -v("bd") * vd * vd
+            - (v("bp") + v("c_alt")) * w * w
+            - v("b") * (vd - w).powi(2)
+            - v("bqd") * vd.abs().powi(3)
+            - v("bqp") * w.abs().powi(3);
         let pw = m.power(&p, &x);
-        assert!((pw.heat - heat).abs() <= 1e-9 * heat.abs().max(1.0), "heat {} vs {heat}", pw.heat);
-        assert_eq!(pw.boundary, 0.0, "a closed engine has no given-pressure boundary");
-        assert!((pw.mechanical - mech).abs() <= 1e-9 * mech.abs().max(1e-6), "mechanical {} vs {mech}", pw.mechanical);
+        assert!(
+            (pw.heat - heat).abs() <= 1e-9 * heat.abs().max(1.0),
+            "heat {} vs {heat}",
+            pw.heat
+        );
+        assert_eq!(
+            pw.boundary, 0.0,
+            "a closed engine has no given-pressure boundary"
+        );
+        assert!(
+            (pw.mechanical - mech).abs() <= 1e-9 * mech.abs().max(1e-6),
+            "mechanical {} vs {mech}",
+            pw.mechanical
+        );
         // the stored energy holds the bounce gas: sum P V / (gamma - 1) over all five CVs
         let (mut pr, mut vol) = (vec![0.0; 5], vec![0.0; 5]);
         m.pv(&p, &x, &mut pr, &mut vol);
         let gas: f64 = pr.iter().zip(&vol).map(|(a, b)| a * b).sum::<f64>() / (v("gamma") - 1.0);
-        let e = gas + 0.5 * v("md") * vd * vd + 0.5 * v("mp") * w * w + 0.5 * v("kd") * xd * xd + 0.5 * v("kp") * y * y;
-        assert!((m.energy(&p, &x) - e).abs() <= 1e-12 * e, "energy {} vs {e}", m.energy(&p, &x));
+        let e = gas
+            + 0.5 * v("md") * vd * vd
+            + 0.5 * v("mp") * w * w
+            + 0.5 * v("kd") * xd * xd
+            + 0.5 * v("kp") * y * y;
+        assert!(
+            (m.energy(&p, &x) - e).abs() <= 1e-12 * e,
+            "energy {} vs {e}",
+            m.energy(&p, &x)
+        );
     }
 }
 
@@ -118,9 +183,15 @@ fn energy_budget_closes_along_a_trajectory() {
     let samples = sim::uniform_samples(t_end, 4000);
     let mut z0 = x0.clone();
     z0.push(0.0);
-    let sys = EnergySystem { inner: ModelSystem { model: &m, p: &p } };
+    let sys = EnergySystem {
+        inner: ModelSystem { model: &m, p: &p },
+    };
     for rtol in [1e-6, 1e-9] {
-        let opts = SimOptions { rtol, atol: rtol, ..Default::default() };
+        let opts = SimOptions {
+            rtol,
+            atol: rtol,
+            ..Default::default()
+        };
         let tr = sim::integrate(&sys, &z0, t_end, &samples, &opts, Hooks::default()).unwrap();
         let (mut worst, mut swing, mut trap, mut trap_worst) = (0.0f64, 0.0f64, 0.0f64, 0.0f64);
         let total = |x: &[f64]| {
@@ -139,8 +210,14 @@ fn energy_budget_closes_along_a_trajectory() {
         }
         eprintln!("rtol {rtol:e}: |dE - quadrature| <= {worst:.3e} J, |dE - trapezoid| <= {trap_worst:.3e} J (E0 = {e0:.4} J, max |dE| = {swing:.3e} J)");
         assert!(swing > 1e-3, "the trajectory exchanges energy: {swing:e} J");
-        assert!(worst < 100.0 * rtol * e0, "budget gap {worst:e} J at rtol {rtol:e}");
-        assert!(trap_worst < 1e-3 * swing, "trapezoid budget gap {trap_worst:e} J");
+        assert!(
+            worst < 100.0 * rtol * e0,
+            "budget gap {worst:e} J at rtol {rtol:e}"
+        );
+        assert!(
+            trap_worst < 1e-3 * swing,
+            "trapezoid budget gap {trap_worst:e} J"
+        );
     }
 }
 
@@ -148,7 +225,10 @@ fn energy_budget_closes_along_a_trajectory() {
 #[test]
 fn the_example_runs_every_analysis() {
     let dir = std::env::temp_dir().join(format!("custom_topology_test_{}", std::process::id()));
-    let args = ex::parse_args(["--n", "1", "--out", dir.to_str().unwrap(), "--t-max", "20"].map(String::from)).unwrap();
+    let args = ex::parse_args(
+        ["--n", "1", "--out", dir.to_str().unwrap(), "--t-max", "20"].map(String::from),
+    )
+    .unwrap();
     let t0 = std::time::Instant::now();
     let s = ex::run(&args).unwrap();
     ex::print(&s);
@@ -157,33 +237,97 @@ fn the_example_runs_every_analysis() {
     let f = &s.cycle.figures;
     eprintln!("wall {:?}", t0.elapsed());
     let unstable: Vec<_> = lin.dynamics.poles.iter().filter(|p| p.rhp).collect();
-    assert_eq!(unstable.len(), 2, "one unstable pair: {:?}", lin.dynamics.poles);
-    assert!(unstable[0].im.abs() > 30.0 && unstable[0].im.abs() < 300.0, "{:?}", unstable[0]);
-    assert!(lin.margins.gain_db.is_some() || lin.margins.phase_deg.is_some(), "{:?}", lin.margins);
-    assert!(f.frequency_hz > 5.0 && f.frequency_hz < 50.0, "f = {}", f.frequency_hz);
-    assert!(f.x_amp > 1e-3 && f.x_amp < 5e-2 && f.y_amp > 1e-4 && f.y_amp < 5e-2, "{f:?}");
-    assert!(s.cycle.work.total > 0.0 && s.electric_power_w > 0.0, "work {}, electric {}", s.cycle.work.total, s.electric_power_w);
-    assert!(s.electric_power_w < s.indicated_power_w, "the alternator gets part of the indicated power");
+    assert_eq!(
+        unstable.len(),
+        2,
+        "one unstable pair: {:?}",
+        lin.dynamics.poles
+    );
+    assert!(
+        unstable[0].im.abs() > 30.0 && unstable[0].im.abs() < 300.0,
+        "{:?}",
+        unstable[0]
+    );
+    assert!(
+        lin.margins.gain_db.is_some() || lin.margins.phase_deg.is_some(),
+        "{:?}",
+        lin.margins
+    );
+    assert!(
+        f.frequency_hz > 5.0 && f.frequency_hz < 50.0,
+        "f = {}",
+        f.frequency_hz
+    );
+    assert!(
+        f.x_amp > 1e-3 && f.x_amp < 5e-2 && f.y_amp > 1e-4 && f.y_amp < 5e-2,
+        "{f:?}"
+    );
+    assert!(
+        s.cycle.work.total > 0.0 && s.electric_power_w > 0.0,
+        "work {}, electric {}",
+        s.cycle.work.total,
+        s.electric_power_w
+    );
+    assert!(
+        s.electric_power_w < s.indicated_power_w,
+        "the alternator gets part of the indicated power"
+    );
     // the bounce gas is a gas spring with hysteresis: it absorbs work over a cycle
-    let ib = s.cycle.work.vessels.iter().position(|v| v.contains("bounce")).unwrap();
-    assert!(s.cycle.work.per_vessel[ib] < 0.0, "bounce-space work {:?}", s.cycle.work.per_vessel);
-    let ones = s.cycle.cycle.floquet.iter().filter(|&&(re, im)| (re - 1.0).hypot(im) < 1e-5).count();
-    assert!(ones >= 2, "trivial and inventory multipliers: {:?}", s.cycle.cycle.floquet);
+    let ib = s
+        .cycle
+        .work
+        .vessels
+        .iter()
+        .position(|v| v.contains("bounce"))
+        .unwrap();
+    assert!(
+        s.cycle.work.per_vessel[ib] < 0.0,
+        "bounce-space work {:?}",
+        s.cycle.work.per_vessel
+    );
+    let ones = s
+        .cycle
+        .cycle
+        .floquet
+        .iter()
+        .filter(|&&(re, im)| (re - 1.0).hypot(im) < 1e-5)
+        .count();
+    assert!(
+        ones >= 2,
+        "trivial and inventory multipliers: {:?}",
+        s.cycle.cycle.floquet
+    );
     for file in &s.files {
         let text = std::fs::read_to_string(file).unwrap();
-        assert!(text.starts_with("<svg") || text.contains("<svg"), "{} is an SVG", file.display());
+        assert!(
+            text.starts_with("<svg") || text.contains("<svg"),
+            "{} is an SVG",
+            file.display()
+        );
     }
     assert!(s.files.iter().any(|f| f.ends_with("pv.svg")));
-    assert!(json["limit_cycle"]["frequency_hz"].as_f64().is_some() && json["linear"]["rhp_count"] == 2, "{json}");
+    assert!(
+        json["limit_cycle"]["frequency_hz"].as_f64().is_some() && json["linear"]["rhp_count"] == 2,
+        "{json}"
+    );
     let _ = std::fs::remove_dir_all(&dir);
 }
 
 #[test]
 fn the_command_line_is_checked() {
-    assert_eq!(ex::parse_args(Vec::<String>::new()).unwrap(), ex::Args::default());
+    assert_eq!(
+        ex::parse_args(Vec::<String>::new()).unwrap(),
+        ex::Args::default()
+    );
     let a = ex::parse_args(["--n", "5", "--json", "--no-plots"].map(String::from)).unwrap();
     assert_eq!((a.n, a.json, a.out), (5, true, None));
-    assert!(ex::parse_args(["--n", "0"].map(String::from)).unwrap_err().contains("at least 1"));
-    assert!(ex::parse_args(["--n"].map(String::from)).unwrap_err().contains("needs a value"));
-    assert!(ex::parse_args(["--bogus"].map(String::from)).unwrap_err().contains("unknown argument"));
+    assert!(ex::parse_args(["--n", "0"].map(String::from))
+        .unwrap_err()
+        .contains("at least 1"));
+    assert!(ex::parse_args(["--n"].map(String::from))
+        .unwrap_err()
+        .contains("needs a value"));
+    assert!(ex::parse_args(["--bogus"].map(String::from))
+        .unwrap_err()
+        .contains("unknown argument"));
 }

@@ -1,6 +1,8 @@
 //! Measured-data input: every malformed case gives an error naming file, row and column.
 
-use stirling::models::data::{cycle_mean, parse_csv, read_csv, remove_position_offsets, write_csv, Measured};
+use stirling::models::data::{
+    cycle_mean, parse_csv, read_csv, remove_position_offsets, write_csv, Measured,
+};
 
 fn err(text: &str) -> String {
     let e = parse_csv("rec.csv", text).unwrap_err();
@@ -10,12 +12,28 @@ fn err(text: &str) -> String {
 }
 
 fn good_rows(n: usize) -> String {
-    (0..n).map(|k| format!("{},{},{},{}\n", k as f64 * 5e-4, 101325.0 + 100.0 * k as f64, 1e-3 * (k as f64 * 0.3).sin(), 2e-3 * (k as f64 * 0.3).cos())).collect()
+    (0..n)
+        .map(|k| {
+            format!(
+                "{},{},{},{}\n",
+                k as f64 * 5e-4,
+                101325.0 + 100.0 * k as f64,
+                1e-3 * (k as f64 * 0.3).sin(),
+                2e-3 * (k as f64 * 0.3).cos()
+            )
+        })
+        .collect()
 }
 
 #[test]
 fn reads_a_good_file_with_comments_and_extra_columns() {
-    let text = format!("# rig output\n\nt,p,x,y,temperature\n{}", good_rows(10).lines().map(|l| format!("{l},300\n")).collect::<String>());
+    let text = format!(
+        "# rig output\n\nt,p,x,y,temperature\n{}",
+        good_rows(10)
+            .lines()
+            .map(|l| format!("{l},300\n"))
+            .collect::<String>()
+    );
     let m = parse_csv("rec.csv", &text).unwrap();
     assert_eq!(m.len(), 10);
     assert_eq!(m.channels(), vec!["p", "x", "y"]);
@@ -31,7 +49,10 @@ fn empty_file() {
 
 #[test]
 fn missing_time_column() {
-    assert_eq!(err("time,p\n0,101325\n"), "rec.csv: row 1, column `t`: missing column `t` (time in s); the header has: time, p");
+    assert_eq!(
+        err("time,p\n0,101325\n"),
+        "rec.csv: row 1, column `t`: missing column `t` (time in s); the header has: time, p"
+    );
 }
 
 #[test]
@@ -42,7 +63,10 @@ fn missing_channels() {
 
 #[test]
 fn no_data_rows() {
-    assert_eq!(err("t,p\n"), "rec.csv: row 2, column `t`: no data rows after the header");
+    assert_eq!(
+        err("t,p\n"),
+        "rec.csv: row 2, column `t`: no data rows after the header"
+    );
 }
 
 #[test]
@@ -59,19 +83,34 @@ fn time_going_backwards() {
 
 #[test]
 fn nan_and_infinite_values() {
-    assert_eq!(err("t,p\n0,101325\n0.001,NaN\n"), "rec.csv: row 3, column `p`: NaN or infinite value `NaN`: expected a finite number");
-    assert_eq!(err("t,x\n0,0.001\n0.001,inf\n"), "rec.csv: row 3, column `x`: NaN or infinite value `inf`: expected a finite number");
+    assert_eq!(
+        err("t,p\n0,101325\n0.001,NaN\n"),
+        "rec.csv: row 3, column `p`: NaN or infinite value `NaN`: expected a finite number"
+    );
+    assert_eq!(
+        err("t,x\n0,0.001\n0.001,inf\n"),
+        "rec.csv: row 3, column `x`: NaN or infinite value `inf`: expected a finite number"
+    );
 }
 
 #[test]
 fn text_in_numbers() {
-    assert_eq!(err("t,p,x\n0,101325,0.001\n0.001,101kPa,0.001\n"), "rec.csv: row 3, column `p`: not a number: `101kPa`");
-    assert_eq!(err("t,p\n0,101325\n0.001,\n"), "rec.csv: row 3, column `p`: empty value: expected a number");
+    assert_eq!(
+        err("t,p,x\n0,101325,0.001\n0.001,101kPa,0.001\n"),
+        "rec.csv: row 3, column `p`: not a number: `101kPa`"
+    );
+    assert_eq!(
+        err("t,p\n0,101325\n0.001,\n"),
+        "rec.csv: row 3, column `p`: empty value: expected a number"
+    );
 }
 
 #[test]
 fn short_row() {
-    assert_eq!(err("t,p,x\n0,101325,0.001\n0.001,101325\n"), "rec.csv: row 3, column `x`: the row has 2 fields, the header 3: value of `x` missing");
+    assert_eq!(
+        err("t,p,x\n0,101325,0.001\n0.001,101325\n"),
+        "rec.csv: row 3, column `x`: the row has 2 fields, the header 3: value of `x` missing"
+    );
 }
 
 #[test]
@@ -91,7 +130,10 @@ fn positions_in_mm() {
 
 #[test]
 fn duplicate_column() {
-    assert_eq!(err("t,p,p\n0,1,1\n"), "rec.csv: row 1, column `p`: column `p` appears twice in the header");
+    assert_eq!(
+        err("t,p,p\n0,1,1\n"),
+        "rec.csv: row 1, column `p`: column `p` appears twice in the header"
+    );
 }
 
 #[test]
@@ -101,7 +143,13 @@ fn file_errors_name_the_file() {
     let f = dir.join("bad.csv");
     std::fs::write(&f, "t,p\n0,101325\n0,101325\n").unwrap();
     let e = read_csv(&f).unwrap_err().to_string();
-    assert!(e.starts_with(&format!("{}: row 3, column `t`: duplicate time", f.display())), "{e}");
+    assert!(
+        e.starts_with(&format!(
+            "{}: row 3, column `t`: duplicate time",
+            f.display()
+        )),
+        "{e}"
+    );
     let e = read_csv(&dir.join("missing.csv")).unwrap_err().to_string();
     assert!(e.contains("cannot read the file"), "{e}");
 }
@@ -112,8 +160,18 @@ fn write_read_roundtrip_and_offsets_are_estimated() {
     let t: Vec<f64> = (0..n).map(|k| k as f64 * 5e-4).collect();
     let w = 85.0;
     let x: Vec<f64> = t.iter().map(|t| 0.004 * (w * t).sin() + 0.0012).collect();
-    let y: Vec<f64> = t.iter().map(|t| 0.006 * (w * t + 1.0).sin() - 0.0007).collect();
-    let m = Measured { source: "mem".into(), t, p: Some(vec![101325.0; n]), p_hot: None, x: Some(x), y: Some(y) };
+    let y: Vec<f64> = t
+        .iter()
+        .map(|t| 0.006 * (w * t + 1.0).sin() - 0.0007)
+        .collect();
+    let m = Measured {
+        source: "mem".into(),
+        t,
+        p: Some(vec![101325.0; n]),
+        p_hot: None,
+        x: Some(x),
+        y: Some(y),
+    };
     let dir = std::env::temp_dir().join(format!("stirling_data_rt_{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let f = dir.join("rt.csv");

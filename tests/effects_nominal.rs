@@ -57,7 +57,12 @@ fn compare(base: &dyn Model, fx: &dyn Model, tol: f64) {
         let rel = (fb[i] - ff[j]).abs() / fb[i].abs().max(1e-300);
         max_rel = max_rel.max(rel);
         eprintln!("{:>10} base {:+.17e} fx {:+.17e}", n, fb[i], ff[j]);
-        assert!(rel <= tol || fb[i] == ff[j], "state {n}: {} vs {}", fb[i], ff[j]);
+        assert!(
+            rel <= tol || fb[i] == ff[j],
+            "state {n}: {} vs {}",
+            fb[i],
+            ff[j]
+        );
     }
     for (j, n) in fnames.iter().enumerate() {
         if !bnames.contains(n) {
@@ -71,7 +76,11 @@ fn compare(base: &dyn Model, fx: &dyn Model, tol: f64) {
 fn nominal_cv1_is_the_base_cv1() {
     // cv1_fx has the CV mass as a state (its leak link) and a differently ordered force sum:
     // equal to a few ulp, not bitwise
-    compare(&Cv1::new(1, Closure::Full).unwrap(), &Cv1Fx::new(1, Closure::Full).unwrap(), 1e-14);
+    compare(
+        &Cv1::new(1, Closure::Full).unwrap(),
+        &Cv1Fx::new(1, Closure::Full).unwrap(),
+        1e-14,
+    );
 }
 
 #[test]
@@ -89,10 +98,18 @@ fn nominal_nsection_is_the_base_nsection_bitwise() {
         assert_eq!(fb, ff, "n = {n}: rhs bitwise equal");
         let jb = base.jacobian_dense(&p, &xb, 0.0);
         let jf = fx.jacobian_dense(&pf, &xb, 0.0);
-        let dj = jb.iter().zip(&jf).map(|(a, b)| (a - b).abs() / a.abs().max(1e-300)).fold(0.0, f64::max);
+        let dj = jb
+            .iter()
+            .zip(&jf)
+            .map(|(a, b)| (a - b).abs() / a.abs().max(1e-300))
+            .fold(0.0, f64::max);
         assert!(dj < 1e-14, "n = {n}: Jacobian differs by {dj:e}");
     }
-    compare(&NSection::new(2, Closure::Full).unwrap(), &NSectionFx::new(2, Closure::Full).unwrap(), 0.0);
+    compare(
+        &NSection::new(2, Closure::Full).unwrap(),
+        &NSectionFx::new(2, Closure::Full).unwrap(),
+        0.0,
+    );
 }
 
 #[test]
@@ -104,15 +121,28 @@ fn each_model_effect_changes_the_rhs() {
     let mut xs = x.clone();
     xs[0] = 0.012;
     let mut f0 = vec![0.0; fx.n_states()];
-    for e in EFFECTS.iter().filter(|e| e.target == effects::EffectTarget::Model) {
-        let s = EffectSettings::parse("nsection", &[format!("{}={}", e.name, e.strength().typical)]).unwrap();
+    for e in EFFECTS
+        .iter()
+        .filter(|e| e.target == effects::EffectTarget::Model)
+    {
+        let s = EffectSettings::parse(
+            "nsection",
+            &[format!("{}={}", e.name, e.strength().typical)],
+        )
+        .unwrap();
         let mut p = p0.clone();
         s.apply(&fx, &mut p).unwrap();
         let xx = if e.name == "end_stops" { &xs } else { &x };
         fx.rhs(&p0, xx, 0.0, &mut f0);
         let mut f1 = vec![0.0; fx.n_states()];
         fx.rhs(&p, xx, 0.0, &mut f1);
-        let changed: Vec<String> = fx.state_names().into_iter().zip(f0.iter().zip(&f1)).filter(|(_, (a, b))| a != b).map(|(n, _)| n).collect();
+        let changed: Vec<String> = fx
+            .state_names()
+            .into_iter()
+            .zip(f0.iter().zip(&f1))
+            .filter(|(_, (a, b))| a != b)
+            .map(|(n, _)| n)
+            .collect();
         eprintln!("{}: changes {changed:?}", e.name);
         assert!(!changed.is_empty(), "{} has no effect", e.name);
     }
@@ -120,15 +150,44 @@ fn each_model_effect_changes_the_rhs() {
 
 #[test]
 fn registry_maps_names() {
-    assert_eq!(effects::augmented("cv1", None, Closure::Full).unwrap().name(), "cv1_fx");
-    assert_eq!(effects::augmented("order8", None, Closure::Full).unwrap().n(), 2);
-    assert!(effects::augmented("schmidt", None, Closure::Full).err().unwrap().to_string().contains("no augmented member"));
-    let e = EffectSettings::parse("cv1", &["regen_quadratic=1e9".into()]).unwrap_err().to_string();
+    assert_eq!(
+        effects::augmented("cv1", None, Closure::Full)
+            .unwrap()
+            .name(),
+        "cv1_fx"
+    );
+    assert_eq!(
+        effects::augmented("order8", None, Closure::Full)
+            .unwrap()
+            .n(),
+        2
+    );
+    assert!(effects::augmented("schmidt", None, Closure::Full)
+        .err()
+        .unwrap()
+        .to_string()
+        .contains("no augmented member"));
+    let e = EffectSettings::parse("cv1", &["regen_quadratic=1e9".into()])
+        .unwrap_err()
+        .to_string();
     assert!(e.contains("does not apply to model `cv1`"), "{e}");
-    let e = EffectSettings::parse("cv1", &["friction=1".into()]).unwrap_err().to_string();
+    let e = EffectSettings::parse("cv1", &["friction=1".into()])
+        .unwrap_err()
+        .to_string();
     assert!(e.contains("unknown effect"), "{e}");
-    let s = EffectSettings::parse("nsection", &["leak=2e-8".into(), "xmax=0.004".into(), "sensor_lag=1e-3".into()]).unwrap();
-    assert_eq!(s.model, vec![("Gleak".to_string(), 2e-8), ("xmax".to_string(), 0.004)]);
+    let s = EffectSettings::parse(
+        "nsection",
+        &[
+            "leak=2e-8".into(),
+            "xmax=0.004".into(),
+            "sensor_lag=1e-3".into(),
+        ],
+    )
+    .unwrap();
+    assert_eq!(
+        s.model,
+        vec![("Gleak".to_string(), 2e-8), ("xmax".to_string(), 0.004)]
+    );
     assert_eq!(s.sensor_value("tau_p"), 1e-3);
     assert_eq!(s.active(), vec!["leak", "sensor_lag"]);
 }

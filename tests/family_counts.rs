@@ -12,8 +12,16 @@ fn count(name: &str, n: Option<usize>, closure: Closure) -> usize {
 #[test]
 fn nsection_has_n_plus_6_frozen_and_2n_plus_8_full() {
     for n in [1, 2, 3, 4, 7, 10, 25] {
-        assert_eq!(count("nsection", Some(n), Closure::Frozen), n + 6, "nsection n = {n}, frozen");
-        assert_eq!(count("nsection", Some(n), Closure::Full), 2 * n + 8, "nsection n = {n}, full");
+        assert_eq!(
+            count("nsection", Some(n), Closure::Frozen),
+            n + 6,
+            "nsection n = {n}, frozen"
+        );
+        assert_eq!(
+            count("nsection", Some(n), Closure::Full),
+            2 * n + 8,
+            "nsection n = {n}, full"
+        );
     }
 }
 
@@ -21,7 +29,11 @@ fn nsection_has_n_plus_6_frozen_and_2n_plus_8_full() {
 fn scalar_members_have_the_seed_counts() {
     for closure in [Closure::Full, Closure::Frozen] {
         assert_eq!(count("schmidt", None, closure), 4, "schmidt {closure}");
-        assert_eq!(count("cv1", None, closure), 5, "cv1 {closure}: no links, so no mass state");
+        assert_eq!(
+            count("cv1", None, closure),
+            5,
+            "cv1 {closure}: no links, so no mass state"
+        );
     }
     assert_eq!(count("cv2", None, Closure::Frozen), 6);
     assert_eq!(count("cv2", None, Closure::Full), 8);
@@ -29,7 +41,13 @@ fn scalar_members_have_the_seed_counts() {
 
 #[test]
 fn order_aliases_count_as_the_seed_does() {
-    for (alias, order) in [("order4", 4), ("order5", 5), ("order6", 6), ("order7", 7), ("order8", 8)] {
+    for (alias, order) in [
+        ("order4", 4),
+        ("order5", 5),
+        ("order6", 6),
+        ("order7", 7),
+        ("order8", 8),
+    ] {
         assert_eq!(count(alias, None, Closure::Frozen), order, "{alias}");
     }
     assert_eq!(build("order8", None, Closure::Frozen).unwrap().n(), 2);
@@ -38,8 +56,12 @@ fn order_aliases_count_as_the_seed_does() {
 /// Positions and velocities first, then one pressure per CV, then (full) one mass per CV.
 fn assert_layout(m: &dyn Model, ncv: usize) {
     let kinds: Vec<StateKind> = m.states().iter().map(|s| s.kind).collect();
-    let mut expected =
-        vec![StateKind::Position(0), StateKind::Velocity(0), StateKind::Position(1), StateKind::Velocity(1)];
+    let mut expected = vec![
+        StateKind::Position(0),
+        StateKind::Velocity(0),
+        StateKind::Position(1),
+        StateKind::Velocity(1),
+    ];
     if m.name() != "schmidt" {
         expected.extend((0..ncv).map(StateKind::Pressure));
         if m.closure() == Closure::Full && m.name() != "cv1" {
@@ -75,11 +97,19 @@ fn state_layout_follows_physics_md() {
 fn every_state_says_what_it_is() {
     let m = build("nsection", Some(3), Closure::Full).unwrap();
     for s in m.states() {
-        assert!(!s.meaning.trim().is_empty(), "state {} has no meaning", s.name);
+        assert!(
+            !s.meaning.trim().is_empty(),
+            "state {} has no meaning",
+            s.name
+        );
     }
     let names = m.state_names();
     let mut unique = names.clone();
     unique.sort();
     unique.dedup();
-    assert_eq!(unique.len(), names.len(), "state names must be unique: {names:?}");
+    assert_eq!(
+        unique.len(),
+        names.len(),
+        "state names must be unique: {names:?}"
+    );
 }

@@ -158,13 +158,31 @@ struct Link {
 
 /// The four family members as CVs, ports and links (section 5).
 fn hot_port(e: &Engine) -> Port {
-    Port { h: e.hh, aw0: e.awh0, awx: -PI * e.d(), awy: 0.0, tw: e.th }
+    Port {
+        h: e.hh,
+        aw0: e.awh0,
+        awx: -PI * e.d(),
+        awy: 0.0,
+        tw: e.th,
+    }
 }
 fn cold_port(e: &Engine) -> Port {
-    Port { h: e.hk, aw0: e.awc0, awx: PI * e.d(), awy: -PI * e.d(), tw: e.tk }
+    Port {
+        h: e.hk,
+        aw0: e.awc0,
+        awx: PI * e.d(),
+        awy: -PI * e.d(),
+        tw: e.tk,
+    }
 }
 fn wall(h: f64, aw: f64, tw: f64) -> Port {
-    Port { h, aw0: aw, awx: 0.0, awy: 0.0, tw }
+    Port {
+        h,
+        aw0: aw,
+        awx: 0.0,
+        awy: 0.0,
+        tw,
+    }
 }
 
 fn cv1(e: &Engine) -> (Vec<Cv>, Vec<Link>) {
@@ -173,7 +191,11 @@ fn cv1(e: &Engine) -> (Vec<Cv>, Vec<Link>) {
         v0: e.vh0 + e.vc0 + e.vr,
         ax: -e.a + (e.a - e.ar),
         ay: -(e.a - e.ar),
-        ports: vec![hot_port(e), cold_port(e), wall(e.hr, e.awr, (e.th + e.tk) / 2.0)],
+        ports: vec![
+            hot_port(e),
+            cold_port(e),
+            wall(e.hr, e.awr, (e.th + e.tk) / 2.0),
+        ],
     };
     (vec![gas], vec![])
 }
@@ -183,30 +205,70 @@ fn cv2(e: &Engine) -> (Vec<Cv>, Vec<Link>) {
         v0: e.vh0 + e.vr / 2.0,
         ax: -e.a,
         ay: 0.0,
-        ports: vec![hot_port(e), wall(e.hr, e.awr / 2.0, (3.0 * e.th + e.tk) / 4.0)],
+        ports: vec![
+            hot_port(e),
+            wall(e.hr, e.awr / 2.0, (3.0 * e.th + e.tk) / 4.0),
+        ],
     };
     let cold = Cv {
         v0: e.vc0 + e.vr / 2.0,
         ax: e.a - e.ar,
         ay: -(e.a - e.ar),
-        ports: vec![cold_port(e), wall(e.hr, e.awr / 2.0, (e.th + 3.0 * e.tk) / 4.0)],
+        ports: vec![
+            cold_port(e),
+            wall(e.hr, e.awr / 2.0, (e.th + 3.0 * e.tk) / 4.0),
+        ],
     };
-    (vec![hot, cold], vec![Link { from: 0, to: 1, r: e.rf }])
+    (
+        vec![hot, cold],
+        vec![Link {
+            from: 0,
+            to: 1,
+            r: e.rf,
+        }],
+    )
 }
 
 fn nsection(e: &Engine, n: usize) -> (Vec<Cv>, Vec<Link>) {
     let nf = n as f64;
-    let mut cvs = vec![Cv { v0: e.vh0, ax: -e.a, ay: 0.0, ports: vec![hot_port(e)] }];
+    let mut cvs = vec![Cv {
+        v0: e.vh0,
+        ax: -e.a,
+        ay: 0.0,
+        ports: vec![hot_port(e)],
+    }];
     for j in 1..=n {
         let tw = e.th - (j as f64 - 0.5) * (e.th - e.tk) / nf;
-        cvs.push(Cv { v0: e.vr / nf, ax: 0.0, ay: 0.0, ports: vec![wall(e.hr, e.awr / nf, tw)] });
+        cvs.push(Cv {
+            v0: e.vr / nf,
+            ax: 0.0,
+            ay: 0.0,
+            ports: vec![wall(e.hr, e.awr / nf, tw)],
+        });
     }
-    cvs.push(Cv { v0: e.vc0, ax: e.a - e.ar, ay: -(e.a - e.ar), ports: vec![cold_port(e)] });
-    let mut links = vec![Link { from: 0, to: 1, r: e.rf / (2.0 * nf) }];
+    cvs.push(Cv {
+        v0: e.vc0,
+        ax: e.a - e.ar,
+        ay: -(e.a - e.ar),
+        ports: vec![cold_port(e)],
+    });
+    let mut links = vec![Link {
+        from: 0,
+        to: 1,
+        r: e.rf / (2.0 * nf),
+    }];
     for j in 1..n {
-        links.push(Link { from: j, to: j + 1, r: e.rf / nf });
+        links.push(Link {
+            from: j,
+            to: j + 1,
+            r: e.rf / nf,
+        });
     }
-    links.push(Link { from: n, to: n + 1, r: e.rf / (2.0 * nf) });
+    links.push(Link {
+        from: n,
+        to: n + 1,
+        r: e.rf / (2.0 * nf),
+    });
     (cvs, links)
 }
 
@@ -218,18 +280,34 @@ fn rest_mass(e: &Engine, cv: &Cv) -> f64 {
 }
 
 /// Section 2: `m a' = F - k q - b_own q' - b (q' - q'_other) - bq q'|q'|`.
-fn body(m: f64, k: f64, b_own: f64, bq: f64, b: f64, q: f64, qd: f64, other: f64, force: Val) -> Val {
+fn body(
+    m: f64,
+    k: f64,
+    b_own: f64,
+    bq: f64,
+    b: f64,
+    q: f64,
+    qd: f64,
+    other: f64,
+    force: Val,
+) -> Val {
     let mut s = force;
     for t in [-k * q, -b_own * qd, -b * (qd - other), -bq * qd * qd.abs()] {
         s.add(t);
     }
-    Val { v: s.v / m, scale: s.scale / m }
+    Val {
+        v: s.v / m,
+        scale: s.scale / m,
+    }
 }
 
 /// Mechanics for given face forces `F_x`, `F_y` (with the bounce space): rows x', v', y', w'.
 fn mechanics(e: &Engine, z: &[f64], fx: Val, fy: Val) -> Vec<Val> {
     let (x, v, y, w) = (z[0], z[1], z[2], z[3]);
-    let exact = |t: f64| Val { v: t, scale: t.abs() };
+    let exact = |t: f64| Val {
+        v: t,
+        scale: t.abs(),
+    };
     vec![
         exact(v),
         body(e.md, e.kd, e.bd, e.bqd, e.b, x, v, w, fx),
@@ -262,14 +340,23 @@ fn schmidt_rhs(e: &Engine, z: &[f64]) -> Vec<Val> {
 
 /// Sections 1, 2 and 4: the RHS of a CV model, states `[x, v, y, w, P.., (m..)]`; `masses`
 /// are the state masses (full) or the rest masses (frozen, or no links).
-fn gas_rhs(e: &Engine, cvs: &[Cv], links: &[Link], z: &[f64], masses: &[f64], with_mass_rows: bool) -> Vec<Val> {
+fn gas_rhs(
+    e: &Engine,
+    cvs: &[Cv],
+    links: &[Link],
+    z: &[f64],
+    masses: &[f64],
+    with_mass_rows: bool,
+) -> Vec<Val> {
     let (x, v, y, w) = (z[0], z[1], z[2], z[3]);
     let ncv = cvs.len();
     let pr = &z[4..4 + ncv];
     let cp = e.gamma * e.r / (e.gamma - 1.0);
     let vol: Vec<f64> = cvs.iter().map(|c| c.v0 + c.ax * x + c.ay * y).collect();
     let vdot: Vec<f64> = cvs.iter().map(|c| c.ax * v + c.ay * w).collect();
-    let temp: Vec<f64> = (0..ncv).map(|i| pr[i] * vol[i] / (masses[i] * e.r)).collect();
+    let temp: Vec<f64> = (0..ncv)
+        .map(|i| pr[i] * vol[i] / (masses[i] * e.r))
+        .collect();
     // Energy into each CV (heat and enthalpy) and mass into each CV.
     let mut energy = vec![Val::default(); ncv];
     let mut mass = vec![Val::default(); ncv];
@@ -298,7 +385,10 @@ fn gas_rhs(e: &Engine, cvs: &[Cv], links: &[Link], z: &[f64], masses: &[f64], wi
         let work = e.gamma * pr[i] * vdot[i];
         let num = (e.gamma - 1.0) * energy[i].v - work;
         let scale = (e.gamma - 1.0) * energy[i].scale + work.abs();
-        out.push(Val { v: num / vol[i], scale: scale / vol[i] });
+        out.push(Val {
+            v: num / vol[i],
+            scale: scale / vol[i],
+        });
     }
     if with_mass_rows {
         out.extend(mass);
@@ -321,8 +411,14 @@ fn reference(name: &str, n: usize, closure: Closure) -> (Vec<f64>, Vec<Val>) {
     let rest: Vec<f64> = cvs.iter().map(|c| rest_mass(&e, c)).collect();
     let full = closure == Closure::Full && !links.is_empty();
     z.extend((0..cvs.len()).map(|i| e.pmean * (1.0 + 0.01 * (i + 1) as f64)));
-    let masses: Vec<f64> =
-        if full { rest.iter().enumerate().map(|(i, m)| 1.02 * m * (1.0 - 0.005 * i as f64)).collect() } else { rest };
+    let masses: Vec<f64> = if full {
+        rest.iter()
+            .enumerate()
+            .map(|(i, m)| 1.02 * m * (1.0 - 0.005 * i as f64))
+            .collect()
+    } else {
+        rest
+    };
     if full {
         z.extend(&masses);
     }
@@ -337,10 +433,22 @@ fn check(name: &str, n: Option<usize>, closure: Closure) {
     assert_eq!(m.n_states(), z.len(), "{name} {closure}: state count");
     let mut eq = vec![0.0; z.len()];
     m.equilibrium_guess(&m.default_params(), &mut eq);
-    let rest = if name == "schmidt" { vec![] } else { reference_equilibrium(name, n.unwrap_or(1), closure) };
-    assert_eq!(eq[4..].len(), rest.len(), "{name} {closure}: equilibrium length");
+    let rest = if name == "schmidt" {
+        vec![]
+    } else {
+        reference_equilibrium(name, n.unwrap_or(1), closure)
+    };
+    assert_eq!(
+        eq[4..].len(),
+        rest.len(),
+        "{name} {closure}: equilibrium length"
+    );
     for (i, (a, b)) in eq[4..].iter().zip(&rest).enumerate() {
-        assert!((a - b).abs() <= 1e-12 * b.abs(), "{name} {closure}: equilibrium state {} = {a}, reference {b}", i + 4);
+        assert!(
+            (a - b).abs() <= 1e-12 * b.abs(),
+            "{name} {closure}: equilibrium state {} = {a}, reference {b}",
+            i + 4
+        );
     }
     let mut got = vec![0.0; z.len()];
     m.rhs(&m.default_params(), &z, 0.0, &mut got);
@@ -381,7 +489,10 @@ fn defaults_are_the_engine_of_physics_md_section_8() {
         assert_eq!(declared.len(), by_hand.len(), "{name}: parameter count");
         for ((dn, dv), (hn, hv)) in declared.iter().zip(&by_hand) {
             assert_eq!(dn, hn, "{name}: parameter order");
-            assert!((dv - hv).abs() <= 1e-15 * hv.abs(), "{name}: {dn} = {dv}, PHYSICS.md says {hv}");
+            assert!(
+                (dv - hv).abs() <= 1e-15 * hv.abs(),
+                "{name}: {dn} = {dv}, PHYSICS.md says {hv}"
+            );
         }
     }
 }
@@ -434,6 +545,9 @@ fn schmidt_linearization_is_the_seed_s13_to_s15() {
     ];
     for (r, c, v) in want {
         let got = j[r + 4 * c];
-        assert!((got - v).abs() <= 1e-10 * v.abs(), "J[{r},{c}] = {got}, S13-S15 give {v}");
+        assert!(
+            (got - v).abs() <= 1e-10 * v.abs(),
+            "J[{r},{c}] = {got}, S13-S15 give {v}"
+        );
     }
 }

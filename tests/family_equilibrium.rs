@@ -75,7 +75,9 @@ fn off_equilibrium(m: &dyn Model, p: &[f64]) -> Vec<f64> {
 fn row_scales(m: &dyn Model, p: &[f64], x: &[f64], s: &[f64]) -> Vec<f64> {
     let n = m.n_states();
     let j = m.jacobian_dense(p, x, 0.0);
-    (0..n).map(|r| (0..n).map(|c| (j[r + n * c] * s[c]).abs()).sum()).collect()
+    (0..n)
+        .map(|r| (0..n).map(|c| (j[r + n * c] * s[c]).abs()).sum())
+        .collect()
 }
 
 #[test]
@@ -87,7 +89,12 @@ fn rhs_vanishes_at_the_equilibrium() {
         let f = rhs(m, &p, &eq);
         let scale = row_scales(m, &p, &eq, &typical(m, &p, &eq));
         for (r, (fr, sr)) in f.iter().zip(&scale).enumerate() {
-            assert!(fr.abs() <= 1e-12 * sr, "{}: row {r} ({}) = {fr:e}, scale {sr:e}", label(m), m.state_names()[r]);
+            assert!(
+                fr.abs() <= 1e-12 * sr,
+                "{}: row {r} ({}) = {fr:e}, scale {sr:e}",
+                label(m),
+                m.state_names()[r]
+            );
         }
     }
 }
@@ -101,7 +108,9 @@ fn equilibrium_is_at_rest_at_the_charge_pressure() {
         let eq = equilibrium(m, &p);
         for (s, v) in m.states().iter().zip(&eq) {
             match s.kind {
-                StateKind::Position(_) | StateKind::Velocity(_) => assert_eq!(*v, 0.0, "{} {}", label(m), s.name),
+                StateKind::Position(_) | StateKind::Velocity(_) => {
+                    assert_eq!(*v, 0.0, "{} {}", label(m), s.name)
+                }
                 StateKind::Pressure(_) => assert_eq!(*v, pmean, "{} {}", label(m), s.name),
                 StateKind::Mass(_) => assert!(*v > 0.0, "{} {}", label(m), s.name),
             }
@@ -111,8 +120,11 @@ fn equilibrium_is_at_rest_at_the_charge_pressure() {
 
 #[test]
 fn rhs_vanishes_at_equilibrium_of_other_parameters() {
-    let sets: [&[(&str, f64)]; 3] =
-        [&[("Th", 750.0), ("Tk", 320.0)], &[("Pmean", 2.0e6), ("Pb", 2.0e6)], &[("Rf", 3.0e3), ("hr", 4e3)]];
+    let sets: [&[(&str, f64)]; 3] = [
+        &[("Th", 750.0), ("Tk", 320.0)],
+        &[("Pmean", 2.0e6), ("Pb", 2.0e6)],
+        &[("Rf", 3.0e3), ("hr", 4e3)],
+    ];
     for m in family() {
         let m = m.as_ref();
         for set in sets {
@@ -124,7 +136,11 @@ fn rhs_vanishes_at_equilibrium_of_other_parameters() {
             let f = rhs(m, &p, &eq);
             let scale = row_scales(m, &p, &eq, &typical(m, &p, &eq));
             for (r, (fr, sr)) in f.iter().zip(&scale).enumerate() {
-                assert!(fr.abs() <= 1e-12 * sr, "{} {set:?}: row {r} = {fr:e}, scale {sr:e}", label(m));
+                assert!(
+                    fr.abs() <= 1e-12 * sr,
+                    "{} {set:?}: row {r} = {fr:e}, scale {sr:e}",
+                    label(m)
+                );
             }
         }
     }
@@ -227,7 +243,10 @@ fn jacobian_matches_finite_differences_inside_the_upwind_band() {
 
 #[test]
 fn full_closure_conserves_mass_and_its_jacobian_has_the_inventory_mode() {
-    for m in family().into_iter().filter(|m| m.closure() == Closure::Full) {
+    for m in family()
+        .into_iter()
+        .filter(|m| m.closure() == Closure::Full)
+    {
         let m = m.as_ref();
         let p = m.default_params();
         let x = off_equilibrium(m, &p);
@@ -241,13 +260,21 @@ fn full_closure_conserves_mass_and_its_jacobian_has_the_inventory_mode() {
             .collect();
         let mdot: f64 = masses.iter().map(|&k| f[k]).sum();
         let flow: f64 = masses.iter().map(|&k| f[k].abs()).sum();
-        assert!(mdot.abs() <= 1e-13 * flow.max(1e-30), "{}: sum m' = {mdot:e}", label(m));
+        assert!(
+            mdot.abs() <= 1e-13 * flow.max(1e-30),
+            "{}: sum m' = {mdot:e}",
+            label(m)
+        );
         let n = m.n_states();
         let j = m.jacobian_dense(&p, &x, 0.0);
         for c in 0..n {
             let cj: f64 = masses.iter().map(|&r| j[r + n * c]).sum();
             let size: f64 = masses.iter().map(|&r| j[r + n * c].abs()).sum();
-            assert!(cj.abs() <= 1e-13 * size.max(1e-30), "{}: (c J) column {c} = {cj:e}", label(m));
+            assert!(
+                cj.abs() <= 1e-13 * size.max(1e-30),
+                "{}: (c J) column {c} = {cj:e}",
+                label(m)
+            );
         }
     }
 }

@@ -25,8 +25,12 @@ fn cv2_bond_graph_dot() {
 /// The equations of `cv1` do not depend on the closure: it has no links, so its mass is a constant.
 #[test]
 fn cv1_equations_are_the_same_for_both_closures() {
-    let full = build("cv1", None, Closure::Full).unwrap().equations(Style::Text);
-    let frozen = build("cv1", None, Closure::Frozen).unwrap().equations(Style::Text);
+    let full = build("cv1", None, Closure::Full)
+        .unwrap()
+        .equations(Style::Text);
+    let frozen = build("cv1", None, Closure::Frozen)
+        .unwrap()
+        .equations(Style::Text);
     let body = |s: &str| s.lines().skip(1).collect::<Vec<_>>().join("\n");
     assert_eq!(body(&full), body(&frozen));
 }

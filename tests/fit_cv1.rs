@@ -25,13 +25,27 @@ fn cv1_two_stage_recovers_perturbed_parameters() {
     let out = rig::run(&cfg).unwrap();
     let model = stirling::models::build("cv1", None, Closure::Full).unwrap();
     let p0 = model.default_params();
-    let opts = FitOptions { free: Some(["kd", "kp", "bd", "bp", "hh", "hk"].iter().map(|s| s.to_string()).collect()), ..Default::default() };
+    let opts = FitOptions {
+        free: Some(
+            ["kd", "kp", "bd", "bp", "hh", "hk"]
+                .iter()
+                .map(|s| s.to_string())
+                .collect(),
+        ),
+        ..Default::default()
+    };
     let res = fit::identify(model.as_ref(), &p0, &out.data, &opts).unwrap();
     eprintln!("total {:.2} s", res.seconds);
     for st in [res.stage1.as_ref().unwrap(), res.stage2.as_ref().unwrap()] {
-        eprintln!("{}: {} it, converged {}, s2 = {:.3}", st.stage, st.iterations, st.converged, st.stats.sigma2);
+        eprintln!(
+            "{}: {} it, converged {}, s2 = {:.3}",
+            st.stage, st.iterations, st.converged, st.stats.sigma2
+        );
         for e in &st.stats.estimates {
-            eprintln!("  {:<12} {:>13.6e} +- {:.2e}  [{:.6e}, {:.6e}]", e.name, e.value, e.std_error, e.ci_low, e.ci_high);
+            eprintln!(
+                "  {:<12} {:>13.6e} +- {:.2e}  [{:.6e}, {:.6e}]",
+                e.name, e.value, e.std_error, e.ci_low, e.ci_high
+            );
         }
         for f in &st.fits {
             eprintln!("  fit {} {} {:.2} %", f.channel, f.block, f.fit_percent);
@@ -43,14 +57,29 @@ fn cv1_two_stage_recovers_perturbed_parameters() {
     for s in truth {
         let (k, v) = s.split_once('=').unwrap();
         let v: f64 = v.parse().unwrap();
-        let e = res.stage1.as_ref().and_then(|s| s.estimate(k)).or_else(|| res.stage2.as_ref().and_then(|s| s.estimate(k))).unwrap();
-        assert!(e.covers(v), "{k}: truth {v} outside [{}, {}]", e.ci_low, e.ci_high);
+        let e = res
+            .stage1
+            .as_ref()
+            .and_then(|s| s.estimate(k))
+            .or_else(|| res.stage2.as_ref().and_then(|s| s.estimate(k)))
+            .unwrap();
+        assert!(
+            e.covers(v),
+            "{k}: truth {v} outside [{}, {}]",
+            e.ci_low,
+            e.ci_high
+        );
     }
     let p_off = res.stage2.as_ref().unwrap().estimate("p_offset").unwrap();
     assert!((p_off.value - 300.0).abs() < 10.0, "p offset {p_off:?}");
     for st in [res.stage1.as_ref().unwrap(), res.stage2.as_ref().unwrap()] {
         for f in st.fits.iter().filter(|f| f.block == "holdout") {
-            assert!(f.fit_percent > 90.0, "{} holdout fit {:.2} %", f.channel, f.fit_percent);
+            assert!(
+                f.fit_percent > 90.0,
+                "{} holdout fit {:.2} %",
+                f.channel,
+                f.fit_percent
+            );
         }
     }
 }

@@ -15,12 +15,19 @@ fn set(model: &dyn Model, p: &mut [f64], name: &str, v: f64) {
 /// The two dominant complex pairs (upper half), least stable first.
 fn dominant(model: &dyn Model, p: &[f64]) -> Vec<Pair> {
     let d = linear::dynamic_poles(model, p, &NewtonOptions::default()).unwrap();
-    d.poles.iter().filter(|q| q.im > 1.0 && q.natural_rad_s < 1e3).map(|q| (q.re, q.im)).collect()
+    d.poles
+        .iter()
+        .filter(|q| q.im > 1.0 && q.natural_rad_s < 1e3)
+        .map(|q| (q.re, q.im))
+        .collect()
 }
 
 fn distance(a: &[Pair], b: &[Pair]) -> f64 {
     assert_eq!(a.len(), 2, "{a:?}");
-    a.iter().zip(b).map(|(x, y)| (x.0 - y.0).hypot(x.1 - y.1)).fold(0.0, f64::max)
+    a.iter()
+        .zip(b)
+        .map(|(x, y)| (x.0 - y.0).hypot(x.1 - y.1))
+        .fold(0.0, f64::max)
 }
 
 fn nsection_limit(n: usize) -> Vec<Pair> {
@@ -49,7 +56,9 @@ fn schmidt_at(tr_n: Option<f64>) -> Vec<Pair> {
 }
 
 fn harmonic_tr(n: usize, th: f64, tk: f64) -> f64 {
-    let inv: f64 = (1..=n).map(|j| 1.0 / (th - (j as f64 - 0.5) * (th - tk) / n as f64)).sum();
+    let inv: f64 = (1..=n)
+        .map(|j| 1.0 / (th - (j as f64 - 0.5) * (th - tk) / n as f64))
+        .sum();
     n as f64 / inv
 }
 
@@ -71,7 +80,10 @@ fn nsection_tends_to_schmidt() {
         assert!(d_log < last, "n = {n}: distance {d_log} does not decrease");
         last = d_log;
         let d_harm = distance(&got, &schmidt_at(Some(harmonic_tr(n, 600.0, 300.0))));
-        assert!(d_harm < 1e-2, "n = {n}: distance to the harmonic-mean Schmidt {d_harm}");
+        assert!(
+            d_harm < 1e-2,
+            "n = {n}: distance to the harmonic-mean Schmidt {d_harm}"
+        );
         println!(
             "| {n} | {:.4} ± {:.4}j | {:.4} ± {:.4}j | {d_log:.2e} | {d_harm:.2e} | {:.2e} |",
             got[0].0,

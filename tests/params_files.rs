@@ -37,12 +37,23 @@ fn defaults_without_file_or_overrides() {
 #[test]
 fn toml_file_sets_parameters_by_name() {
     let m = model();
-    let path = file("hot.toml", "# a hotter engine\nTh = 700.0\nRf = 2e5\nhh = 800\n");
+    let path = file(
+        "hot.toml",
+        "# a hotter engine\nTh = 700.0\nRf = 2e5\nhh = 800\n",
+    );
     let p = load(m.as_ref(), Some(&path), &[]).unwrap();
     assert_eq!(value(m.as_ref(), &p, "Th"), 700.0);
     assert_eq!(value(m.as_ref(), &p, "Rf"), 2e5);
-    assert_eq!(value(m.as_ref(), &p, "hh"), 800.0, "TOML integers are numbers too");
-    assert_eq!(value(m.as_ref(), &p, "Tk"), 300.0, "unnamed parameters keep their defaults");
+    assert_eq!(
+        value(m.as_ref(), &p, "hh"),
+        800.0,
+        "TOML integers are numbers too"
+    );
+    assert_eq!(
+        value(m.as_ref(), &p, "Tk"),
+        300.0,
+        "unnamed parameters keep their defaults"
+    );
 }
 
 #[test]
@@ -69,15 +80,29 @@ fn unknown_names_are_rejected_with_the_valid_list() {
     let m = model();
     for err in [
         load(m.as_ref(), Some(&file("typo.toml", "Thot = 700.0\n")), &[]).unwrap_err(),
-        load(m.as_ref(), Some(&file("typo.json", r#"{"Thot": 700.0}"#)), &[]).unwrap_err(),
+        load(
+            m.as_ref(),
+            Some(&file("typo.json", r#"{"Thot": 700.0}"#)),
+            &[],
+        )
+        .unwrap_err(),
         load(m.as_ref(), None, &sets(&["Thot=700"])).unwrap_err(),
     ] {
-        let ParamError::Unknown { name, valid, .. } = &err else { panic!("expected Unknown, got {err:?}") };
+        let ParamError::Unknown { name, valid, .. } = &err else {
+            panic!("expected Unknown, got {err:?}")
+        };
         assert_eq!(name, "Thot");
         let text = err.to_string();
-        assert!(text.contains("Thot") && text.contains("valid parameters"), "{text}");
+        assert!(
+            text.contains("Thot") && text.contains("valid parameters"),
+            "{text}"
+        );
         for p in m.params() {
-            assert!(valid.split(", ").any(|v| v == p.name), "`{}` missing from the list: {valid}", p.name);
+            assert!(
+                valid.split(", ").any(|v| v == p.name),
+                "`{}` missing from the list: {valid}",
+                p.name
+            );
         }
     }
 }
@@ -97,7 +122,12 @@ fn malformed_overrides_and_values_are_errors() {
     assert!(matches!(json, ParamError::Parse { .. }), "{json:?}");
     let toml = load(m.as_ref(), Some(&file("broken.toml", "Th = = 3")), &[]).unwrap_err();
     assert!(matches!(toml, ParamError::Parse { .. }), "{toml:?}");
-    let missing = load(m.as_ref(), Some(&PathBuf::from("/nonexistent/params.toml")), &[]).unwrap_err();
+    let missing = load(
+        m.as_ref(),
+        Some(&PathBuf::from("/nonexistent/params.toml")),
+        &[],
+    )
+    .unwrap_err();
     assert!(matches!(missing, ParamError::Read { .. }), "{missing:?}");
 }
 
@@ -142,11 +172,20 @@ fn validation_rejects_unphysical_values() {
 #[test]
 fn validation_errors_read_well() {
     let m = model();
-    let e = load(m.as_ref(), None, &sets(&["Th=250"])).unwrap_err().to_string();
-    assert!(e.contains("Th") && e.contains("250") && e.contains("hotter"), "{e}");
-    let e = load(m.as_ref(), None, &sets(&["Ar=0.01"])).unwrap_err().to_string();
+    let e = load(m.as_ref(), None, &sets(&["Th=250"]))
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("Th") && e.contains("250") && e.contains("hotter"),
+        "{e}"
+    );
+    let e = load(m.as_ref(), None, &sets(&["Ar=0.01"]))
+        .unwrap_err()
+        .to_string();
     assert!(e.contains("Ar") && e.contains("thinner"), "{e}");
-    let e = load(m.as_ref(), None, &sets(&["md=0"])).unwrap_err().to_string();
+    let e = load(m.as_ref(), None, &sets(&["md=0"]))
+        .unwrap_err()
+        .to_string();
     assert!(e.contains("md") && e.contains("positive"), "{e}");
 }
 

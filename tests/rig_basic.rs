@@ -8,25 +8,49 @@ fn rig_writes_csv_and_truth_and_is_reproducible() {
     let dir = std::env::temp_dir().join(format!("stirling_rig_{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let f = dir.join("cv1.csv");
-    let cfg = RigConfig { model: "cv1".into(), t_end: 0.2, effects: vec!["leak=2e-8".into(), "sensor_gain=0.02".into()], offset_x: 1e-3, seed: 7, ..Default::default() };
+    let cfg = RigConfig {
+        model: "cv1".into(),
+        t_end: 0.2,
+        effects: vec!["leak=2e-8".into(), "sensor_gain=0.02".into()],
+        offset_x: 1e-3,
+        seed: 7,
+        ..Default::default()
+    };
     let out = rig::run(&cfg).unwrap();
     let side = rig::write(&out, &f, false).unwrap();
     let back = read_csv(&f).unwrap();
     assert_eq!(back.len(), 401);
     assert_eq!(back.channels(), vec!["p", "x", "y"]);
-    let truth: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&side).unwrap()).unwrap();
+    let truth: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&side).unwrap()).unwrap();
     assert_eq!(truth["model"], "cv1_fx");
     assert_eq!(truth["seed"], 7);
     assert_eq!(truth["parameters"]["Gleak"], 2e-8);
-    assert_eq!(truth["active_effects"], serde_json::json!(["leak", "sensor_gain"]));
+    assert_eq!(
+        truth["active_effects"],
+        serde_json::json!(["leak", "sensor_gain"])
+    );
     let e = rig::write(&out, &f, false).unwrap_err().to_string();
     assert!(e.contains("pass --force"), "{e}");
     rig::write(&out, &f, true).unwrap();
     let again = rig::run(&cfg).unwrap();
     assert_eq!(again.data, out.data, "same seed, same record");
     // noise level: a clean run differs by noise of the requested size
-    let clean = rig::run(&RigConfig { noise_p: 0.0, noise_x: 0.0, ..cfg.clone() }).unwrap();
-    let d: Vec<f64> = out.data.p.as_ref().unwrap().iter().zip(clean.data.p.as_ref().unwrap()).map(|(a, b)| a - b).collect();
+    let clean = rig::run(&RigConfig {
+        noise_p: 0.0,
+        noise_x: 0.0,
+        ..cfg.clone()
+    })
+    .unwrap();
+    let d: Vec<f64> = out
+        .data
+        .p
+        .as_ref()
+        .unwrap()
+        .iter()
+        .zip(clean.data.p.as_ref().unwrap())
+        .map(|(a, b)| a - b)
+        .collect();
     let sd = (d.iter().map(|v| v * v).sum::<f64>() / d.len() as f64).sqrt();
     assert!((sd - 50.0).abs() < 7.0, "p noise sd {sd}");
     let mx = out.data.x.as_ref().unwrap().iter().sum::<f64>() / 401.0;
@@ -35,7 +59,13 @@ fn rig_writes_csv_and_truth_and_is_reproducible() {
 
 #[test]
 fn nsection_rig_has_hot_pressure() {
-    let cfg = RigConfig { model: "nsection".into(), n: Some(2), t_end: 0.05, effects: vec!["regen_quadratic=1e9".into()], ..Default::default() };
+    let cfg = RigConfig {
+        model: "nsection".into(),
+        n: Some(2),
+        t_end: 0.05,
+        effects: vec!["regen_quadratic=1e9".into()],
+        ..Default::default()
+    };
     let out = rig::run(&cfg).unwrap();
     assert_eq!(out.data.channels(), vec!["p", "p_hot", "x", "y"]);
     assert_eq!(out.truth.model, "nsection_fx");

@@ -29,7 +29,10 @@ fn an_unphysical_parameter_vector_stops_at_t_zero() {
     m.equilibrium_guess(&p, &mut x0);
     let e = sim::simulate(&m, &p, &x0, 0.1, &[], &SimOptions::default()).unwrap_err();
     eprintln!("{e}");
-    assert!(matches!(e, SimError::Nonphysical { t, .. } if t == 0.0), "{e:?}");
+    assert!(
+        matches!(e, SimError::Nonphysical { t, .. } if t == 0.0),
+        "{e:?}"
+    );
 }
 
 #[test]
@@ -47,7 +50,12 @@ fn a_run_driven_to_negative_volume_names_time_and_quantity() {
     match e {
         SimError::Nonphysical { t, quantity, .. } => {
             assert!(t > 0.0 && t < 0.1);
-            assert!(quantity.contains("hot") || quantity.contains("temperature") || quantity.contains("pressure"), "{quantity}");
+            assert!(
+                quantity.contains("hot")
+                    || quantity.contains("temperature")
+                    || quantity.contains("pressure"),
+                "{quantity}"
+            );
         }
         SimError::StepSizeCollapse { t } | SimError::SolverFailure { t, .. } => assert!(t > 0.0),
         other => panic!("unexpected {other:?}"),

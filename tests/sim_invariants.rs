@@ -17,13 +17,31 @@ fn perturbed(model: &dyn Model, p: &[f64]) -> Vec<f64> {
 
 #[test]
 fn mass_is_conserved_to_round_off() {
-    for model in [Box::new(NSection::new(3, Closure::Full).unwrap()) as Box<dyn Model>, Box::new(Cv2::new(1, Closure::Full).unwrap())] {
+    for model in [
+        Box::new(NSection::new(3, Closure::Full).unwrap()) as Box<dyn Model>,
+        Box::new(Cv2::new(1, Closure::Full).unwrap()),
+    ] {
         let p = model.default_params();
         let x0 = perturbed(model.as_ref(), &p);
         let m0 = model.gas_mass(&p, &x0);
-        let tr = sim::simulate(model.as_ref(), &p, &x0, 0.3, &sim::uniform_samples(0.3, 300), &SimOptions::default()).unwrap();
-        let drift = tr.x.iter().map(|x| (model.gas_mass(&p, x) - m0).abs() / m0).fold(0.0, f64::max);
-        eprintln!("{}: max relative mass drift {drift:.2e} over {} steps", model.name(), tr.stats.steps);
+        let tr = sim::simulate(
+            model.as_ref(),
+            &p,
+            &x0,
+            0.3,
+            &sim::uniform_samples(0.3, 300),
+            &SimOptions::default(),
+        )
+        .unwrap();
+        let drift =
+            tr.x.iter()
+                .map(|x| (model.gas_mass(&p, x) - m0).abs() / m0)
+                .fold(0.0, f64::max);
+        eprintln!(
+            "{}: max relative mass drift {drift:.2e} over {} steps",
+            model.name(),
+            tr.stats.steps
+        );
         assert!(drift < 1e-12, "{}: mass drift {drift:e}", model.name());
     }
 }
@@ -34,12 +52,29 @@ fn energy_budget_closes_along_a_trajectory() {
     let p = model.default_params();
     let x0 = perturbed(&model, &p);
     let n = model.n_states();
-    let sys = EnergySystem { inner: ModelSystem { model: &model, p: &p } };
+    let sys = EnergySystem {
+        inner: ModelSystem {
+            model: &model,
+            p: &p,
+        },
+    };
     let mut z0 = x0.clone();
     z0.push(0.0);
     for rtol in [1e-6, 1e-9] {
-        let opts = SimOptions { rtol, atol: rtol, ..Default::default() };
-        let tr = sim::integrate(&sys, &z0, 0.2, &sim::uniform_samples(0.2, 200), &opts, Hooks::default()).unwrap();
+        let opts = SimOptions {
+            rtol,
+            atol: rtol,
+            ..Default::default()
+        };
+        let tr = sim::integrate(
+            &sys,
+            &z0,
+            0.2,
+            &sim::uniform_samples(0.2, 200),
+            &opts,
+            Hooks::default(),
+        )
+        .unwrap();
         let e0 = model.energy(&p, &x0);
         let (mut worst, mut swing) = (0.0f64, 0.0f64);
         for z in &tr.x {
@@ -48,6 +83,9 @@ fn energy_budget_closes_along_a_trajectory() {
             swing = swing.max(de.abs());
         }
         eprintln!("rtol {rtol:e}: |dE - integral| <= {worst:.3e} J (E0 = {e0:.4} J, max |dE| = {swing:.3e} J)");
-        assert!(worst < 100.0 * rtol * e0, "budget gap {worst:e} J at rtol {rtol:e}");
+        assert!(
+            worst < 100.0 * rtol * e0,
+            "budget gap {worst:e} J at rtol {rtol:e}"
+        );
     }
 }

@@ -9,7 +9,9 @@ use stirling::models::sim::{self, SimOptions};
 /// Solve `a x = b` (row-major `a`, `n x n`) by Gaussian elimination with partial pivoting.
 fn solve(mut a: Vec<f64>, mut b: Vec<f64>, n: usize) -> Vec<f64> {
     for c in 0..n {
-        let piv = (c..n).max_by(|&i, &j| a[i * n + c].abs().total_cmp(&a[j * n + c].abs())).unwrap();
+        let piv = (c..n)
+            .max_by(|&i, &j| a[i * n + c].abs().total_cmp(&a[j * n + c].abs()))
+            .unwrap();
         for k in 0..n {
             a.swap(c * n + k, piv * n + k);
         }
@@ -38,8 +40,12 @@ fn radau_step(model: &dyn Model, p: &[f64], y: &[f64], t: f64, h: f64) -> Vec<f6
     let mut f = [vec![0.0; n], vec![0.0; n]];
     for _ in 0..30 {
         // stage derivatives and Jacobians at the current iterate (full Newton)
-        let ys: Vec<Vec<f64>> = (0..2).map(|i| (0..n).map(|k| y[k] + z[i * n + k]).collect()).collect();
-        let js: Vec<Vec<f64>> = (0..2).map(|i| model.jacobian_dense(p, &ys[i], t + C[i] * h)).collect();
+        let ys: Vec<Vec<f64>> = (0..2)
+            .map(|i| (0..n).map(|k| y[k] + z[i * n + k]).collect())
+            .collect();
+        let js: Vec<Vec<f64>> = (0..2)
+            .map(|i| model.jacobian_dense(p, &ys[i], t + C[i] * h))
+            .collect();
         for i in 0..2 {
             model.rhs(p, &ys[i], t + C[i] * h, &mut f[i]);
         }
@@ -57,7 +63,11 @@ fn radau_step(model: &dyn Model, p: &[f64], y: &[f64], t: f64, h: f64) -> Vec<f6
             }
         }
         let dz = solve(m, g, 2 * n);
-        let norm = dz.iter().zip(y.iter().chain(y)).map(|(d, s)| (d / s.abs().max(1e-3)).abs()).fold(0.0, f64::max);
+        let norm = dz
+            .iter()
+            .zip(y.iter().chain(y))
+            .map(|(d, s)| (d / s.abs().max(1e-3)).abs())
+            .fold(0.0, f64::max);
         for k in 0..2 * n {
             z[k] += dz[k];
         }
@@ -80,12 +90,29 @@ fn compare(model: &dyn Model) {
     for k in 0..steps {
         y = radau_step(model, &p, &y, k as f64 * h, h);
     }
-    let opts = SimOptions { rtol: 1e-11, atol: 1e-11, ..Default::default() };
+    let opts = SimOptions {
+        rtol: 1e-11,
+        atol: 1e-11,
+        ..Default::default()
+    };
     let tr = sim::simulate(model, &p, &x0, t_end, &[t_end], &opts).unwrap();
     let scale = sim::state_scale(model, &p);
-    let err = tr.x[0].iter().zip(&y).zip(&scale).map(|((a, b), s)| ((a - b) / s).abs()).fold(0.0, f64::max);
-    eprintln!("{}: max scaled |BDF - Radau IIA| at t = {t_end} s: {err:.3e} ({} BDF steps)", model.name(), tr.stats.steps);
-    assert!(err < 1e-8, "{}: BDF and Radau IIA differ by {err:e}", model.name());
+    let err = tr.x[0]
+        .iter()
+        .zip(&y)
+        .zip(&scale)
+        .map(|((a, b), s)| ((a - b) / s).abs())
+        .fold(0.0, f64::max);
+    eprintln!(
+        "{}: max scaled |BDF - Radau IIA| at t = {t_end} s: {err:.3e} ({} BDF steps)",
+        model.name(),
+        tr.stats.steps
+    );
+    assert!(
+        err < 1e-8,
+        "{}: BDF and Radau IIA differ by {err:e}",
+        model.name()
+    );
 }
 
 #[test]

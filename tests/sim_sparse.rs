@@ -20,7 +20,12 @@ fn nsection3_sparse_and_dense_agree() {
     let scale = sim::state_scale(&model, &p);
     let samples = sim::uniform_samples(0.05, 50);
     let run = |kind| {
-        let opts = SimOptions { rtol: 1e-10, atol: 1e-10, linear_solver: kind, ..SimOptions::default() };
+        let opts = SimOptions {
+            rtol: 1e-10,
+            atol: 1e-10,
+            linear_solver: kind,
+            ..SimOptions::default()
+        };
         sim::simulate(&model, &p, &x0, 0.05, &samples, &opts).unwrap()
     };
     let (d, s) = (run(LinearSolverKind::Dense), run(LinearSolverKind::Sparse));
@@ -31,7 +36,10 @@ fn nsection3_sparse_and_dense_agree() {
             worst = worst.max((u - v).abs() / w);
         }
     }
-    eprintln!("max scaled difference {worst:.3e}; dense {:?}, sparse {:?}", d.stats, s.stats);
+    eprintln!(
+        "max scaled difference {worst:.3e}; dense {:?}, sparse {:?}",
+        d.stats, s.stats
+    );
     assert!(worst < 1e-6, "dense and sparse runs differ by {worst:e}");
 }
 
@@ -41,12 +49,24 @@ fn nsection2_radau_monodromy_matches_variational() {
     let p = model.default_params();
     let n = model.n_states();
     let x0 = start(&model, &p);
-    let opts = SimOptions { rtol: 1e-10, atol: 1e-10, ..SimOptions::default() };
+    let opts = SimOptions {
+        rtol: 1e-10,
+        atol: 1e-10,
+        ..SimOptions::default()
+    };
     let t = 0.07;
-    let (xr, mr, _) = sim::flow_with_monodromy_by(&model, &p, &x0, t, &opts, MonodromyMethod::default()).unwrap();
-    let (xv, mv, _) = sim::flow_with_monodromy_by(&model, &p, &x0, t, &opts, MonodromyMethod::Variational).unwrap();
+    let (xr, mr, _) =
+        sim::flow_with_monodromy_by(&model, &p, &x0, t, &opts, MonodromyMethod::default()).unwrap();
+    let (xv, mv, _) =
+        sim::flow_with_monodromy_by(&model, &p, &x0, t, &opts, MonodromyMethod::Variational)
+            .unwrap();
     let scale = sim::state_scale(&model, &p);
-    let dx = xr.iter().zip(&xv).zip(&scale).map(|((a, b), s)| (a - b).abs() / s).fold(0.0, f64::max);
+    let dx = xr
+        .iter()
+        .zip(&xv)
+        .zip(&scale)
+        .map(|((a, b), s)| (a - b).abs() / s)
+        .fold(0.0, f64::max);
     // scaled monodromy entries: d x_i / d x0_j * s_j / s_i
     let mut dm = 0.0f64;
     for j in 0..n {
@@ -57,10 +77,22 @@ fn nsection2_radau_monodromy_matches_variational() {
     }
     eprintln!("state difference {dx:.2e}, scaled monodromy difference {dm:.2e}");
     assert!(dx < 1e-7);
-    assert!(dm < 1e-5, "Radau IIA and variational monodromy differ by {dm:e}");
+    assert!(
+        dm < 1e-5,
+        "Radau IIA and variational monodromy differ by {dm:e}"
+    );
     // the same with the sparse stage LU
-    let sp = SimOptions { linear_solver: LinearSolverKind::Sparse, ..opts };
-    let (_, ms, _) = sim::flow_with_monodromy_by(&model, &p, &x0, t, &sp, MonodromyMethod::default()).unwrap();
-    let ds = mr.iter().zip(&ms).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max) / mr.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+    let sp = SimOptions {
+        linear_solver: LinearSolverKind::Sparse,
+        ..opts
+    };
+    let (_, ms, _) =
+        sim::flow_with_monodromy_by(&model, &p, &x0, t, &sp, MonodromyMethod::default()).unwrap();
+    let ds = mr
+        .iter()
+        .zip(&ms)
+        .map(|(a, b)| (a - b).abs())
+        .fold(0.0, f64::max)
+        / mr.iter().fold(0.0f64, |a, v| a.max(v.abs()));
     assert!(ds < 1e-6, "sparse and dense stage LU differ by {ds:e}");
 }

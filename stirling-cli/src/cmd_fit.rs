@@ -46,8 +46,12 @@ pub struct FitArgs {
 pub fn run(a: &FitArgs) -> anyhow::Result<()> {
     let data = read_csv(&a.data)?;
     let model = stirling_models::build(&a.model, a.n, Closure::Full)?;
-    let p0 = stirling_models::params::load(model.as_ref(), a.params.as_deref(), &a.set).with_context(|| format!("parameters of model `{}`", model.name()))?;
-    let mut opts = FitOptions { free: a.free.clone(), ..Default::default() };
+    let p0 = stirling_models::params::load(model.as_ref(), a.params.as_deref(), &a.set)
+        .with_context(|| format!("parameters of model `{}`", model.name()))?;
+    let mut opts = FitOptions {
+        free: a.free.clone(),
+        ..Default::default()
+    };
     if let Some(s) = &a.train {
         opts.train = Some(parse_span(s, &data).map_err(anyhow::Error::msg)?);
     }
@@ -60,7 +64,12 @@ pub fn run(a: &FitArgs) -> anyhow::Result<()> {
         for (k, st) in [&res.stage1, &res.stage2].into_iter().enumerate() {
             for s in st.iter().flat_map(|s| &s.series) {
                 let f = dir.join(format!("stage{}_{}.svg", k + 1, s.channel));
-                plot_series(&f, &format!("stage {}: {} measured vs model", k + 1, s.channel), s).map_err(anyhow::Error::msg)?;
+                plot_series(
+                    &f,
+                    &format!("stage {}: {} measured vs model", k + 1, s.channel),
+                    s,
+                )
+                .map_err(anyhow::Error::msg)?;
             }
         }
     }
@@ -68,25 +77,65 @@ pub fn run(a: &FitArgs) -> anyhow::Result<()> {
         println!("{}", serde_json::to_string_pretty(&res)?);
         return Ok(());
     }
-    println!("model {} (n = {}), data {}, train {:.3}:{:.3} s{}", res.model, res.n, a.data.display(), res.train.0, res.train.1,
-        res.holdout.map(|h| format!(", holdout {:.3}:{:.3} s", h.0, h.1)).unwrap_or_default());
+    println!(
+        "model {} (n = {}), data {}, train {:.3}:{:.3} s{}",
+        res.model,
+        res.n,
+        a.data.display(),
+        res.train.0,
+        res.train.1,
+        res.holdout
+            .map(|h| format!(", holdout {:.3}:{:.3} s", h.0, h.1))
+            .unwrap_or_default()
+    );
     for st in [&res.stage1, &res.stage2].into_iter().flatten() {
-        println!("\n{} ({} iterations, {} evaluations, {}, {:.2} s)", st.stage, st.iterations, st.evaluations, if st.converged { "converged" } else { "NOT converged" }, st.seconds);
-        println!("  {:<14} {:>14} {:>14} {:>12} {:>28}", "quantity", "initial", "estimate", "std error", "95 % interval");
+        println!(
+            "\n{} ({} iterations, {} evaluations, {}, {:.2} s)",
+            st.stage,
+            st.iterations,
+            st.evaluations,
+            if st.converged {
+                "converged"
+            } else {
+                "NOT converged"
+            },
+            st.seconds
+        );
+        println!(
+            "  {:<14} {:>14} {:>14} {:>12} {:>28}",
+            "quantity", "initial", "estimate", "std error", "95 % interval"
+        );
         for e in &st.stats.estimates {
-            println!("  {:<14} {:>14.6e} {:>14.6e} {:>12.3e}   [{:.6e}, {:.6e}]", e.name, e.initial, e.value, e.std_error, e.ci_low, e.ci_high);
+            println!(
+                "  {:<14} {:>14.6e} {:>14.6e} {:>12.3e}   [{:.6e}, {:.6e}]",
+                e.name, e.initial, e.value, e.std_error, e.ci_low, e.ci_high
+            );
         }
         let names: Vec<&str> = st.stats.estimates.iter().map(|e| e.name.as_str()).collect();
         println!("  correlation:");
-        println!("  {:>12} {}", "", names.iter().map(|n| format!("{:>9}", &n[..n.len().min(9)])).collect::<String>());
+        println!(
+            "  {:>12} {}",
+            "",
+            names
+                .iter()
+                .map(|n| format!("{:>9}", &n[..n.len().min(9)]))
+                .collect::<String>()
+        );
         for (i, row) in st.stats.correlation.iter().enumerate() {
-            println!("  {:>12} {}", &names[i][..names[i].len().min(12)], row.iter().map(|v| format!("{v:>9.3}")).collect::<String>());
+            println!(
+                "  {:>12} {}",
+                &names[i][..names[i].len().min(12)],
+                row.iter().map(|v| format!("{v:>9.3}")).collect::<String>()
+            );
         }
         for w in &st.stats.warnings {
             println!("  WARNING: {w}");
         }
         for f in &st.fits {
-            println!("  fit {:<6} {:<8} {:>7.2} %  (rms {:.3e}, {} samples)", f.channel, f.block, f.fit_percent, f.rms, f.samples);
+            println!(
+                "  fit {:<6} {:<8} {:>7.2} %  (rms {:.3e}, {} samples)",
+                f.channel, f.block, f.fit_percent, f.rms, f.samples
+            );
         }
     }
     println!("\ntotal {:.2} s", res.seconds);

@@ -44,7 +44,11 @@ pub fn run(args: &InfoArgs) -> anyhow::Result<()> {
             None => Ok(print!("{dot}")),
         };
     }
-    let style = if args.latex { Style::Latex } else { Style::Text };
+    let style = if args.latex {
+        Style::Latex
+    } else {
+        Style::Text
+    };
     if args.json {
         println!("{}", serde_json::to_string_pretty(&json(model, &p, style))?);
     } else {
@@ -69,25 +73,41 @@ fn write_new(path: &Path, text: &str, force: bool) -> anyhow::Result<()> {
         }
         Err(e) => return Err(e).with_context(|| format!("cannot create {}", path.display())),
     };
-    f.write_all(text.as_bytes()).with_context(|| format!("cannot write {}", path.display()))?;
+    f.write_all(text.as_bytes())
+        .with_context(|| format!("cannot write {}", path.display()))?;
     eprintln!("wrote {}", path.display());
     Ok(())
 }
 
 /// The title line: name, sections, closure, state count and the declaration's doc.
 fn title(model: &dyn Model) -> String {
-    let n = if model.has_array() { format!(", n = {}", model.n()) } else { String::new() };
+    let n = if model.has_array() {
+        format!(", n = {}", model.n())
+    } else {
+        String::new()
+    };
     let doc = model.topology().doc.trim();
-    format!("model {}{n}, closure {}: {} states\n  {doc}\n", model.name(), model.closure(), model.n_states())
+    format!(
+        "model {}{n}, closure {}: {} states\n  {doc}\n",
+        model.name(),
+        model.closure(),
+        model.n_states()
+    )
 }
 
 /// The human-readable listing.
 fn listing(model: &dyn Model, p: &[f64], style: Style) -> String {
     let mut s = title(model);
     s.push_str("\nstates\n");
-    s.push_str(&table(&state_rows(model), &["#", "name", "unit", "meaning"]));
+    s.push_str(&table(
+        &state_rows(model),
+        &["#", "name", "unit", "meaning"],
+    ));
     s.push_str("\nparameters\n");
-    s.push_str(&table(&param_rows(model, p), &["name", "value", "unit", "meaning"]));
+    s.push_str(&table(
+        &param_rows(model, p),
+        &["name", "value", "unit", "meaning"],
+    ));
     s.push('\n');
     s.push_str(&model.equations(style));
     s
@@ -98,7 +118,14 @@ fn state_rows(model: &dyn Model) -> Vec<Vec<String>> {
     states
         .iter()
         .enumerate()
-        .map(|(k, st)| vec![k.to_string(), st.name.clone(), st.unit.into(), st.meaning.clone()])
+        .map(|(k, st)| {
+            vec![
+                k.to_string(),
+                st.name.clone(),
+                st.unit.into(),
+                st.meaning.clone(),
+            ]
+        })
         .collect()
 }
 
@@ -136,7 +163,10 @@ fn table(rows: &[Vec<String>], header: &[&str]) -> String {
         }
     }
     let head: Vec<String> = header.iter().map(|h| h.to_string()).collect();
-    std::iter::once(&head).chain(rows).map(|r| line(r, &width)).collect()
+    std::iter::once(&head)
+        .chain(rows)
+        .map(|r| line(r, &width))
+        .collect()
 }
 
 fn line(r: &[String], width: &[usize]) -> String {
@@ -144,7 +174,13 @@ fn line(r: &[String], width: &[usize]) -> String {
     let cells: Vec<String> = r
         .iter()
         .enumerate()
-        .map(|(k, c)| if k == last { c.clone() } else { format!("{c:<w$}", w = width[k]) })
+        .map(|(k, c)| {
+            if k == last {
+                c.clone()
+            } else {
+                format!("{c:<w$}", w = width[k])
+            }
+        })
         .collect();
     format!("  {}\n", cells.join("  ").trim_end())
 }

@@ -32,8 +32,12 @@ pub struct LinearizeArgs {
 /// Run the analysis and print it.
 pub fn run(a: &LinearizeArgs) -> anyhow::Result<()> {
     let (model, p) = a.model.load()?;
-    let opts = LinearOptions { channel: a.channel.clone(), ..Default::default() };
-    let lin = linear::linearize(model.as_ref(), &p, &opts).with_context(|| format!("linearizing `{}`", model.name()))?;
+    let opts = LinearOptions {
+        channel: a.channel.clone(),
+        ..Default::default()
+    };
+    let lin = linear::linearize(model.as_ref(), &p, &opts)
+        .with_context(|| format!("linearizing `{}`", model.name()))?;
     let report = lin.report(model.as_ref());
     if let Some(dir) = &a.plot {
         plots(dir, model.as_ref(), &lin)?;
@@ -49,17 +53,35 @@ pub fn run(a: &LinearizeArgs) -> anyhow::Result<()> {
 fn plots(dir: &Path, model: &dyn Model, lin: &Linearization) -> anyhow::Result<()> {
     std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
     let tag = format!("{} (n = {}, {})", model.name(), model.n(), model.closure());
-    plot::poles::pole_map(&dir.join("poles.svg"), &format!("Poles of {tag}"), &lin.dynamics.poles, &lin.open_loop.poles)?;
-    let center = lin.margins.gain_crossover_rad_s.or(lin.margins.phase_crossover_rad_s).unwrap_or_else(|| dominant_freq(&lin.dynamics.poles));
+    plot::poles::pole_map(
+        &dir.join("poles.svg"),
+        &format!("Poles of {tag}"),
+        &lin.dynamics.poles,
+        &lin.open_loop.poles,
+    )?;
+    let center = lin
+        .margins
+        .gain_crossover_rad_s
+        .or(lin.margins.phase_crossover_rad_s)
+        .unwrap_or_else(|| dominant_freq(&lin.dynamics.poles));
     let w = bode::log_grid(center / 30.0, center * 30.0, 400);
     let data = bode::bode(&|w| lin.open_loop.at(w), &w);
-    let title = format!("Open loop at the {} input of {tag}", lin.open_loop.full.name);
+    let title = format!(
+        "Open loop at the {} input of {tag}",
+        lin.open_loop.full.name
+    );
     plot::bode::bode_diagram(&dir.join("bode.svg"), &title, &data, &lin.margins)?;
     Ok(())
 }
 
 fn dominant_freq(poles: &[Pole]) -> f64 {
-    poles.iter().filter(|p| p.im > 0.0).map(|p| p.im).fold(f64::INFINITY, f64::min).min(1e6).max(1e-3)
+    poles
+        .iter()
+        .filter(|p| p.im > 0.0)
+        .map(|p| p.im)
+        .fold(f64::INFINITY, f64::min)
+        .min(1e6)
+        .max(1e-3)
 }
 
 fn opt(v: Option<f64>, prec: usize) -> String {
@@ -75,16 +97,31 @@ fn print_pole(p: &Pole) {
 }
 
 fn print_text(r: &LinearReport) {
-    println!("model {} (n = {}, closure {}), {} states", r.model, r.n, r.closure, r.n_states);
+    println!(
+        "model {} (n = {}, closure {}), {} states",
+        r.model, r.n, r.closure, r.n_states
+    );
     let eq = &r.equilibrium;
-    println!("equilibrium: residual max|f| = {:.3e}, scaled {:.3e} 1/s, {} Newton iterations", eq.residual, eq.scaled_residual, eq.iterations);
+    println!(
+        "equilibrium: residual max|f| = {:.3e}, scaled {:.3e} 1/s, {} Newton iterations",
+        eq.residual, eq.scaled_residual, eq.iterations
+    );
     if let Some(inv) = &r.inventory_mode {
-        println!("inventory mode: eigenvalue {:.3e}, mass conservation defect {:.1e} (removed)", inv.eigenvalue, inv.conservation_defect);
+        println!(
+            "inventory mode: eigenvalue {:.3e}, mass conservation defect {:.1e} (removed)",
+            inv.eigenvalue, inv.conservation_defect
+        );
     }
-    println!("closed-loop poles ({} in the right half plane):", r.rhp_count);
+    println!(
+        "closed-loop poles ({} in the right half plane):",
+        r.rhp_count
+    );
     r.poles.iter().for_each(print_pole);
     let l = &r.loop_break;
-    println!("loop broken at the {} input ({}); open-loop poles ({} RHP):", l.channel, l.unit, l.open_loop_rhp_count);
+    println!(
+        "loop broken at the {} input ({}); open-loop poles ({} RHP):",
+        l.channel, l.unit, l.open_loop_rhp_count
+    );
     l.open_loop_poles.iter().for_each(print_pole);
     let m = &r.margins;
     println!(
@@ -95,9 +132,15 @@ fn print_text(r: &LinearReport) {
         opt(m.gain_crossover_rad_s, 2)
     );
     for g in &m.all_gain {
-        println!("  phase crossover {:>10.3} rad/s: Gm = {:.3} dB", g.phase_crossover_rad_s, g.gain_db);
+        println!(
+            "  phase crossover {:>10.3} rad/s: Gm = {:.3} dB",
+            g.phase_crossover_rad_s, g.gain_db
+        );
     }
     for p in &m.all_phase {
-        println!("  gain crossover  {:>10.3} rad/s: Pm = {:.2} deg", p.gain_crossover_rad_s, p.phase_deg);
+        println!(
+            "  gain crossover  {:>10.3} rad/s: Pm = {:.2} deg",
+            p.gain_crossover_rad_s, p.phase_deg
+        );
     }
 }

@@ -41,8 +41,14 @@ pub fn run(a: &LocusArgs) -> anyhow::Result<()> {
     }
     let (model, p) = a.model.load()?;
     let values = locus::linspace(a.from, a.to, a.steps);
-    let l = locus::locus(model.as_ref(), &p, &a.param, &values, &NewtonOptions::default())
-        .with_context(|| format!("root locus of `{}` over `{}`", model.name(), a.param))?;
+    let l = locus::locus(
+        model.as_ref(),
+        &p,
+        &a.param,
+        &values,
+        &NewtonOptions::default(),
+    )
+    .with_context(|| format!("root locus of `{}` over `{}`", model.name(), a.param))?;
     if let Some(dir) = &a.plot {
         std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
         plot::locus::root_locus(&dir.join("locus.svg"), &l)?;
@@ -51,12 +57,20 @@ pub fn run(a: &LocusArgs) -> anyhow::Result<()> {
         println!("{}", serde_json::to_string_pretty(&l)?);
         return Ok(());
     }
-    println!("root locus of {} over {} ({} values); least stable pair per value:", l.model, l.param, l.points.len());
+    println!(
+        "root locus of {} over {} ({} values); least stable pair per value:",
+        l.model,
+        l.param,
+        l.points.len()
+    );
     for pt in &l.points {
         let top = pt.poles.first();
         let rhp = pt.poles.iter().filter(|p| p.rhp).count();
         match top {
-            Some(q) => println!("  {} = {:<12} {:>12.5} {:>+12.5}j   ({rhp} RHP)", l.param, pt.value, q.re, q.im),
+            Some(q) => println!(
+                "  {} = {:<12} {:>12.5} {:>+12.5}j   ({rhp} RHP)",
+                l.param, pt.value, q.re, q.im
+            ),
             None => println!("  {} = {}: no poles", l.param, pt.value),
         }
     }

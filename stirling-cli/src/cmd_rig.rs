@@ -87,7 +87,10 @@ pub fn run(a: &RigArgs) -> anyhow::Result<()> {
     let out = rig::run(&cfg)?;
     let side = rig::write(&out, &a.out, a.force)?;
     if a.json {
-        println!("{}", serde_json::json!({ "csv": a.out, "truth": side, "samples": out.data.len(), "channels": out.data.channels(), "model": out.truth.model, "active_effects": out.truth.active_effects }));
+        println!(
+            "{}",
+            serde_json::json!({ "csv": a.out, "truth": side, "samples": out.data.len(), "channels": out.data.channels(), "model": out.truth.model, "active_effects": out.truth.active_effects })
+        );
     } else {
         println!(
             "wrote {} ({} samples, channels t,{}) and {}; truth model {} with effects: {}",
@@ -96,7 +99,11 @@ pub fn run(a: &RigArgs) -> anyhow::Result<()> {
             out.data.channels().join(","),
             side.display(),
             out.truth.model,
-            if out.truth.active_effects.is_empty() { "none".to_string() } else { out.truth.active_effects.join(", ") }
+            if out.truth.active_effects.is_empty() {
+                "none".to_string()
+            } else {
+                out.truth.active_effects.join(", ")
+            }
         );
     }
     Ok(())

@@ -59,26 +59,52 @@ pub fn run(args: &SimulateArgs) -> anyhow::Result<()> {
     }
     let x0 = initial_state(model, &p, args)?;
     let samples = sim::uniform_samples(args.t_end, args.samples.max(1));
-    let opts = SimOptions { rtol: args.rtol, atol: args.rtol, ..Default::default() };
+    let opts = SimOptions {
+        rtol: args.rtol,
+        atol: args.rtol,
+        ..Default::default()
+    };
     let bar = ProgressBar::new(1000);
-    bar.set_style(ProgressStyle::with_template("{spinner} simulating [{bar:40}] t = {msg} s ({elapsed})").unwrap_or_else(|_| ProgressStyle::default_bar()));
+    bar.set_style(
+        ProgressStyle::with_template("{spinner} simulating [{bar:40}] t = {msg} s ({elapsed})")
+            .unwrap_or_else(|_| ProgressStyle::default_bar()),
+    );
     let t_end = args.t_end;
     let mut progress = |t: f64| {
         bar.set_position((1000.0 * t / t_end) as u64);
         bar.set_message(format!("{t:.4}"));
     };
     let (traj, summary, lc) = if args.limit_cycle {
-        let lc = sim::limit_cycle(model, &p, &x0, args.t_end, &samples, &opts, Some(&mut progress))
-            .with_context(|| format!("limit cycle of `{}`", model.name()))?;
+        let lc = sim::limit_cycle(
+            model,
+            &p,
+            &x0,
+            args.t_end,
+            &samples,
+            &opts,
+            Some(&mut progress),
+        )
+        .with_context(|| format!("limit cycle of `{}`", model.name()))?;
         let tr = lc.settled.trajectory.clone();
         let s = SimSummary::from_run(model, &tr).with_cycle(&lc);
         (tr, s, Some(lc))
     } else {
         let checker = sim::PhysicalCheck::new(model, &p);
         let check = |t: f64, x: &[f64]| checker.check(t, x);
-        let hooks = sim::Hooks { check: Some(&check), progress: Some(&mut progress), ..Default::default() };
-        let tr = sim::integrate(&sim::ModelSystem { model, p: &p }, &x0, args.t_end, &samples, &opts, hooks)
-            .with_context(|| format!("simulation of `{}`", model.name()))?;
+        let hooks = sim::Hooks {
+            check: Some(&check),
+            progress: Some(&mut progress),
+            ..Default::default()
+        };
+        let tr = sim::integrate(
+            &sim::ModelSystem { model, p: &p },
+            &x0,
+            args.t_end,
+            &samples,
+            &opts,
+            hooks,
+        )
+        .with_context(|| format!("simulation of `{}`", model.name()))?;
         let s = SimSummary::from_run(model, &tr);
         (tr, s, None)
     };
@@ -100,21 +126,40 @@ pub fn run(args: &SimulateArgs) -> anyhow::Result<()> {
 fn initial_state(model: &dyn Model, p: &[f64], args: &SimulateArgs) -> anyhow::Result<Vec<f64>> {
     let n = model.n_states();
     if let Some(s) = &args.x0 {
-        let x: Vec<f64> = s.split(',').map(|v| v.trim().parse::<f64>().with_context(|| format!("--x0: `{v}` is not a number"))).collect::<Result<_, _>>()?;
+        let x: Vec<f64> = s
+            .split(',')
+            .map(|v| {
+                v.trim()
+                    .parse::<f64>()
+                    .with_context(|| format!("--x0: `{v}` is not a number"))
+            })
+            .collect::<Result<_, _>>()?;
         if x.len() != n {
-            bail!("--x0 has {} values; `{}` has {} states: {}", x.len(), model.name(), n, model.state_names().join(", "));
+            bail!(
+                "--x0 has {} values; `{}` has {} states: {}",
+                x.len(),
+                model.name(),
+                n,
+                model.state_names().join(", ")
+            );
         }
         return Ok(x);
     }
     let mut x = vec![0.0; n];
     model.equilibrium_guess(p, &mut x);
-    let ix = model.states().iter().position(|s| s.kind == StateKind::Position(0)).context("the model has no displacer position")?;
+    let ix = model
+        .states()
+        .iter()
+        .position(|s| s.kind == StateKind::Position(0))
+        .context("the model has no displacer position")?;
     x[ix] += args.perturb.unwrap_or(5e-3);
     Ok(x)
 }
 
 fn write_csv(path: &Path, model: &dyn Model, tr: &Trajectory) -> anyhow::Result<()> {
-    let mut f = std::io::BufWriter::new(std::fs::File::create(path).with_context(|| format!("cannot create {}", path.display()))?);
+    let mut f = std::io::BufWriter::new(
+        std::fs::File::create(path).with_context(|| format!("cannot create {}", path.display()))?,
+    );
     writeln!(f, "t,{}", model.state_names().join(","))?;
     for (t, x) in tr.t.iter().zip(&tr.x) {
         let row: Vec<String> = x.iter().map(|v| format!("{v:.10e}")).collect();
@@ -123,14 +168,37 @@ fn write_csv(path: &Path, model: &dyn Model, tr: &Trajectory) -> anyhow::Result<
     Ok(())
 }
 
-fn plots(dir: &Path, model: &dyn Model, p: &[f64], tr: &Trajectory, lc: Option<&sim::LimitCycleReport>) -> anyhow::Result<()> {
+fn plots(
+    dir: &Path,
+    model: &dyn Model,
+    p: &[f64],
+    tr: &Trajectory,
+    lc: Option<&sim::LimitCycleReport>,
+) -> anyhow::Result<()> {
     std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
     let states = model.states();
     let find = |k: StateKind| states.iter().position(|s| s.kind == k);
-    let (ix, iy) = (find(StateKind::Position(0)).unwrap_or(0), find(StateKind::Position(1)).unwrap_or(0));
-    let pressures: Vec<(String, usize)> = states.iter().enumerate().filter(|(_, s)| matches!(s.kind, StateKind::Pressure(_))).map(|(i, s)| (s.name.clone(), i)).collect();
+    let (ix, iy) = (
+        find(StateKind::Position(0)).unwrap_or(0),
+        find(StateKind::Position(1)).unwrap_or(0),
+    );
+    let pressures: Vec<(String, usize)> = states
+        .iter()
+        .enumerate()
+        .filter(|(_, s)| matches!(s.kind, StateKind::Pressure(_)))
+        .map(|(i, s)| (s.name.clone(), i))
+        .collect();
     let title = format!("{} (n = {})", model.name(), model.n());
-    stirling_models::plot::timeseries::startup_svg(&dir.join("startup.svg"), &title, &tr.t, &tr.x, ix, iy, &pressures).map_err(anyhow::Error::msg)?;
+    stirling_models::plot::timeseries::startup_svg(
+        &dir.join("startup.svg"),
+        &title,
+        &tr.t,
+        &tr.x,
+        ix,
+        iy,
+        &pressures,
+    )
+    .map_err(anyhow::Error::msg)?;
     if let Some(lc) = lc {
         let nv = model.vessel_names().len();
         let mut loops = vec![Vec::new(); nv];
@@ -141,15 +209,26 @@ fn plots(dir: &Path, model: &dyn Model, p: &[f64], tr: &Trajectory, lc: Option<&
                 loops[i].push((v[i], pr[i]));
             }
         }
-        stirling_models::plot::pv::pv_svg(&dir.join("pv.svg"), &title, &lc.work.vessels, &loops, &lc.work.per_vessel).map_err(anyhow::Error::msg)?;
+        stirling_models::plot::pv::pv_svg(
+            &dir.join("pv.svg"),
+            &title,
+            &lc.work.vessels,
+            &loops,
+            &lc.work.per_vessel,
+        )
+        .map_err(anyhow::Error::msg)?;
     }
     eprintln!("plots written to {}", dir.display());
     Ok(())
 }
 
 fn print_summary(s: &SimSummary) {
-    println!("model {} (n = {}, closure {}, {} states), t_end = {:.4} s", s.model, s.n, s.closure, s.n_states, s.t_end);
-    if let (Some(f), Some(xa), Some(ya), Some(ph)) = (s.frequency_hz, s.x_amp, s.y_amp, s.phase_deg) {
+    println!(
+        "model {} (n = {}, closure {}, {} states), t_end = {:.4} s",
+        s.model, s.n, s.closure, s.n_states, s.t_end
+    );
+    if let (Some(f), Some(xa), Some(ya), Some(ph)) = (s.frequency_hz, s.x_amp, s.y_amp, s.phase_deg)
+    {
         println!("limit cycle: f = {f:.4} Hz ({:.2} rad/s), x_amp = {:.3} mm, y_amp = {:.3} mm, phase(x - y) = {ph:.2} deg", f * std::f64::consts::TAU, 1e3 * xa, 1e3 * ya);
         if let Some(pa) = &s.p_amp {
             let pa: Vec<String> = pa.iter().map(|v| format!("{:.1}", v)).collect();
@@ -164,12 +243,25 @@ fn print_summary(s: &SimSummary) {
             }
         }
         if let Some(fl) = &s.floquet {
-            let fl: Vec<String> = fl.iter().take(6).map(|[re, im]| if *im == 0.0 { format!("{re:.6}") } else { format!("{re:.6}{im:+.6}i") }).collect();
+            let fl: Vec<String> = fl
+                .iter()
+                .take(6)
+                .map(|[re, im]| {
+                    if *im == 0.0 {
+                        format!("{re:.6}")
+                    } else {
+                        format!("{re:.6}{im:+.6}i")
+                    }
+                })
+                .collect();
             println!("Floquet multipliers (largest): {}", fl.join(", "));
         }
     } else {
         let x: Vec<String> = s.final_state.iter().map(|v| format!("{v:.6e}")).collect();
         println!("final state: {}", x.join(", "));
     }
-    println!("solver: {} steps, {} RHS calls, {} Jacobian calls, {} LU factorizations", s.steps, s.rhs_calls, s.jacobian_calls, s.lu_factorizations);
+    println!(
+        "solver: {} steps, {} RHS calls, {} Jacobian calls, {} LU factorizations",
+        s.steps, s.rhs_calls, s.jacobian_calls, s.lu_factorizations
+    );
 }

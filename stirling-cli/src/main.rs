@@ -1,14 +1,15 @@
 //! `stirling`: the command line of the framework.
 
-mod common;
 mod cmd_models;
+mod common;
 // <mods>
-mod cmd_rig;
+mod cmd_diagnose;
 mod cmd_fit;
+mod cmd_info;
 mod cmd_linearize;
 mod cmd_locus;
+mod cmd_rig;
 mod cmd_simulate;
-mod cmd_info;
 
 use clap::{Parser, Subcommand};
 
@@ -29,6 +30,8 @@ enum Command {
         json: bool,
     },
     // <commands>
+    /// Sim-to-real gap diagnosis: where the gap lies, which omitted effect, how far it closes
+    Diagnose(cmd_diagnose::DiagnoseArgs),
     /// Virtual test rig: truth model plus effects, noise and offsets -> measured CSV + truth sidecar
     Rig(cmd_rig::RigArgs),
     /// Two-stage identification from measured data (mechanics, then gas), with intervals and fit %
@@ -48,6 +51,7 @@ fn main() {
     let result = match cli.command {
         Command::Models { json } => cmd_models::run(json),
         // <dispatch>
+        Command::Diagnose(a) => cmd_diagnose::run(&a),
         Command::Rig(a) => cmd_rig::run(&a),
         Command::Fit(a) => cmd_fit::run(&a),
         Command::Linearize(a) => cmd_linearize::run(&a),

@@ -36,7 +36,9 @@ impl std::str::FromStr for Closure {
         match s {
             "full" => Ok(Closure::Full),
             "frozen" => Ok(Closure::Frozen),
-            _ => Err(format!("unknown closure `{s}`: expected `full` or `frozen`")),
+            _ => Err(format!(
+                "unknown closure `{s}`: expected `full` or `frozen`"
+            )),
         }
     }
 }

@@ -60,8 +60,17 @@ impl Parse for ParamAst {
         let name = input.parse()?;
         input.parse::<Token![:]>()?;
         let default = input.parse()?;
-        let unit = if input.peek(LitStr) { input.parse::<LitStr>()?.value() } else { "-".to_string() };
-        Ok(ParamAst { doc, name, default, unit })
+        let unit = if input.peek(LitStr) {
+            input.parse::<LitStr>()?.value()
+        } else {
+            "-".to_string()
+        };
+        Ok(ParamAst {
+            doc,
+            name,
+            default,
+            unit,
+        })
     }
 }
 
@@ -70,7 +79,11 @@ pub fn docs(attrs: &[Attribute]) -> String {
     let mut lines = Vec::new();
     for a in attrs {
         if let syn::Meta::NameValue(nv) = &a.meta {
-            if let Expr::Lit(syn::ExprLit { lit: syn::Lit::Str(s), .. }) = &nv.value {
+            if let Expr::Lit(syn::ExprLit {
+                lit: syn::Lit::Str(s),
+                ..
+            }) = &nv.value
+            {
                 lines.push(s.value().trim().to_string());
             }
         }
@@ -166,7 +179,10 @@ impl Parse for ModelAst {
         let vis = input.parse()?;
         let kw: Ident = input.parse()?;
         if kw != "model" {
-            return Err(syn::Error::new(kw.span(), format!("expected `model Name {{ .. }}`, found `{kw}`")));
+            return Err(syn::Error::new(
+                kw.span(),
+                format!("expected `model Name {{ .. }}`, found `{kw}`"),
+            ));
         }
         let ident = input.parse()?;
         let content;
@@ -175,7 +191,12 @@ impl Parse for ModelAst {
         while !content.is_empty() {
             items.push(item(&content)?);
         }
-        Ok(ModelAst { doc, vis, ident, items })
+        Ok(ModelAst {
+            doc,
+            vis,
+            ident,
+            items,
+        })
     }
 }
 
@@ -228,7 +249,12 @@ fn body(input: ParseStream) -> syn::Result<Item> {
     let pos = content.parse()?;
     content.parse::<Token![,]>()?;
     let vel = content.parse()?;
-    Ok(Item::Body(BodyAst { name, pos, vel, fields: fields(input)? }))
+    Ok(Item::Body(BodyAst {
+        name,
+        pos,
+        vel,
+        fields: fields(input)?,
+    }))
 }
 
 fn vessel(input: ParseStream) -> syn::Result<VesselAst> {
@@ -242,7 +268,13 @@ fn vessel(input: ParseStream) -> syn::Result<VesselAst> {
     };
     let content;
     braced!(content in input);
-    let mut v = VesselAst { name, array, fields: Vec::new(), faces: Vec::new(), ports: Vec::new() };
+    let mut v = VesselAst {
+        name,
+        array,
+        fields: Vec::new(),
+        faces: Vec::new(),
+        ports: Vec::new(),
+    };
     while !content.is_empty() {
         let key: Ident = content.fork().parse()?;
         if key == "faces" && content.peek2(syn::token::Brace) {
@@ -251,7 +283,10 @@ fn vessel(input: ParseStream) -> syn::Result<VesselAst> {
         } else if key == "port" && !content.peek2(Token![:]) {
             content.parse::<Ident>()?;
             let name = content.parse()?;
-            v.ports.push(PortAst { name, fields: fields(&content)? });
+            v.ports.push(PortAst {
+                name,
+                fields: fields(&content)?,
+            });
         } else {
             v.fields.push(content.parse()?);
         }
@@ -271,17 +306,31 @@ fn link(input: ParseStream, span: Span) -> syn::Result<Item> {
         let var = input.parse()?;
         input.parse::<Token![in]>()?;
         let Expr::Range(r) = Expr::parse_without_eager_brace(input)? else {
-            return Err(syn::Error::new(kw.span, "expected a range after `in`, e.g. `for j in 0..n - 1`"));
+            return Err(syn::Error::new(
+                kw.span,
+                "expected a range after `in`, e.g. `for j in 0..n - 1`",
+            ));
         };
         let span = kw.span.join(var_span(&r)).unwrap_or(kw.span);
         let (Some(start), Some(end)) = (r.start, r.end) else {
             return Err(syn::Error::new(span, "expected a range `a..b`"));
         };
-        Some(RangeAst { var, start: *start, end: *end, span })
+        Some(RangeAst {
+            var,
+            start: *start,
+            end: *end,
+            span,
+        })
     } else {
         None
     };
-    Ok(Item::Link(LinkAst { span, from, to, range, fields: fields(input)? }))
+    Ok(Item::Link(LinkAst {
+        span,
+        from,
+        to,
+        range,
+        fields: fields(input)?,
+    }))
 }
 
 fn var_span(r: &syn::ExprRange) -> Span {

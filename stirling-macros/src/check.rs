@@ -6,7 +6,8 @@ use std::collections::HashMap;
 use proc_macro2::Span;
 use stirling_dsl::expr::{At, Id, Sym};
 use stirling_dsl::topology::{
-    BodyDecl, CouplingDecl, CvDecl, End, FaceDecl, GasDecl, LinkDecl, ParamDecl, PortDecl, SpaceDecl, Topology, Vessel,
+    BodyDecl, CouplingDecl, CvDecl, End, FaceDecl, GasDecl, LinkDecl, ParamDecl, PortDecl,
+    SpaceDecl, Topology, Vessel,
 };
 use syn::spanned::Spanned;
 use syn::Ident;
@@ -50,8 +51,15 @@ pub fn lower(ast: &ModelAst) -> syn::Result<Topology> {
 /// Names the generated functions use for their own locals: a declared name equal to one
 /// would shadow it (or be shadowed) in the emitted code.
 fn generated_local(name: &str) -> bool {
-    let temp = name.strip_prefix('t').is_some_and(|d| !d.is_empty() && d.bytes().all(|b| b.is_ascii_digit()));
-    matches!(name, "p" | "x" | "t" | "u" | "out" | "sink" | "f" | "nf" | "jf") || temp || name.starts_with("o_") || name.starts_with("__")
+    let temp = name
+        .strip_prefix('t')
+        .is_some_and(|d| !d.is_empty() && d.bytes().all(|b| b.is_ascii_digit()));
+    matches!(
+        name,
+        "p" | "x" | "t" | "u" | "out" | "sink" | "f" | "nf" | "jf"
+    ) || temp
+        || name.starts_with("o_")
+        || name.starts_with("__")
 }
 
 fn model_name(ast: &ModelAst) -> String {
@@ -84,7 +92,10 @@ impl Lower {
             return false;
         }
         if matches!(name.as_str(), "n" | "pi" | "j") {
-            self.cx.error(id.span(), format!("`{name}` is reserved (`n` sections, `j` section index, `pi`)"));
+            self.cx.error(
+                id.span(),
+                format!("`{name}` is reserved (`n` sections, `j` section index, `pi`)"),
+            );
             return false;
         }
         self.declared.insert(name, id.span());
@@ -158,7 +169,12 @@ impl Lower {
 
     /// Convert an expression, recording an error (and returning 0) on failure.
     pub(crate) fn expr(&mut self, e: &syn::Expr, index: Option<&str>) -> Id {
-        let scope = Scope { params: &self.params, lets: &self.lets, states: &self.states, index: index.map(str::to_string) };
+        let scope = Scope {
+            params: &self.params,
+            lets: &self.lets,
+            states: &self.states,
+            index: index.map(str::to_string),
+        };
         match convert(&mut self.topo.arena, &scope, e) {
             Ok(id) => id,
             Err(err) => {
@@ -171,8 +187,17 @@ impl Lower {
     /// As [`Lower::expr`], and the value must not depend on the motion.
     fn static_expr(&mut self, e: &syn::Expr, index: Option<&str>, what: &str) -> Id {
         let id = self.expr(e, index);
-        if self.topo.arena.symbols(id).iter().any(|s| matches!(s, Sym::State(..))) {
-            self.cx.error(e.span(), format!("{what} must not depend on the states (positions, velocities)"));
+        if self
+            .topo
+            .arena
+            .symbols(id)
+            .iter()
+            .any(|s| matches!(s, Sym::State(..)))
+        {
+            self.cx.error(
+                e.span(),
+                format!("{what} must not depend on the states (positions, velocities)"),
+            );
         }
         id
     }
@@ -183,7 +208,12 @@ impl Lower {
         }
         let empty = HashMap::new();
         let (no_lets, no_states) = (HashMap::new(), HashMap::new());
-        let scope = Scope { params: &empty, lets: &no_lets, states: &no_states, index: None };
+        let scope = Scope {
+            params: &empty,
+            lets: &no_lets,
+            states: &no_states,
+            index: None,
+        };
         let default = match convert(&mut self.topo.arena, &scope, &p.default) {
             Ok(id) => self.topo.arena.eval_const(id).unwrap_or(f64::NAN),
             Err(e) => {
@@ -192,16 +222,26 @@ impl Lower {
             }
         };
         let name = p.name.to_string();
-        self.params.insert(name.clone(), self.topo.params.len() as u32);
-        self.topo.params.push(ParamDecl { name, default, unit: p.unit.clone(), doc: p.doc.clone() });
+        self.params
+            .insert(name.clone(), self.topo.params.len() as u32);
+        self.topo.params.push(ParamDecl {
+            name,
+            default,
+            unit: p.unit.clone(),
+            doc: p.doc.clone(),
+        });
     }
 
     fn declare_body(&mut self, b: &BodyAst) {
         let k = self.topo.bodies.len();
         self.declare(&b.name);
-        for (id, blk) in [(&b.pos, Topology::pos_block(k)), (&b.vel, Topology::vel_block(k))] {
+        for (id, blk) in [
+            (&b.pos, Topology::pos_block(k)),
+            (&b.vel, Topology::vel_block(k)),
+        ] {
             if self.declare(id) {
-                self.states.insert(id.to_string(), Sym::State(blk, At::Scalar));
+                self.states
+                    .insert(id.to_string(), Sym::State(blk, At::Scalar));
             }
         }
         self.bodies.insert(b.name.to_string(), k);
@@ -225,8 +265,20 @@ impl Lower {
         if cv {
             self.cv_arrays.push(v.array.is_some());
         }
-        let vessel = if cv { Vessel::Cv(self.vessels.values().filter(|x| matches!(x, Vessel::Cv(_))).count()) } else {
-            Vessel::Space(self.vessels.values().filter(|x| matches!(x, Vessel::Space(_))).count())
+        let vessel = if cv {
+            Vessel::Cv(
+                self.vessels
+                    .values()
+                    .filter(|x| matches!(x, Vessel::Cv(_)))
+                    .count(),
+            )
+        } else {
+            Vessel::Space(
+                self.vessels
+                    .values()
+                    .filter(|x| matches!(x, Vessel::Space(_)))
+                    .count(),
+            )
         };
         self.vessels.insert(v.name.to_string(), vessel);
     }
@@ -240,30 +292,59 @@ impl Lower {
     }
 
     /// Split fields into the known ones; unknown or repeated fields are errors.
-    fn fields<'f>(&mut self, fields: &'f [Field], known: &[&str], what: &str) -> HashMap<String, &'f Field> {
+    fn fields<'f>(
+        &mut self,
+        fields: &'f [Field],
+        known: &[&str],
+        what: &str,
+    ) -> HashMap<String, &'f Field> {
         let mut out = HashMap::new();
         for f in fields {
             let key = f.name.to_string();
             if !known.contains(&key.as_str()) {
-                self.cx.error(f.name.span(), format!("unknown field `{key}` in {what}: expected one of {}", known.join(", ")));
+                self.cx.error(
+                    f.name.span(),
+                    format!(
+                        "unknown field `{key}` in {what}: expected one of {}",
+                        known.join(", ")
+                    ),
+                );
             } else if out.insert(key.clone(), f).is_some() {
-                self.cx.error(f.name.span(), format!("field `{key}` given twice in {what}"));
+                self.cx.error(
+                    f.name.span(),
+                    format!("field `{key}` given twice in {what}"),
+                );
             }
         }
         out
     }
 
-    fn required(&mut self, f: &HashMap<String, &Field>, key: &str, span: Span, what: &str, index: Option<&str>) -> Id {
+    fn required(
+        &mut self,
+        f: &HashMap<String, &Field>,
+        key: &str,
+        span: Span,
+        what: &str,
+        index: Option<&str>,
+    ) -> Id {
         match f.get(key) {
             Some(field) => self.expr(&field.value, index),
             None => {
-                self.cx.error(span, format!("{what} has no `{key}`: expected `{key}: <expression>`"));
+                self.cx.error(
+                    span,
+                    format!("{what} has no `{key}`: expected `{key}: <expression>`"),
+                );
                 self.topo.arena.num(1.0)
             }
         }
     }
 
-    fn optional(&mut self, f: &HashMap<String, &Field>, key: &str, index: Option<&str>) -> Option<Id> {
+    fn optional(
+        &mut self,
+        f: &HashMap<String, &Field>,
+        key: &str,
+        index: Option<&str>,
+    ) -> Option<Id> {
         f.get(key).map(|field| self.expr(&field.value, index))
     }
 
@@ -273,13 +354,24 @@ impl Lower {
         let gamma = self.required(&f, "gamma", span, "`gas`", None);
         let charge = self.required(&f, "charge", span, "`gas`", None);
         let mdot_eps = self.required(&f, "mdot_eps", span, "`gas`", None);
-        self.topo.gas = Some(GasDecl { r, gamma, charge, mdot_eps });
+        self.topo.gas = Some(GasDecl {
+            r,
+            gamma,
+            charge,
+            mdot_eps,
+        });
     }
 
     fn body(&mut self, b: &BodyAst) {
-        let Some(&k) = self.bodies.get(&b.name.to_string()) else { return };
+        let Some(&k) = self.bodies.get(&b.name.to_string()) else {
+            return;
+        };
         let what = format!("body `{}`", b.name);
-        let f = self.fields(&b.fields, &["mass", "spring", "damper", "quad_damper", "force"], &what);
+        let f = self.fields(
+            &b.fields,
+            &["mass", "spring", "damper", "quad_damper", "force"],
+            &what,
+        );
         let mass = self.required(&f, "mass", b.name.span(), &what, None);
         let zero = self.topo.arena.num(0.0);
         let spring = self.optional(&f, "spring", None).unwrap_or(zero);
@@ -287,7 +379,13 @@ impl Lower {
         let quad_damper = self.optional(&f, "quad_damper", None).unwrap_or(zero);
         let force = self.optional(&f, "force", None).unwrap_or(zero);
         let body = &mut self.topo.bodies[k];
-        (body.mass, body.spring, body.damper, body.quad_damper, body.force) = (mass, spring, damper, quad_damper, force);
+        (
+            body.mass,
+            body.spring,
+            body.damper,
+            body.quad_damper,
+            body.force,
+        ) = (mass, spring, damper, quad_damper, force);
     }
 
     fn body_ref(&mut self, id: &Ident) -> Option<usize> {
@@ -295,8 +393,15 @@ impl Lower {
         if found.is_none() {
             let mut names: Vec<&String> = self.bodies.keys().collect();
             names.sort();
-            let list = names.iter().map(|s| s.as_str()).collect::<Vec<_>>().join(", ");
-            self.cx.error(id.span(), format!("unknown body `{id}`: expected one of {list}"));
+            let list = names
+                .iter()
+                .map(|s| s.as_str())
+                .collect::<Vec<_>>()
+                .join(", ");
+            self.cx.error(
+                id.span(),
+                format!("unknown body `{id}`: expected one of {list}"),
+            );
         }
         found
     }
@@ -314,7 +419,11 @@ impl Lower {
         let mut out = Vec::new();
         for f in faces {
             let body = self.body_ref(&f.name);
-            let coeff = self.static_expr(&f.value, None, &format!("the face coefficient of `{owner}` on `{}`", f.name));
+            let coeff = self.static_expr(
+                &f.value,
+                None,
+                &format!("the face coefficient of `{owner}` on `{}`", f.name),
+            );
             if let Some(body) = body {
                 out.push(FaceDecl { body, coeff });
             }
@@ -325,17 +434,31 @@ impl Lower {
     fn space(&mut self, v: &VesselAst) {
         let what = format!("space `{}`", v.name);
         if let Some(n) = &v.array {
-            self.cx.error(n.span(), format!("{what}: a given-pressure space cannot be an array"));
+            self.cx.error(
+                n.span(),
+                format!("{what}: a given-pressure space cannot be an array"),
+            );
         }
         if !v.ports.is_empty() {
-            self.cx.error(v.ports[0].name.span(), format!("{what}: a given-pressure space has no heat ports (make it a `cv`)"));
+            self.cx.error(
+                v.ports[0].name.span(),
+                format!("{what}: a given-pressure space has no heat ports (make it a `cv`)"),
+            );
         }
         let f = self.fields(&v.fields, &["pressure", "volume", "temperature"], &what);
         let pressure = self.required(&f, "pressure", v.name.span(), &what, None);
-        let volume = self.optional(&f, "volume", None).unwrap_or_else(|| self.topo.arena.num(0.0));
+        let volume = self
+            .optional(&f, "volume", None)
+            .unwrap_or_else(|| self.topo.arena.num(0.0));
         let temperature = self.optional(&f, "temperature", None);
         let faces = self.faces(&v.faces, &v.name.to_string());
-        self.topo.spaces.push(SpaceDecl { name: v.name.to_string(), pressure, volume, temperature, faces });
+        self.topo.spaces.push(SpaceDecl {
+            name: v.name.to_string(),
+            pressure,
+            volume,
+            temperature,
+            faces,
+        });
     }
 
     fn cv(&mut self, v: &VesselAst) {
@@ -351,7 +474,9 @@ impl Lower {
         }
         let f = self.fields(&v.fields, &["volume"], &what);
         let volume = match f.get("volume") {
-            Some(field) => self.static_expr(&field.value, index, &format!("the volume of `{}`", v.name)),
+            Some(field) => {
+                self.static_expr(&field.value, index, &format!("the volume of `{}`", v.name))
+            }
             None => {
                 self.cx.error(v.name.span(), format!("{what} has no volume: expected `volume: <expression>` (its volume at rest)"));
                 self.topo.arena.num(1.0)
@@ -361,8 +486,18 @@ impl Lower {
             self.cx.error(v.name.span(), format!("{what} has no heat port: expected `port name {{ h: .., area: .., wall: .. }}` (its rest temperature is the ports' mean wall temperature)"));
         }
         let ports = v.ports.iter().map(|p| self.port(p, index)).collect();
-        let faces = if v.array.is_some() { Vec::new() } else { self.faces(&v.faces, &v.name.to_string()) };
-        self.topo.cvs.push(CvDecl { name: v.name.to_string(), array: v.array.is_some(), volume, faces, ports });
+        let faces = if v.array.is_some() {
+            Vec::new()
+        } else {
+            self.faces(&v.faces, &v.name.to_string())
+        };
+        self.topo.cvs.push(CvDecl {
+            name: v.name.to_string(),
+            array: v.array.is_some(),
+            volume,
+            faces,
+            ports,
+        });
     }
 
     fn port(&mut self, p: &crate::ast::PortAst, index: Option<&str>) -> PortDecl {
@@ -373,18 +508,30 @@ impl Lower {
         let wall = match f.get("wall") {
             Some(field) => self.expr(&field.value, index),
             None => {
-                self.cx.error(p.name.span(), format!("{what} has no wall temperature: expected `wall: <expression>`"));
+                self.cx.error(
+                    p.name.span(),
+                    format!("{what} has no wall temperature: expected `wall: <expression>`"),
+                );
                 self.topo.arena.num(1.0)
             }
         };
-        PortDecl { name: p.name.to_string(), h, area, wall }
+        PortDecl {
+            name: p.name.to_string(),
+            h,
+            area,
+            wall,
+        }
     }
 
     fn link(&mut self, l: &LinkAst) {
         let var = l.range.as_ref().map(|r| r.var.to_string());
         let from = self.end(&l.from, var.as_deref());
         let to = self.end(&l.to, var.as_deref());
-        let f = self.fields(&l.fields, &["resistance", "conductance", "quadratic"], "`link`");
+        let f = self.fields(
+            &l.fields,
+            &["resistance", "conductance", "quadratic"],
+            "`link`",
+        );
         let conductance = self.optional(&f, "conductance", var.as_deref());
         let resistance = match conductance {
             Some(g) => {
@@ -394,11 +541,29 @@ impl Lower {
                 let one = self.topo.arena.num(1.0);
                 self.topo.arena.div(one, g)
             }
-            None => self.required(&f, "resistance", l.span, "`link` (or `conductance: G`)", var.as_deref()),
+            None => self.required(
+                &f,
+                "resistance",
+                l.span,
+                "`link` (or `conductance: G`)",
+                var.as_deref(),
+            ),
         };
-        let quadratic = if conductance.is_some() { None } else { self.optional(&f, "quadratic", var.as_deref()) };
-        let (Some(from), Some(to)) = (from, to) else { return };
-        let link = LinkDecl { from, to, resistance, quadratic, conductance };
+        let quadratic = if conductance.is_some() {
+            None
+        } else {
+            self.optional(&f, "quadratic", var.as_deref())
+        };
+        let (Some(from), Some(to)) = (from, to) else {
+            return;
+        };
+        let link = LinkDecl {
+            from,
+            to,
+            resistance,
+            quadratic,
+            conductance,
+        };
         if self.link_shape_ok(l, &link) {
             self.topo.links.push(link);
         }
@@ -408,19 +573,41 @@ impl Lower {
         let Some(&vessel) = self.vessels.get(&e.name.to_string()) else {
             let mut names: Vec<&String> = self.vessels.keys().collect();
             names.sort();
-            let list = names.iter().map(|s| s.as_str()).collect::<Vec<_>>().join(", ");
-            self.cx.error(e.name.span(), format!("unknown control volume or space `{}`: expected one of {list}", e.name));
+            let list = names
+                .iter()
+                .map(|s| s.as_str())
+                .collect::<Vec<_>>()
+                .join(", ");
+            self.cx.error(
+                e.name.span(),
+                format!(
+                    "unknown control volume or space `{}`: expected one of {list}",
+                    e.name
+                ),
+            );
             return None;
         };
         let array = matches!(vessel, Vessel::Cv(i) if self.is_array_cv(i));
         match (&e.index, array) {
-            (None, false) => Some(End { vessel, at: At::Scalar }),
+            (None, false) => Some(End {
+                vessel,
+                at: At::Scalar,
+            }),
             (Some(ix), false) => {
-                self.cx.error(ix.span(), format!("`{}` is not an array: remove the index", e.name));
+                self.cx.error(
+                    ix.span(),
+                    format!("`{}` is not an array: remove the index", e.name),
+                );
                 None
             }
             (None, true) => {
-                self.cx.error(e.name.span(), format!("`{}` is an array: name a section, e.g. `{0}[0]`, `{0}[n - 1]` or `{0}[j]`", e.name));
+                self.cx.error(
+                    e.name.span(),
+                    format!(
+                        "`{}` is an array: name a section, e.g. `{0}[0]`, `{0}[n - 1]` or `{0}[j]`",
+                        e.name
+                    ),
+                );
                 None
             }
             (Some(ix), true) => self.index(ix, var).map(|at| End { vessel, at }),

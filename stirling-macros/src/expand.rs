@@ -10,6 +10,10 @@ use crate::check::lower;
 /// The whole expansion of one `stirling_model!` invocation.
 pub fn expand(ast: ModelAst) -> syn::Result<TokenStream> {
     let topo = lower(&ast)?;
-    let spec = ModelSpec { ident: ast.ident.clone(), vis: ast.vis.to_token_stream(), krate: quote!(::stirling_dsl) };
+    let spec = ModelSpec {
+        ident: ast.ident.clone(),
+        vis: ast.vis.to_token_stream(),
+        krate: quote!(::stirling_dsl),
+    };
     Ok(generate(topo, &spec))
 }

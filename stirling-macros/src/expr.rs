@@ -71,7 +71,11 @@ fn name(a: &mut Arena, scope: &Scope, id: &syn::Ident) -> syn::Result<Id> {
         "n" => Ok(a.sym(Sym::Count)),
         "pi" => Ok(a.num(std::f64::consts::PI)),
         _ => {
-            let index = scope.index.as_ref().map(|i| format!(", the section index `{i}`")).unwrap_or_default();
+            let index = scope
+                .index
+                .as_ref()
+                .map(|i| format!(", the section index `{i}`"))
+                .unwrap_or_default();
             err(id, format!("unknown name `{s}`: expected a parameter, a `let` name, a body state, `n`{index} or `pi`"))
         }
     }
@@ -84,7 +88,12 @@ fn binary(a: &mut Arena, scope: &Scope, b: &syn::ExprBinary) -> syn::Result<Id> 
         BinOp::Sub(_) => a.sub(x, y),
         BinOp::Mul(_) => a.mul(x, y),
         BinOp::Div(_) => a.div(x, y),
-        _ => return err(&b.op, "unsupported operator: expected + - * / (powers are `powi(x, k)` or `x.powi(k)`)"),
+        _ => {
+            return err(
+                &b.op,
+                "unsupported operator: expected + - * / (powers are `powi(x, k)` or `x.powi(k)`)",
+            )
+        }
     })
 }
 
@@ -105,7 +114,13 @@ fn method(a: &mut Arena, scope: &Scope, m: &syn::ExprMethodCall) -> syn::Result<
     apply(a, scope, &m.method, &args, m)
 }
 
-fn apply(a: &mut Arena, scope: &Scope, f: &syn::Ident, args: &[&Expr], whole: &impl Spanned) -> syn::Result<Id> {
+fn apply(
+    a: &mut Arena,
+    scope: &Scope,
+    f: &syn::Ident,
+    args: &[&Expr],
+    whole: &impl Spanned,
+) -> syn::Result<Id> {
     let name = f.to_string();
     match (name.as_str(), args.len()) {
         ("powi", 2) => {

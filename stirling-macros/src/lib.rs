@@ -34,7 +34,9 @@ use proc_macro::TokenStream;
 #[proc_macro]
 pub fn stirling_model(input: TokenStream) -> TokenStream {
     let ast = syn::parse_macro_input!(input as ast::ModelAst);
-    expand::expand(ast).unwrap_or_else(syn::Error::into_compile_error).into()
+    expand::expand(ast)
+        .unwrap_or_else(syn::Error::into_compile_error)
+        .into()
 }
 
 #[cfg(test)]

@@ -23,10 +23,17 @@ impl Lower {
         let id = self.expr(ix, var);
         let syms = self.topo.arena.symbols(id);
         if syms.iter().any(|s| !matches!(s, Sym::Index | Sym::Count)) {
-            self.cx.error(ix.span(), "a section index may use only `n`, the range variable and integers");
+            self.cx.error(
+                ix.span(),
+                "a section index may use only `n`, the range variable and integers",
+            );
             return None;
         }
-        let (f00, f10, f01) = (sample(self, id, 0.0, 10.0), sample(self, id, 1.0, 10.0), sample(self, id, 0.0, 11.0));
+        let (f00, f10, f01) = (
+            sample(self, id, 0.0, 10.0),
+            sample(self, id, 1.0, 10.0),
+            sample(self, id, 0.0, 11.0),
+        );
         let (dj, dn) = (f10 - f00, f01 - f00);
         let at = match (dj, dn) {
             (0.0, 0.0) if f00 == 0.0 => Some(At::First),
@@ -47,7 +54,10 @@ impl Lower {
         let (rf, rt) = (rel(link.from.at), rel(link.to.at));
         let Some(range) = &l.range else {
             if rf.is_some() || rt.is_some() {
-                self.cx.error(l.span, "a link with a section variable needs a range: `for j in 0..n - 1`");
+                self.cx.error(
+                    l.span,
+                    "a link with a section variable needs a range: `for j in 0..n - 1`",
+                );
                 return false;
             }
             return true;
@@ -57,7 +67,8 @@ impl Lower {
             return false;
         };
         if link.from.vessel != link.to.vessel {
-            self.cx.error(l.span, "a chain link must join sections of one array");
+            self.cx
+                .error(l.span, "a chain link must join sections of one array");
             return false;
         }
         let start = self.expr(&range.start, None);
@@ -66,13 +77,23 @@ impl Lower {
         let e_off = sample(self, end, 0.0, 10.0) - 10.0;
         let (lo, hi) = (rf.min(rt), rf.max(rt));
         if s + lo as f64 != 0.0 && s + (lo as f64) < 0.0 {
-            self.cx.error(range.start.span(), format!("the link runs before the start of the array: the index reaches {}", s as i32 + lo));
+            self.cx.error(
+                range.start.span(),
+                format!(
+                    "the link runs before the start of the array: the index reaches {}",
+                    s as i32 + lo
+                ),
+            );
             return false;
         }
         if e_off + hi as f64 > 0.0 {
             let name = self.vessel_name(link.from.vessel);
             let reach = e_off as i32 + hi - 1;
-            let reach = if reach == 0 { "n".to_string() } else { format!("n {} {}", if reach > 0 { "+" } else { "-" }, reach.abs()) };
+            let reach = if reach == 0 {
+                "n".to_string()
+            } else {
+                format!("n {} {}", if reach > 0 { "+" } else { "-" }, reach.abs())
+            };
             self.cx.error(
                 range.end.span(),
                 format!(
@@ -90,6 +111,10 @@ impl Lower {
     }
 
     fn vessel_name(&self, v: Vessel) -> String {
-        self.vessels.iter().find(|(_, &x)| x == v).map(|(k, _)| k.clone()).unwrap_or_default()
+        self.vessels
+            .iter()
+            .find(|(_, &x)| x == v)
+            .map(|(k, _)| k.clone())
+            .unwrap_or_default()
     }
 }

@@ -15,7 +15,12 @@ fn linearize(c: &mut Criterion) {
             group.sample_size(10);
         }
         group.bench_with_input(BenchmarkId::from_parameter(n), &n, |b, _| {
-            b.iter(|| dynamic_poles(model.as_ref(), &p, &NewtonOptions::default()).unwrap().poles.len())
+            b.iter(|| {
+                dynamic_poles(model.as_ref(), &p, &NewtonOptions::default())
+                    .unwrap()
+                    .poles
+                    .len()
+            })
         });
     }
     group.finish();

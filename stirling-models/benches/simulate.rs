@@ -12,7 +12,10 @@ fn one_second(model: &dyn Model, p: &[f64], kind: LinearSolverKind) -> sim::Traj
     let mut x0 = vec![0.0; model.n_states()];
     model.equilibrium_guess(p, &mut x0);
     x0[0] = 5e-3;
-    let opts = SimOptions { linear_solver: kind, ..SimOptions::default() };
+    let opts = SimOptions {
+        linear_solver: kind,
+        ..SimOptions::default()
+    };
     sim::simulate(model, p, &x0, 1.0, &[1.0], &opts).expect("the default engine runs")
 }
 
@@ -39,10 +42,22 @@ fn bench(c: &mut Criterion) {
         let p = model.default_params();
         let d = report(n, &model, &p, LinearSolverKind::Dense);
         let s = report(n, &model, &p, LinearSolverKind::Sparse);
-        let diff = d.x_end.iter().zip(&s.x_end).zip(&sim::state_scale(&model, &p)).map(|((a, b), s)| (a - b).abs() / s).fold(0.0, f64::max);
-        eprintln!("nsection n = {n}: dense vs sparse final state, max scaled difference {diff:.2e}");
-        g.bench_function(format!("nsection_{n}_dense"), |b| b.iter(|| one_second(&model, &p, LinearSolverKind::Dense)));
-        g.bench_function(format!("nsection_{n}_sparse"), |b| b.iter(|| one_second(&model, &p, LinearSolverKind::Sparse)));
+        let diff = d
+            .x_end
+            .iter()
+            .zip(&s.x_end)
+            .zip(&sim::state_scale(&model, &p))
+            .map(|((a, b), s)| (a - b).abs() / s)
+            .fold(0.0, f64::max);
+        eprintln!(
+            "nsection n = {n}: dense vs sparse final state, max scaled difference {diff:.2e}"
+        );
+        g.bench_function(format!("nsection_{n}_dense"), |b| {
+            b.iter(|| one_second(&model, &p, LinearSolverKind::Dense))
+        });
+        g.bench_function(format!("nsection_{n}_sparse"), |b| {
+            b.iter(|| one_second(&model, &p, LinearSolverKind::Sparse))
+        });
     }
     if std::env::var_os("STIRLING_BENCH_SKIP_N1000").is_none() {
         let model = NSection::new(1000, Closure::Full).unwrap();

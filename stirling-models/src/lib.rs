@@ -117,19 +117,21 @@ pub mod family;
 pub mod params;
 pub mod plot;
 // <analysis mods>
-/// Effects the nominal models leave out, as DSL-declared model augmentations.
-pub mod effects;
 /// Measured data: CSV input with row/column errors, sensor offsets.
 pub mod data;
-/// The virtual test rig: truth model plus effects, noise, offsets, sample rate.
-pub mod rig;
+/// The sim-to-real gap diagnosis: where, which effect, how far.
+pub mod diagnose;
+/// Effects the nominal models leave out, as DSL-declared model augmentations.
+pub mod effects;
 /// Identification: driven subsystems, forward sensitivities, Levenberg-Marquardt, report.
 pub mod fit;
-/// Nonlinear simulation, limit cycles, Floquet multipliers and cycle work.
-pub mod sim;
 /// Linear analysis: equilibrium, poles, the loop broken at a pressure force, margins, locus.
 pub mod linear;
 pub mod registry;
+/// The virtual test rig: truth model plus effects, noise, offsets, sample rate.
+pub mod rig;
+/// Nonlinear simulation, limit cycles, Floquet multipliers and cycle work.
+pub mod sim;
 
 pub use registry::{build, RegistryError, FAMILY};
 pub use stirling_dsl as dsl;

@@ -13,17 +13,34 @@ pub enum ParamError {
     #[error("parameter file {path}: {why}")]
     Parse { path: String, why: String },
     #[error("{origin}: unknown parameter `{name}` for model `{model}`; valid parameters: {valid}")]
-    Unknown { origin: String, name: String, model: String, valid: String },
+    Unknown {
+        origin: String,
+        name: String,
+        model: String,
+        valid: String,
+    },
     #[error("{origin}: parameter `{name}` must be a number, found {found}")]
-    NotANumber { origin: String, name: String, found: String },
+    NotANumber {
+        origin: String,
+        name: String,
+        found: String,
+    },
     #[error("--set `{0}`: expected name=value, e.g. --set Th=650")]
     BadOverride(String),
     #[error("parameter `{name}` = {value} is not physical: {why}")]
-    Unphysical { name: String, value: f64, why: String },
+    Unphysical {
+        name: String,
+        value: f64,
+        why: String,
+    },
 }
 
 /// The defaults, then the file (if any), then the overrides, then validation.
-pub fn load(model: &dyn Model, file: Option<&Path>, sets: &[String]) -> Result<Vec<f64>, ParamError> {
+pub fn load(
+    model: &dyn Model,
+    file: Option<&Path>,
+    sets: &[String],
+) -> Result<Vec<f64>, ParamError> {
     let mut p = model.default_params();
     if let Some(path) = file {
         apply_file(model, path, &mut p)?;
@@ -37,33 +54,65 @@ pub fn load(model: &dyn Model, file: Option<&Path>, sets: &[String]) -> Result<V
 
 fn unknown(model: &dyn Model, origin: &str, name: &str) -> ParamError {
     let valid: Vec<&str> = model.params().iter().map(|p| p.name).collect();
-    ParamError::Unknown { origin: origin.into(), name: name.into(), model: model.name().into(), valid: valid.join(", ") }
+    ParamError::Unknown {
+        origin: origin.into(),
+        name: name.into(),
+        model: model.name().into(),
+        valid: valid.join(", "),
+    }
 }
 
 /// Apply a TOML (`.toml`) or JSON (anything else) file of `name = value` pairs.
 pub fn apply_file(model: &dyn Model, path: &Path, p: &mut [f64]) -> Result<(), ParamError> {
     let shown = path.display().to_string();
-    let text = std::fs::read_to_string(path).map_err(|e| ParamError::Read { path: shown.clone(), why: e.to_string() })?;
-    let table: serde_json::Map<String, serde_json::Value> = if path.extension().is_some_and(|e| e == "toml") {
-        let v: toml::Table = toml::from_str(&text).map_err(|e| ParamError::Parse { path: shown.clone(), why: e.to_string() })?;
-        serde_json::to_value(v).ok().and_then(|v| v.as_object().cloned()).unwrap_or_default()
-    } else {
-        serde_json::from_str(&text).map_err(|e| ParamError::Parse { path: shown.clone(), why: e.to_string() })?
-    };
+    let text = std::fs::read_to_string(path).map_err(|e| ParamError::Read {
+        path: shown.clone(),
+        why: e.to_string(),
+    })?;
+    let table: serde_json::Map<String, serde_json::Value> =
+        if path.extension().is_some_and(|e| e == "toml") {
+            let v: toml::Table = toml::from_str(&text).map_err(|e| ParamError::Parse {
+                path: shown.clone(),
+                why: e.to_string(),
+            })?;
+            serde_json::to_value(v)
+                .ok()
+                .and_then(|v| v.as_object().cloned())
+                .unwrap_or_default()
+        } else {
+            serde_json::from_str(&text).map_err(|e| ParamError::Parse {
+                path: shown.clone(),
+                why: e.to_string(),
+            })?
+        };
     for (name, value) in table {
-        let k = model.param_index(&name).ok_or_else(|| unknown(model, &shown, &name))?;
-        p[k] = value.as_f64().ok_or_else(|| ParamError::NotANumber { origin: shown.clone(), name: name.clone(), found: value.to_string() })?;
+        let k = model
+            .param_index(&name)
+            .ok_or_else(|| unknown(model, &shown, &name))?;
+        p[k] = value.as_f64().ok_or_else(|| ParamError::NotANumber {
+            origin: shown.clone(),
+            name: name.clone(),
+            found: value.to_string(),
+        })?;
     }
     Ok(())
 }
 
 /// Apply one `name=value` override.
 pub fn apply_override(model: &dyn Model, s: &str, p: &mut [f64]) -> Result<(), ParamError> {
-    let (name, value) = s.split_once('=').ok_or_else(|| ParamError::BadOverride(s.to_string()))?;
+    let (name, value) = s
+        .split_once('=')
+        .ok_or_else(|| ParamError::BadOverride(s.to_string()))?;
     let (name, value) = (name.trim(), value.trim());
     let origin = format!("--set {s}");
-    let k = model.param_index(name).ok_or_else(|| unknown(model, &origin, name))?;
-    p[k] = value.parse().map_err(|_| ParamError::NotANumber { origin, name: name.into(), found: value.into() })?;
+    let k = model
+        .param_index(name)
+        .ok_or_else(|| unknown(model, &origin, name))?;
+    p[k] = value.parse().map_err(|_| ParamError::NotANumber {
+        origin,
+        name: name.into(),
+        found: value.into(),
+    })?;
     Ok(())
 }
 
@@ -73,11 +122,20 @@ pub fn apply_override(model: &dyn Model, s: &str, p: &mut [f64]) -> Result<(), P
 pub fn validate(model: &dyn Model, p: &[f64]) -> Result<(), ParamError> {
     let get = |n: &str| model.param_index(n).map(|k| p[k]);
     for (info, &v) in model.params().iter().zip(p) {
-        let bad = |why: &str| Err(ParamError::Unphysical { name: info.name.into(), value: v, why: why.into() });
+        let bad = |why: &str| {
+            Err(ParamError::Unphysical {
+                name: info.name.into(),
+                value: v,
+                why: why.into(),
+            })
+        };
         if !v.is_finite() {
             return bad("must be finite");
         }
-        let must_be_positive = matches!(info.unit, "kg" | "m^2" | "m^3" | "K" | "Pa" | "J/(kg K)" | "kg/s" | "Pa s/kg" | "W/(m^2 K)");
+        let must_be_positive = matches!(
+            info.unit,
+            "kg" | "m^2" | "m^3" | "K" | "Pa" | "J/(kg K)" | "kg/s" | "Pa s/kg" | "W/(m^2 K)"
+        );
         if must_be_positive && v <= 0.0 {
             return bad(&format!("must be positive (unit {})", info.unit));
         }
@@ -87,17 +145,29 @@ pub fn validate(model: &dyn Model, p: &[f64]) -> Result<(), ParamError> {
     }
     if let Some(g) = get("gamma") {
         if g <= 1.0 {
-            return Err(ParamError::Unphysical { name: "gamma".into(), value: g, why: "the heat-capacity ratio must exceed 1".into() });
+            return Err(ParamError::Unphysical {
+                name: "gamma".into(),
+                value: g,
+                why: "the heat-capacity ratio must exceed 1".into(),
+            });
         }
     }
     if let (Some(th), Some(tk)) = (get("Th"), get("Tk")) {
         if th <= tk {
-            return Err(ParamError::Unphysical { name: "Th".into(), value: th, why: format!("the hot wall must be hotter than the cold wall (Tk = {tk})") });
+            return Err(ParamError::Unphysical {
+                name: "Th".into(),
+                value: th,
+                why: format!("the hot wall must be hotter than the cold wall (Tk = {tk})"),
+            });
         }
     }
     if let (Some(a), Some(ar)) = (get("A"), get("Ar")) {
         if ar >= a {
-            return Err(ParamError::Unphysical { name: "Ar".into(), value: ar, why: format!("the rod must be thinner than the cylinder (A = {a})") });
+            return Err(ParamError::Unphysical {
+                name: "Ar".into(),
+                value: ar,
+                why: format!("the rod must be thinner than the cylinder (A = {a})"),
+            });
         }
     }
     Ok(())

@@ -27,18 +27,28 @@ pub const FAMILY: &[ModelEntry] = &[
 /// Why a model request cannot be served.
 #[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
 pub enum RegistryError {
-    #[error("unknown model `{0}`: expected one of schmidt, cv1, cv2, nsection (aliases order4..order8)")]
+    #[error(
+        "unknown model `{0}`: expected one of schmidt, cv1, cv2, nsection (aliases order4..order8)"
+    )]
     UnknownModel(String),
     #[error("model `{model}` has no regenerator sections: --n {n} does not apply (omit --n)")]
     NotAnArray { model: String, n: usize },
     #[error("--n must be at least 1, found {0}")]
     ZeroSections(usize),
     #[error("alias `{alias}` fixes n = {fixed}; --n {n} contradicts it")]
-    AliasFixesN { alias: String, fixed: usize, n: usize },
+    AliasFixesN {
+        alias: String,
+        fixed: usize,
+        n: usize,
+    },
 }
 
 /// Build a family member; `n` is `None` when not given (default 1 section for `nsection`).
-pub fn build(name: &str, n: Option<usize>, closure: Closure) -> Result<Box<dyn Model>, RegistryError> {
+pub fn build(
+    name: &str,
+    n: Option<usize>,
+    closure: Closure,
+) -> Result<Box<dyn Model>, RegistryError> {
     let (canonical, fixed_n) = match name {
         "order4" => ("schmidt", None),
         "order5" => ("cv1", None),
@@ -49,14 +59,21 @@ pub fn build(name: &str, n: Option<usize>, closure: Closure) -> Result<Box<dyn M
     };
     if let (Some(f), Some(n)) = (fixed_n, n) {
         if f != n {
-            return Err(RegistryError::AliasFixesN { alias: name.to_string(), fixed: f, n });
+            return Err(RegistryError::AliasFixesN {
+                alias: name.to_string(),
+                fixed: f,
+                n,
+            });
         }
     }
     if n == Some(0) {
         return Err(RegistryError::ZeroSections(0));
     }
     let scalar = |m: &str| match n {
-        Some(k) if k != 1 => Err(RegistryError::NotAnArray { model: m.to_string(), n: k }),
+        Some(k) if k != 1 => Err(RegistryError::NotAnArray {
+            model: m.to_string(),
+            n: k,
+        }),
         _ => Ok(()),
     };
     let boxed: Box<dyn Model> = match canonical {

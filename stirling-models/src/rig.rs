@@ -130,7 +130,13 @@ impl Gauss {
 
 /// Indices of the cold-side and hot-side pressure states (last and first CV).
 pub fn pressure_states(model: &dyn Model) -> (usize, usize) {
-    let ps: Vec<usize> = model.states().iter().enumerate().filter(|(_, s)| matches!(s.kind, StateKind::Pressure(_))).map(|(i, _)| i).collect();
+    let ps: Vec<usize> = model
+        .states()
+        .iter()
+        .enumerate()
+        .filter(|(_, s)| matches!(s.kind, StateKind::Pressure(_)))
+        .map(|(i, _)| i)
+        .collect();
     (*ps.last().expect("a CV model"), ps[0])
 }
 
@@ -151,7 +157,10 @@ pub fn first_order_lag(u: &[f64], dt: f64, tau: f64) -> Vec<f64> {
 /// Run the rig.
 pub fn run(cfg: &RigConfig) -> Result<RigOutput, RigError> {
     if !(cfg.t_end > 0.0 && cfg.rate > 0.0 && cfg.settle >= 0.0) {
-        return Err(RigError::Bad(format!("need --t-end > 0, --rate > 0, --settle >= 0 (got {}, {}, {})", cfg.t_end, cfg.rate, cfg.settle)));
+        return Err(RigError::Bad(format!(
+            "need --t-end > 0, --rate > 0, --settle >= 0 (got {}, {}, {})",
+            cfg.t_end, cfg.rate, cfg.settle
+        )));
     }
     if !(cfg.noise_p >= 0.0 && cfg.noise_x >= 0.0) {
         return Err(RigError::Bad("noise levels must be non-negative".into()));
@@ -166,23 +175,76 @@ pub fn run(cfg: &RigConfig) -> Result<RigOutput, RigError> {
     let count = (cfg.t_end * cfg.rate).round() as usize;
     let dt = 1.0 / cfg.rate;
     let samples: Vec<f64> = (0..=count).map(|k| cfg.settle + k as f64 * dt).collect();
-    let opts = SimOptions { rtol: 1e-8, atol: 1e-8, ..Default::default() };
-    let traj = simulate(model.as_ref(), &p, &x0, cfg.settle + count as f64 * dt, &samples, &opts)?;
+    let opts = SimOptions {
+        rtol: 1e-8,
+        atol: 1e-8,
+        ..Default::default()
+    };
+    let traj = simulate(
+        model.as_ref(),
+        &p,
+        &x0,
+        cfg.settle + count as f64 * dt,
+        &samples,
+        &opts,
+    )?;
     let (ic, ih) = pressure_states(model.as_ref());
-    let ncv = model.states().iter().filter(|s| matches!(s.kind, StateKind::Pressure(_))).count();
+    let ncv = model
+        .states()
+        .iter()
+        .filter(|s| matches!(s.kind, StateKind::Pressure(_)))
+        .count();
     let col = |i: usize| traj.x.iter().map(|r| r[i]).collect::<Vec<f64>>();
     let tau = fx.sensor_value("tau_p");
     let (gx, gy) = (fx.sensor_value("gain_x"), fx.sensor_value("gain_y"));
     let mut g = Gauss(StdRng::seed_from_u64(cfg.seed));
-    let mut noisy = |v: Vec<f64>, gain: f64, off: f64, sd: f64| v.into_iter().map(|s| (1.0 + gain) * s + off + sd * g.next()).collect::<Vec<f64>>();
-    let pc = noisy(first_order_lag(&col(ic), dt, tau), 0.0, cfg.offset_p, cfg.noise_p);
-    let ph = if ncv > 1 { Some(noisy(first_order_lag(&col(ih), dt, tau), 0.0, cfg.offset_p, cfg.noise_p)) } else { None };
+    let mut noisy = |v: Vec<f64>, gain: f64, off: f64, sd: f64| {
+        v.into_iter()
+            .map(|s| (1.0 + gain) * s + off + sd * g.next())
+            .collect::<Vec<f64>>()
+    };
+    let pc = noisy(
+        first_order_lag(&col(ic), dt, tau),
+        0.0,
+        cfg.offset_p,
+        cfg.noise_p,
+    );
+    let ph = if ncv > 1 {
+        Some(noisy(
+            first_order_lag(&col(ih), dt, tau),
+            0.0,
+            cfg.offset_p,
+            cfg.noise_p,
+        ))
+    } else {
+        None
+    };
     let x = noisy(col(0), gx, cfg.offset_x, cfg.noise_x);
     let y = noisy(col(2), gy, cfg.offset_y, cfg.noise_x);
     let t: Vec<f64> = (0..=count).map(|k| k as f64 * dt).collect();
-    let data = Measured { source: format!("rig:{}", model.name()), t, p: Some(pc), p_hot: ph, x: Some(x), y: Some(y) };
-    let parameters = model.params().iter().zip(&p).map(|(i, v)| (i.name.to_string(), *v)).collect();
-    let offsets = [("p", cfg.offset_p), ("p_hot", cfg.offset_p), ("x", cfg.offset_x), ("y", cfg.offset_y)].into_iter().map(|(k, v)| (k.to_string(), v)).collect();
+    let data = Measured {
+        source: format!("rig:{}", model.name()),
+        t,
+        p: Some(pc),
+        p_hot: ph,
+        x: Some(x),
+        y: Some(y),
+    };
+    let parameters = model
+        .params()
+        .iter()
+        .zip(&p)
+        .map(|(i, v)| (i.name.to_string(), *v))
+        .collect();
+    let offsets = [
+        ("p", cfg.offset_p),
+        ("p_hot", cfg.offset_p),
+        ("x", cfg.offset_x),
+        ("y", cfg.offset_y),
+    ]
+    .into_iter()
+    .map(|(k, v)| (k.to_string(), v))
+    .collect();
     let truth = Truth {
         model: model.name().to_string(),
         base: cfg.model.clone(),
@@ -191,7 +253,10 @@ pub fn run(cfg: &RigConfig) -> Result<RigOutput, RigError> {
         active_effects: fx.active().into_iter().map(String::from).collect(),
         effects: fx,
         seed: cfg.seed,
-        noise: Noise { p: cfg.noise_p, x: cfg.noise_x },
+        noise: Noise {
+            p: cfg.noise_p,
+            x: cfg.noise_x,
+        },
         offsets,
         rate: cfg.rate,
         t_end: cfg.t_end,

@@ -55,8 +55,13 @@ pub fn random_state(model: &dyn Model, p: &[f64], spread: Spread, rng: &mut StdR
 
 /// The smallest difference between two gas pressures of `x`.
 pub fn min_pressure_gap(model: &dyn Model, x: &[f64]) -> f64 {
-    let pressures: Vec<f64> =
-        model.states().iter().zip(x).filter(|(s, _)| matches!(s.kind, StateKind::Pressure(_))).map(|(_, &v)| v).collect();
+    let pressures: Vec<f64> = model
+        .states()
+        .iter()
+        .zip(x)
+        .filter(|(s, _)| matches!(s.kind, StateKind::Pressure(_)))
+        .map(|(_, &v)| v)
+        .collect();
     let mut gap = f64::INFINITY;
     for (i, a) in pressures.iter().enumerate() {
         for b in &pressures[i + 1..] {
@@ -98,7 +103,13 @@ pub fn fd_steps(model: &dyn Model, p: &[f64], x: &[f64]) -> Vec<f64> {
     states
         .iter()
         .zip(state_scales(model, p))
-        .map(|(s, scale)| if matches!(s.kind, StateKind::Pressure(_)) { dp } else { 1e-3 * scale })
+        .map(|(s, scale)| {
+            if matches!(s.kind, StateKind::Pressure(_)) {
+                dp
+            } else {
+                1e-3 * scale
+            }
+        })
         .collect()
 }
 
@@ -114,7 +125,13 @@ pub fn fd_jacobian(f: &dyn Fn(&[f64], &mut [f64]), x: &[f64], m: usize, steps: &
 /// As [`fd_jacobian`], starting from each of `starts` (factors of `steps`) and keeping, per
 /// entry, the estimate with the smallest error estimate: for parameters, whose scales of
 /// nonlinearity range from the parameter itself down to a few percent of it.
-pub fn fd_jacobian_multi(f: &dyn Fn(&[f64], &mut [f64]), x: &[f64], m: usize, steps: &[f64], starts: &[f64]) -> Vec<f64> {
+pub fn fd_jacobian_multi(
+    f: &dyn Fn(&[f64], &mut [f64]),
+    x: &[f64],
+    m: usize,
+    steps: &[f64],
+    starts: &[f64],
+) -> Vec<f64> {
     let mut best: Option<(Vec<f64>, Vec<f64>)> = None;
     for s in starts {
         let h: Vec<f64> = steps.iter().map(|h| h * s).collect();
@@ -135,7 +152,12 @@ pub fn fd_jacobian_multi(f: &dyn Fn(&[f64], &mut [f64]), x: &[f64], m: usize, st
 }
 
 /// Ridders' extrapolation: the estimates and their error estimates, column-major.
-fn ridders(f: &dyn Fn(&[f64], &mut [f64]), x: &[f64], m: usize, steps: &[f64]) -> (Vec<f64>, Vec<f64>) {
+fn ridders(
+    f: &dyn Fn(&[f64], &mut [f64]),
+    x: &[f64],
+    m: usize,
+    steps: &[f64],
+) -> (Vec<f64>, Vec<f64>) {
     const CON: f64 = 1.4;
     const NTAB: usize = 14;
     const SAFE: f64 = 2.0;
@@ -166,10 +188,14 @@ fn ridders(f: &dyn Fn(&[f64], &mut [f64]), x: &[f64], m: usize, steps: &[f64]) -
             tab[0][i] = central(h);
             let mut fac = CON * CON;
             for k in 1..=i {
-                tab[k][i] = (0..m).map(|r| (tab[k - 1][i][r] * fac - tab[k - 1][i - 1][r]) / (fac - 1.0)).collect();
+                tab[k][i] = (0..m)
+                    .map(|r| (tab[k - 1][i][r] * fac - tab[k - 1][i - 1][r]) / (fac - 1.0))
+                    .collect();
                 fac *= CON * CON;
                 for r in (0..m).filter(|&r| !done[r]) {
-                    let e = (tab[k][i][r] - tab[k - 1][i][r]).abs().max((tab[k][i][r] - tab[k - 1][i - 1][r]).abs());
+                    let e = (tab[k][i][r] - tab[k - 1][i][r])
+                        .abs()
+                        .max((tab[k][i][r] - tab[k - 1][i - 1][r]).abs());
                     if e <= err[r] {
                         err[r] = e;
                         best[r] = tab[k][i][r];
@@ -240,9 +266,18 @@ pub fn compare(
             let floor = tiny * colmax[j].max(rowmax[i]);
             let (a, d) = (analytic[i + m * j], fd[i + m * j]);
             let (sa, sd) = (scaled(a, i).abs(), scaled(d, i).abs());
-            let ok = if sa.max(sd) > floor { (a - d).abs() <= rel * a.abs().max(d.abs()) } else { true };
+            let ok = if sa.max(sd) > floor {
+                (a - d).abs() <= rel * a.abs().max(d.abs())
+            } else {
+                true
+            };
             if !ok || !a.is_finite() {
-                bad.push(Mismatch { row: row_names[i].clone(), col: col_names[j].clone(), analytic: a, fd: d });
+                bad.push(Mismatch {
+                    row: row_names[i].clone(),
+                    col: col_names[j].clone(),
+                    analytic: a,
+                    fd: d,
+                });
             }
         }
     }
@@ -266,12 +301,21 @@ pub fn check_jacobians(model: &dyn Model, p: &[f64], x: &[f64]) -> Vec<Mismatch>
     let jac = model.jacobian_dense(p, x, 0.0);
     let mut bad = compare(&jac, &fd, &names, &names, &scales, &scales, REL, TINY);
     // parameters
-    let pnames: Vec<String> = model.params().iter().map(|q| format!("param {}", q.name)).collect();
+    let pnames: Vec<String> = model
+        .params()
+        .iter()
+        .map(|q| format!("param {}", q.name))
+        .collect();
     let g = |pp: &[f64], out: &mut [f64]| model.rhs(pp, x, 0.0, out);
-    let pscales: Vec<f64> = p.iter().map(|v| if *v == 0.0 { 1.0 } else { v.abs() }).collect();
+    let pscales: Vec<f64> = p
+        .iter()
+        .map(|v| if *v == 0.0 { 1.0 } else { v.abs() })
+        .collect();
     let pfd = fd_jacobian_multi(&g, p, n, &pscales, &[0.5, 0.1]);
     let pjac = model.param_jacobian_dense(p, x, 0.0);
-    bad.extend(compare(&pjac, &pfd, &names, &pnames, &scales, &pscales, REL, TINY));
+    bad.extend(compare(
+        &pjac, &pfd, &names, &pnames, &scales, &pscales, REL, TINY,
+    ));
     bad
 }
 
@@ -296,5 +340,10 @@ pub fn assert_jacobians(model: &dyn Model, label: &str, seed: u64, count: usize)
             }
         }
     }
-    assert!(report.is_empty(), "{label}: {} Jacobian entries disagree with finite differences:\n{}", report.len(), report.join("\n"));
+    assert!(
+        report.is_empty(),
+        "{label}: {} Jacobian entries disagree with finite differences:\n{}",
+        report.len(),
+        report.join("\n")
+    );
 }

@@ -45,13 +45,36 @@ pub fn equations(arena: &Arena, lay: &Layout, model: &str, style: Style) -> Stri
 }
 
 fn header(lay: &Layout, model: &str) -> String {
-    let states: Vec<String> =
-        lay.sys.blocks.iter().map(|b| if b.array { format!("{}[j]", b.name) } else { b.name.clone() }).collect();
-    let arrays = if lay.sys.blocks.iter().any(|b| b.array) { " (j = 0..n-1)" } else { "" };
-    format!("model {model}, closure {}\nstates: {}{arrays}\n", lay.sys.closure, states.join(", "))
+    let states: Vec<String> = lay
+        .sys
+        .blocks
+        .iter()
+        .map(|b| {
+            if b.array {
+                format!("{}[j]", b.name)
+            } else {
+                b.name.clone()
+            }
+        })
+        .collect();
+    let arrays = if lay.sys.blocks.iter().any(|b| b.array) {
+        " (j = 0..n-1)"
+    } else {
+        ""
+    };
+    format!(
+        "model {model}, closure {}\nstates: {}{arrays}\n",
+        lay.sys.closure,
+        states.join(", ")
+    )
 }
 
-fn text(lay: &Layout, model: &str, defs: &[(String, String)], eqs: &[(String, String, Option<String>)]) -> String {
+fn text(
+    lay: &Layout,
+    model: &str,
+    defs: &[(String, String)],
+    eqs: &[(String, String, Option<String>)],
+) -> String {
     let mut s = header(lay, model);
     s.push_str("\nwhere\n");
     for (name, body) in defs {
@@ -67,7 +90,11 @@ fn text(lay: &Layout, model: &str, defs: &[(String, String)], eqs: &[(String, St
     s
 }
 
-fn latex(p: &Printer, defs: &[(String, String)], eqs: &[(String, String, Option<String>)]) -> String {
+fn latex(
+    p: &Printer,
+    defs: &[(String, String)],
+    eqs: &[(String, String, Option<String>)],
+) -> String {
     let mut s = String::from("\\begin{aligned}\n");
     for (name, body) in defs {
         s.push_str(&format!("{name} &= {body} \\\\\n"));
@@ -75,7 +102,10 @@ fn latex(p: &Printer, defs: &[(String, String)], eqs: &[(String, String, Option<
     for (lhs, rhs, note) in eqs {
         let lhs = format!("\\dot{{{}}}", p.ident(lhs));
         match note {
-            Some(n) => s.push_str(&format!("{lhs} &= {rhs} && \\text{{for }} {} \\\\\n", n.replace(">=", "\\ge"))),
+            Some(n) => s.push_str(&format!(
+                "{lhs} &= {rhs} && \\text{{for }} {} \\\\\n",
+                n.replace(">=", "\\ge")
+            )),
             None => s.push_str(&format!("{lhs} &= {rhs} \\\\\n")),
         }
     }

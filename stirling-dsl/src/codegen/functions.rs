@@ -9,7 +9,13 @@ use super::terms;
 use crate::expr::Arena;
 
 /// Wrap `body` into a method with the standard prologue (`n`, parameters, offsets).
-fn method(name: &Ident, args: TokenStream, ret: TokenStream, lay: &Layout, body: TokenStream) -> TokenStream {
+fn method(
+    name: &Ident,
+    args: TokenStream,
+    ret: TokenStream,
+    lay: &Layout,
+    body: TokenStream,
+) -> TokenStream {
     let (params, offsets) = (lay.params(), lay.offsets());
     quote! {
         #[allow(non_snake_case, unused_variables, unused_parens, clippy::all)]
@@ -25,7 +31,13 @@ fn method(name: &Ident, args: TokenStream, ret: TokenStream, lay: &Layout, body:
 }
 
 /// All methods for the closure `tag` (`full` or `frozen`).
-pub fn closure_methods(arena: &mut Arena, lay: &Layout, tag: &str, private: &TokenStream, krate: &TokenStream) -> TokenStream {
+pub fn closure_methods(
+    arena: &mut Arena,
+    lay: &Layout,
+    tag: &str,
+    private: &TokenStream,
+    krate: &TokenStream,
+) -> TokenStream {
     let f = |what: &str| format_ident!("__{}_{}", what, tag);
     let sink = quote!(sink: &mut #krate::JacSink);
     let xp = quote!(p: &[f64], x: &[f64]);
@@ -40,15 +52,51 @@ pub fn closure_methods(arena: &mut Arena, lay: &Layout, tag: &str, private: &Tok
     let masses = terms::masses(arena, lay, private);
     let n_states = n_states(lay);
     let items = [
-        method(&f("rhs"), quote!(#xp, t: f64, out: &mut [f64]), quote!(), lay, rhs),
+        method(
+            &f("rhs"),
+            quote!(#xp, t: f64, out: &mut [f64]),
+            quote!(),
+            lay,
+            rhs,
+        ),
         method(&f("jac"), quote!(#xp, t: f64, #sink), quote!(), lay, jac),
         method(&f("pjac"), quote!(#xp, t: f64, #sink), quote!(), lay, pjac),
-        method(&f("forces"), quote!(#xp, out: &mut [f64]), quote!(), lay, forces),
-        method(&f("force_grad"), quote!(__body: usize, #xp, out: &mut [f64]), quote!(), lay, grads),
-        method(&f("init"), quote!(p: &[f64], out: &mut [f64]), quote!(), lay, init),
-        method(&f("vessels"), quote!(#xp, f: &mut dyn FnMut(usize, [f64; 7])), quote!(), lay, vessels),
+        method(
+            &f("forces"),
+            quote!(#xp, out: &mut [f64]),
+            quote!(),
+            lay,
+            forces,
+        ),
+        method(
+            &f("force_grad"),
+            quote!(__body: usize, #xp, out: &mut [f64]),
+            quote!(),
+            lay,
+            grads,
+        ),
+        method(
+            &f("init"),
+            quote!(p: &[f64], out: &mut [f64]),
+            quote!(),
+            lay,
+            init,
+        ),
+        method(
+            &f("vessels"),
+            quote!(#xp, f: &mut dyn FnMut(usize, [f64; 7])),
+            quote!(),
+            lay,
+            vessels,
+        ),
         method(&f("mech"), quote!(#xp), quote!(-> [f64; 2]), lay, mech),
-        method(&f("masses"), quote!(p: &[f64], out: &mut [f64]), quote!(), lay, masses),
+        method(
+            &f("masses"),
+            quote!(p: &[f64], out: &mut [f64]),
+            quote!(),
+            lay,
+            masses,
+        ),
     ];
     let ns = f("n_states");
     let items = quote! {

@@ -28,7 +28,10 @@ pub fn bodies(topo: &Topology, krate: &TokenStream) -> TokenStream {
 /// Vessel-element offset of CV `i`: `(scalars before, arrays before)`.
 fn cv_element_offset(topo: &Topology, i: usize) -> (usize, usize) {
     let before = &topo.cvs[..i];
-    (before.iter().filter(|c| !c.array).count(), before.iter().filter(|c| c.array).count())
+    (
+        before.iter().filter(|c| !c.array).count(),
+        before.iter().filter(|c| c.array).count(),
+    )
 }
 
 /// Body of `fn states(&self) -> Vec<StateInfo>` for one closure.
@@ -115,7 +118,10 @@ pub fn topology(topo: &Topology, lay: &Layout, krate: &TokenStream) -> TokenStre
     }
     let links = topo.links.iter().map(|l| {
         let end = |e: &crate::topology::End| match e.vessel {
-            Vessel::Cv(i) => crate::topology::frame::rename(&format!("{}{}", topo.cvs[i].name, at_text(e.at)), crate::topology::frame::Place::Own),
+            Vessel::Cv(i) => crate::topology::frame::rename(
+                &format!("{}{}", topo.cvs[i].name, at_text(e.at)),
+                crate::topology::frame::Place::Own,
+            ),
             Vessel::Space(s) => topo.spaces[s].name.clone(),
         };
         let (f, t, r, chain) = (end(&l.from), end(&l.to), p.expr(l.resistance), l.is_chain());

@@ -21,7 +21,9 @@ impl Layout<'_> {
     }
 
     fn block(&self, sym: u32) -> usize {
-        self.sys.block_index(sym).unwrap_or_else(|| panic!("internal: state block {sym} has no state in this closure"))
+        self.sys
+            .block_index(sym)
+            .unwrap_or_else(|| panic!("internal: state block {sym} has no state in this closure"))
     }
 
     /// `let o_x: usize = 0; ...` for every block, as `scalars + arrays * n`.
@@ -49,7 +51,10 @@ impl Layout<'_> {
     pub fn params(&self) -> TokenStream {
         let mut out = TokenStream::new();
         for (i, p) in self.topo.params.iter().enumerate() {
-            let (id, k) = (Ident::new(&p.name, Span::call_site()), Literal::usize_unsuffixed(i));
+            let (id, k) = (
+                Ident::new(&p.name, Span::call_site()),
+                Literal::usize_unsuffixed(i),
+            );
             out.extend(quote! { let #id: f64 = p[#k]; });
         }
         out
@@ -98,7 +103,11 @@ impl Layout<'_> {
         match s {
             Sym::Param(i) => self.topo.params[i as usize].name.clone(),
             Sym::State(b, at) => {
-                let name = self.sys.block_index(b).map(|i| self.sys.blocks[i].name.clone()).unwrap_or_else(|| format!("s{b}"));
+                let name = self
+                    .sys
+                    .block_index(b)
+                    .map(|i| self.sys.blocks[i].name.clone())
+                    .unwrap_or_else(|| format!("s{b}"));
                 match at {
                     At::Scalar => name,
                     At::Rel(r) => format!("{name}[{}]", crate::topology::frame::index_text(r)),

@@ -38,7 +38,9 @@ pub fn generate(mut topo: Topology, spec: &ModelSpec) -> TokenStream {
     let mut states = Vec::new();
     for (sys, tag) in [(&full, "full"), (&frozen, "frozen")] {
         let lay = Layout { sys, topo: &topo };
-        parts.push(functions::closure_methods(&mut arena, &lay, tag, &private, krate));
+        parts.push(functions::closure_methods(
+            &mut arena, &lay, tag, &private, krate,
+        ));
         texts.push([
             equations::equations(&arena, &lay, &topo.name, Style::Text),
             equations::equations(&arena, &lay, &topo.name, Style::Latex),
@@ -46,7 +48,10 @@ pub fn generate(mut topo: Topology, spec: &ModelSpec) -> TokenStream {
         states.push(info::states(&lay, krate));
     }
     topo.arena = arena;
-    let lay = Layout { sys: &full, topo: &topo };
+    let lay = Layout {
+        sys: &full,
+        topo: &topo,
+    };
     let statics = Statics {
         params: info::params(&topo, krate),
         bodies: info::bodies(&topo, krate),
@@ -119,8 +124,15 @@ fn params_struct(topo: &Topology, spec: &ModelSpec) -> TokenStream {
     let (vis, krate) = (&spec.vis, &spec.krate);
     let ps = format_ident!("{}Params", spec.ident);
     let serde_path = format!("{}::__private::serde", krate.to_string().replace(' ', ""));
-    let fields: Vec<Ident> = topo.params.iter().map(|p| Ident::new(&p.name, Span::call_site())).collect();
-    let docs = topo.params.iter().map(|p| format!("{} [{}]", p.doc, p.unit));
+    let fields: Vec<Ident> = topo
+        .params
+        .iter()
+        .map(|p| Ident::new(&p.name, Span::call_site()))
+        .collect();
+    let docs = topo
+        .params
+        .iter()
+        .map(|p| format!("{} [{}]", p.doc, p.unit));
     let defaults = topo.params.iter().map(|p| p.default);
     let idx = 0..topo.params.len();
     let count = topo.params.len();
@@ -164,7 +176,10 @@ fn model_impl(topo: &Topology, spec: &ModelSpec, st: &Statics) -> TokenStream {
     let [ft, fl] = &st.texts[0];
     let [zt, zl] = &st.texts[1];
     let call = |what: &str, args: TokenStream| {
-        let (f, z) = (format_ident!("__{}_full", what), format_ident!("__{}_frozen", what));
+        let (f, z) = (
+            format_ident!("__{}_full", what),
+            format_ident!("__{}_frozen", what),
+        );
         quote! {
             match self.closure {
                 #krate::Closure::Full => self.#f(#args),

@@ -29,13 +29,37 @@ struct Entry {
 }
 
 /// The body of a generated rhs / Jacobian function (after the prologue).
-pub fn rows_body(arena: &mut Arena, lay: &Layout, rows: &[Row], what: Output, private: &TokenStream) -> TokenStream {
-    let scalar: Vec<(usize, Id)> =
-        rows.iter().enumerate().filter_map(|(i, r)| if let Row::Scalar(id) = r { Some((i, *id)) } else { None }).collect();
+pub fn rows_body(
+    arena: &mut Arena,
+    lay: &Layout,
+    rows: &[Row],
+    what: Output,
+    private: &TokenStream,
+) -> TokenStream {
+    let scalar: Vec<(usize, Id)> = rows
+        .iter()
+        .enumerate()
+        .filter_map(|(i, r)| {
+            if let Row::Scalar(id) = r {
+                Some((i, *id))
+            } else {
+                None
+            }
+        })
+        .collect();
     let entries = entries(arena, lay, &scalar, what, false);
     let scalar_code = block(arena, lay, &entries, what, private);
-    let arrays: Vec<(usize, [Id; 4])> =
-        rows.iter().enumerate().filter_map(|(i, r)| if let Row::Array(v) = r { Some((i, *v)) } else { None }).collect();
+    let arrays: Vec<(usize, [Id; 4])> = rows
+        .iter()
+        .enumerate()
+        .filter_map(|(i, r)| {
+            if let Row::Array(v) = r {
+                Some((i, *v))
+            } else {
+                None
+            }
+        })
+        .collect();
     if arrays.is_empty() {
         return scalar_code;
     }
@@ -51,7 +75,13 @@ pub fn rows_body(arena: &mut Arena, lay: &Layout, rows: &[Row], what: Output, pr
 }
 
 /// Group the variants that give the same expressions and emit one arm per group.
-fn variant_arms(arena: &mut Arena, lay: &Layout, arrays: &[(usize, [Id; 4])], what: Output, private: &TokenStream) -> TokenStream {
+fn variant_arms(
+    arena: &mut Arena,
+    lay: &Layout,
+    arrays: &[(usize, [Id; 4])],
+    what: Output,
+    private: &TokenStream,
+) -> TokenStream {
     let mut groups: Vec<(Vec<Variant>, Vec<Id>)> = Vec::new();
     for (k, v) in VARIANTS.iter().enumerate() {
         let ids: Vec<Id> = arrays.iter().map(|(_, r)| r[k]).collect();
@@ -63,7 +93,11 @@ fn variant_arms(arena: &mut Arena, lay: &Layout, arrays: &[(usize, [Id; 4])], wh
     let bodies: Vec<TokenStream> = groups
         .iter()
         .map(|(_, ids)| {
-            let rows: Vec<(usize, Id)> = arrays.iter().zip(ids).map(|((i, _), id)| (*i, *id)).collect();
+            let rows: Vec<(usize, Id)> = arrays
+                .iter()
+                .zip(ids)
+                .map(|((i, _), id)| (*i, *id))
+                .collect();
             let entries = entries(arena, lay, &rows, what, true);
             block(arena, lay, &entries, what, private)
         })
@@ -93,7 +127,13 @@ fn variant_path(v: Variant, private: &TokenStream) -> TokenStream {
 }
 
 /// The outputs of `rows` for `what`: values, or nonzero derivatives with their columns.
-fn entries(arena: &mut Arena, lay: &Layout, rows: &[(usize, Id)], what: Output, in_loop: bool) -> Vec<Entry> {
+fn entries(
+    arena: &mut Arena,
+    lay: &Layout,
+    rows: &[(usize, Id)],
+    what: Output,
+    in_loop: bool,
+) -> Vec<Entry> {
     let mut out = Vec::new();
     for &(b, id) in rows {
         let at = if in_loop { At::Rel(0) } else { At::Scalar };
@@ -113,14 +153,24 @@ fn entries(arena: &mut Arena, lay: &Layout, rows: &[(usize, Id)], what: Output, 
             };
             let d = arena.diff(id, s);
             if arena.as_const(d) != Some(0.0) {
-                out.push(Entry { id: d, row: row.clone(), col: Some(col) });
+                out.push(Entry {
+                    id: d,
+                    row: row.clone(),
+                    col: Some(col),
+                });
             }
         }
     }
     out
 }
 
-fn block(arena: &Arena, lay: &Layout, entries: &[Entry], what: Output, private: &TokenStream) -> TokenStream {
+fn block(
+    arena: &Arena,
+    lay: &Layout,
+    entries: &[Entry],
+    what: Output,
+    private: &TokenStream,
+) -> TokenStream {
     let roots: Vec<Id> = entries.iter().map(|e| e.id).collect();
     let leaf = |s: Sym| lay.leaf(s);
     let b = emit_block(arena, &roots, &leaf, private);

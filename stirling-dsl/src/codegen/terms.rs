@@ -40,7 +40,10 @@ pub fn force_gradients(arena: &mut Arena, lay: &Layout, private: &TokenStream) -
         let leaf = |s: Sym| lay.leaf(s);
         let b = emit_block(arena, &roots, &leaf, private);
         let lets = b.lets;
-        let stores = cols.iter().zip(b.outputs).map(|(c, v)| quote! { out[#c] += #v; });
+        let stores = cols
+            .iter()
+            .zip(b.outputs)
+            .map(|(c, v)| quote! { out[#c] += #v; });
         let k = Literal::usize_unsuffixed(k);
         arms.push(quote! { #k => { #(#lets)* #(#stores)* } });
     }
@@ -63,7 +66,10 @@ pub fn vessels(arena: &Arena, lay: &Layout, private: &TokenStream) -> TokenStrea
         let leaf = |s: Sym| lay.leaf(s);
         let b = emit_block(arena, &roots, &leaf, private);
         let (lets, outs) = (b.lets, b.outputs);
-        let (s, a) = (Literal::usize_unsuffixed(scalar_before), Literal::usize_unsuffixed(arrays_before));
+        let (s, a) = (
+            Literal::usize_unsuffixed(scalar_before),
+            Literal::usize_unsuffixed(arrays_before),
+        );
         code.extend(if v.array {
             quote! {
                 for j in 0..n {
@@ -86,13 +92,26 @@ pub fn vessels(arena: &Arena, lay: &Layout, private: &TokenStream) -> TokenStrea
 }
 
 fn terms(v: &VesselTerms) -> Vec<Id> {
-    vec![v.pressure, v.volume, v.energy, v.heat, v.boundary, v.mass, v.temperature]
+    vec![
+        v.pressure,
+        v.volume,
+        v.energy,
+        v.heat,
+        v.boundary,
+        v.mass,
+        v.temperature,
+    ]
 }
 
 /// `[mechanical energy, mechanical power]`.
 pub fn mech(arena: &Arena, lay: &Layout, private: &TokenStream) -> TokenStream {
     let leaf = |s: Sym| lay.leaf(s);
-    let b = emit_block(arena, &[lay.sys.mech_energy, lay.sys.mech_power], &leaf, private);
+    let b = emit_block(
+        arena,
+        &[lay.sys.mech_energy, lay.sys.mech_power],
+        &leaf,
+        private,
+    );
     let (lets, outs) = (b.lets, b.outputs);
     quote! { #(#lets)* [#(#outs),*] }
 }

@@ -26,24 +26,58 @@ pub struct Block {
 
 /// Emit `roots` as one block; `leaf` prints each symbol. `private` is the path of the
 /// runtime helpers (`::stirling_dsl::__private`).
-pub fn emit_block(arena: &Arena, roots: &[Id], leaf: &dyn Fn(Sym) -> TokenStream, private: &TokenStream) -> Block {
+pub fn emit_block(
+    arena: &Arena,
+    roots: &[Id],
+    leaf: &dyn Fn(Sym) -> TokenStream,
+    private: &TokenStream,
+) -> Block {
     let uses = count_uses(arena, roots);
     let mut names: Vec<Option<Ident>> = vec![None; arena.len()];
     let mut taken = std::collections::HashSet::new();
     let mut lets = Vec::new();
-    let em = Emitter { arena, leaf, private };
+    let em = Emitter {
+        arena,
+        leaf,
+        private,
+    };
+    let preferred = preferred_names(arena, &uses);
     for i in 0..arena.len() {
         let id = Id(i as u32);
         if uses[i] == 0 || !needs_let(arena, id, uses[i]) {
             continue;
         }
-        let name = fresh(temp_name(arena, id, lets.len()), &mut taken);
+        // a named quantity whose value already has a `let` is that `let`
+        if let Node::Named(_, inner) = *arena.node(id) {
+            if let Some(n) = names[inner.index()].clone() {
+                names[i] = Some(n);
+                continue;
+            }
+        }
+        let base = preferred[i]
+            .clone()
+            .unwrap_or_else(|| temp_name(arena, id, lets.len()));
+        let name = fresh(base, &mut taken);
         let value = em.go(inner(arena, id), &names).0;
         lets.push(quote! { let #name = #value; });
         names[i] = Some(name);
     }
     let outputs = roots.iter().map(|&r| em.go(r, &names).0).collect();
     Block { lets, outputs }
+}
+
+/// The name of the quantity a shared node is the value of, so that its `let` reads
+/// `let T_hot = ...` rather than `let t2 = ...; let T_hot = t2;`.
+fn preferred_names(arena: &Arena, uses: &[u32]) -> Vec<Option<String>> {
+    let mut out = vec![None; arena.len()];
+    for i in 0..arena.len() {
+        if let Node::Named(n, inner) = *arena.node(Id(i as u32)) {
+            if uses[i] > 0 && out[inner.index()].is_none() {
+                out[inner.index()] = Some(sanitize(arena.name(n)));
+            }
+        }
+    }
+    out
 }
 
 fn inner(arena: &Arena, id: Id) -> Id {
@@ -88,7 +122,9 @@ fn temp_name(arena: &Arena, id: Id, k: usize) -> String {
 }
 
 fn sanitize(name: &str) -> String {
-    name.chars().map(|c| if c.is_ascii_alphanumeric() { c } else { '_' }).collect()
+    name.chars()
+        .map(|c| if c.is_ascii_alphanumeric() { c } else { '_' })
+        .collect()
 }
 
 fn fresh(base: String, taken: &mut std::collections::HashSet<String>) -> Ident {
@@ -167,7 +203,11 @@ fn number(v: f64) -> (TokenStream, u8) {
         return (quote!(f64::NAN), P_ATOM);
     }
     if v.is_infinite() {
-        return if v > 0.0 { (quote!(f64::INFINITY), P_ATOM) } else { (quote!(f64::NEG_INFINITY), P_ATOM) };
+        return if v > 0.0 {
+            (quote!(f64::INFINITY), P_ATOM)
+        } else {
+            (quote!(f64::NEG_INFINITY), P_ATOM)
+        };
     }
     let lit = Literal::f64_unsuffixed(v.abs());
     if v < 0.0 {

@@ -29,7 +29,11 @@ pub struct Printer<'a> {
 impl<'a> Printer<'a> {
     /// A printer; `namer` gives each symbol's display name (plain text; LaTeX is derived).
     pub fn new(arena: &'a Arena, style: Style, namer: &'a dyn Fn(Sym) -> String) -> Self {
-        Self { arena, style, namer }
+        Self {
+            arena,
+            style,
+            namer,
+        }
     }
 
     /// One expression; named subexpressions appear by name.
@@ -80,8 +84,14 @@ impl<'a> Printer<'a> {
             Node::Named(n, _) => (self.ident(a.name(n)), P_ATOM),
             Node::Const(bits) => self.number(f64::from_bits(bits)),
             Node::Sym(s) => (self.ident(&(self.namer)(s)), P_ATOM),
-            Node::Add(x, y) => (format!("{} + {}", self.wrap(x, P_ADD), self.wrap(y, P_ADD)), P_ADD),
-            Node::Sub(x, y) => (format!("{} - {}", self.wrap(x, P_ADD), self.wrap(y, P_MUL)), P_ADD),
+            Node::Add(x, y) => (
+                format!("{} + {}", self.wrap(x, P_ADD), self.wrap(y, P_ADD)),
+                P_ADD,
+            ),
+            Node::Sub(x, y) => (
+                format!("{} - {}", self.wrap(x, P_ADD), self.wrap(y, P_MUL)),
+                P_ADD,
+            ),
             Node::Mul(x, y) => (self.product(x, y), P_MUL),
             Node::Div(x, y) => (self.quotient(x, y), self.div_prec()),
             Node::Neg(x) => (format!("-{}", self.wrap(x, P_MUL)), P_NEG),
@@ -105,7 +115,14 @@ impl<'a> Printer<'a> {
 
     fn number(&self, v: f64) -> (String, u8) {
         if v == std::f64::consts::PI {
-            return (if self.style == Style::Latex { "\\pi".into() } else { "pi".into() }, P_ATOM);
+            return (
+                if self.style == Style::Latex {
+                    "\\pi".into()
+                } else {
+                    "pi".into()
+                },
+                P_ATOM,
+            );
         }
         let s = format_number(v);
         let p = if v < 0.0 { P_NEG } else { P_ATOM };
@@ -119,7 +136,11 @@ impl<'a> Printer<'a> {
     }
 
     fn product(&self, x: Id, y: Id) -> String {
-        let op = if self.style == Style::Text { " * " } else { " \\, " };
+        let op = if self.style == Style::Text {
+            " * "
+        } else {
+            " \\, "
+        };
         format!("{}{op}{}", self.wrap(x, P_MUL), self.wrap(y, P_MUL + 1))
     }
 
@@ -188,8 +209,8 @@ pub fn format_number(v: f64) -> String {
 }
 
 const GREEK: &[&str] = &[
-    "alpha", "beta", "gamma", "delta", "epsilon", "eta", "theta", "kappa", "lambda", "mu", "nu", "rho",
-    "sigma", "tau", "phi", "omega",
+    "alpha", "beta", "gamma", "delta", "epsilon", "eta", "theta", "kappa", "lambda", "mu", "nu",
+    "rho", "sigma", "tau", "phi", "omega",
 ];
 
 /// `P_hot` -> `P_{\mathrm{hot}}`, `gamma` -> `\gamma`, `mdot_eps` -> `\dot{m}_{\mathrm{eps}}`.

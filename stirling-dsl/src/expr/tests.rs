@@ -128,12 +128,16 @@ fn check_diff(name: &str, build: impl Fn(&mut Arena, Id, Id) -> Id, points: &[(f
             let analytic = eval_at(&a, d, px, py);
             let fd = |s: f64| {
                 let (hx, hy) = (h.0 * s, h.1 * s);
-                (eval_at(&a, e, px + hx, py + hy) - eval_at(&a, e, px - hx, py - hy)) / (2.0 * s * 1e-4)
+                (eval_at(&a, e, px + hx, py + hy) - eval_at(&a, e, px - hx, py - hy))
+                    / (2.0 * s * 1e-4)
             };
             // one Richardson step: error O(h^4)
             let numeric = (4.0 * fd(0.5) - fd(1.0)) / 3.0;
             let err = (analytic - numeric).abs() / analytic.abs().max(1.0);
-            assert!(err < 1e-9, "d/d{which} {name} at ({px}, {py}): analytic {analytic}, fd {numeric}");
+            assert!(
+                err < 1e-9,
+                "d/d{which} {name} at ({px}, {py}): analytic {analytic}, fd {numeric}"
+            );
         }
     }
 }
@@ -145,27 +149,51 @@ const POSITIVE: &[(f64, f64)] = &[(0.7, 1.3), (1.9, 0.4), (3.1, 2.2)];
 fn diff_of_arithmetic() {
     check_diff("x + y", |a, x, y| a.add(x, y), POINTS);
     check_diff("x - y", |a, x, y| a.sub(x, y), POINTS);
-    check_diff("-x y", |a, x, y| {
-        let m = a.mul(x, y);
-        a.neg(m)
-    }, POINTS);
+    check_diff(
+        "-x y",
+        |a, x, y| {
+            let m = a.mul(x, y);
+            a.neg(m)
+        },
+        POINTS,
+    );
     check_diff("x * y", |a, x, y| a.mul(x, y), POINTS);
     check_diff("x / y", |a, x, y| a.div(x, y), POINTS);
-    check_diff("x^3 y^-2", |a, x, y| {
-        let (p, q) = (a.powi(x, 3), a.powi(y, -2));
-        a.mul(p, q)
-    }, POINTS);
+    check_diff(
+        "x^3 y^-2",
+        |a, x, y| {
+            let (p, q) = (a.powi(x, 3), a.powi(y, -2));
+            a.mul(p, q)
+        },
+        POINTS,
+    );
     check_diff("x^y", |a, x, y| a.powf(x, y), POSITIVE);
 }
 
 #[test]
 fn diff_of_functions() {
-    for f in [Func::Sqrt, Func::Ln, Func::Exp, Func::Tanh, Func::Abs, Func::Sin, Func::Cos] {
-        let pts = if matches!(f, Func::Sqrt | Func::Ln) { POSITIVE } else { POINTS };
-        check_diff(f.name(), |a, x, y| {
-            let xy = a.mul(x, y);
-            a.func(f, xy)
-        }, pts);
+    for f in [
+        Func::Sqrt,
+        Func::Ln,
+        Func::Exp,
+        Func::Tanh,
+        Func::Abs,
+        Func::Sin,
+        Func::Cos,
+    ] {
+        let pts = if matches!(f, Func::Sqrt | Func::Ln) {
+            POSITIVE
+        } else {
+            POINTS
+        };
+        check_diff(
+            f.name(),
+            |a, x, y| {
+                let xy = a.mul(x, y);
+                a.func(f, xy)
+            },
+            pts,
+        );
     }
     // sign is piecewise constant: derivative 0 away from 0
     let mut a = Arena::new();
@@ -178,17 +206,21 @@ fn diff_of_functions() {
 #[test]
 fn diff_of_the_upwind_enthalpy() {
     // H = mdot (y + (1 + tanh(mdot / 0.01)) / 2 (1 - y)), the link law of PHYSICS.md 4
-    check_diff("enthalpy", |a, x, y| {
-        let (one, half, eps) = (a.num(1.0), a.num(0.5), a.num(0.01));
-        let r = a.div(x, eps);
-        let t = a.func(Func::Tanh, r);
-        let o = a.add(one, t);
-        let s = a.mul(half, o);
-        let d = a.sub(one, y);
-        let sd = a.mul(s, d);
-        let up = a.add(y, sd);
-        a.mul(x, up)
-    }, &[(0.003, 1.3), (-0.004, 0.4), (0.0, 2.0)]);
+    check_diff(
+        "enthalpy",
+        |a, x, y| {
+            let (one, half, eps) = (a.num(1.0), a.num(0.5), a.num(0.01));
+            let r = a.div(x, eps);
+            let t = a.func(Func::Tanh, r);
+            let o = a.add(one, t);
+            let s = a.mul(half, o);
+            let d = a.sub(one, y);
+            let sd = a.mul(s, d);
+            let up = a.add(y, sd);
+            a.mul(x, up)
+        },
+        &[(0.003, 1.3), (-0.004, 0.4), (0.0, 2.0)],
+    );
 }
 
 #[test]
@@ -254,7 +286,10 @@ fn prints_latex() {
     let (x, y) = xy(&mut a);
     let q = a.div(x, y);
     let r = a.func(Func::Sqrt, q);
-    assert_eq!(Printer::new(&a, Style::Latex, &namer).expr(r), "\\sqrt{\\frac{x}{y}}");
+    assert_eq!(
+        Printer::new(&a, Style::Latex, &namer).expr(r),
+        "\\sqrt{\\frac{x}{y}}"
+    );
 }
 
 #[test]
@@ -269,7 +304,13 @@ fn prints_definitions_inner_first() {
     let e = a.mul(w, v);
     let p = Printer::new(&a, Style::Text, &namer);
     assert_eq!(p.expr(e), "W * V");
-    assert_eq!(p.definitions(&[e]), vec![("V".to_string(), "x + y".to_string()), ("W".to_string(), "2 * V".to_string())]);
+    assert_eq!(
+        p.definitions(&[e]),
+        vec![
+            ("V".to_string(), "x + y".to_string()),
+            ("W".to_string(), "2 * V".to_string())
+        ]
+    );
 }
 
 // ---- emission ------------------------------------------------------------------------
@@ -283,7 +324,10 @@ fn leaf(s: Sym) -> TokenStream {
 }
 
 fn compact(t: &TokenStream) -> String {
-    t.to_string().split_whitespace().collect::<Vec<_>>().join(" ")
+    t.to_string()
+        .split_whitespace()
+        .collect::<Vec<_>>()
+        .join(" ")
 }
 
 #[test]
@@ -300,7 +344,10 @@ fn emits_an_expression_with_shared_temporaries() {
     let lets: Vec<String> = block.lets.iter().map(compact).collect();
     assert_eq!(lets, vec!["let t0 = x [0] + x [1] ;"]);
     assert_eq!(compact(&block.outputs[0]), "t0 . sin () / (2.0 * t0)");
-    assert_eq!(compact(&block.outputs[1]), "crate :: __private :: sign (x [0])");
+    assert_eq!(
+        compact(&block.outputs[1]),
+        "crate :: __private :: sign (x [0])"
+    );
 }
 
 #[test]

@@ -16,21 +16,38 @@ pub fn to_dot(t: &TopologyInfo) -> String {
     let _ = writeln!(s, "digraph \"{}\" {{", t.name);
     let _ = writeln!(s, "  rankdir=LR;\n  node [fontname=\"Helvetica\"];");
     for b in t.bodies {
-        let _ = writeln!(s, "  \"body:{b}\" [shape=box, style=bold, label=\"I: {b}\"];");
+        let _ = writeln!(
+            s,
+            "  \"body:{b}\" [shape=box, style=bold, label=\"I: {b}\"];"
+        );
     }
     for (a, b) in t.couplings {
         let _ = writeln!(s, "  \"R:{a}-{b}\" [shape=plaintext, label=\"R: damper\"];");
-        let _ = writeln!(s, "  \"body:{a}\" -> \"R:{a}-{b}\" -> \"body:{b}\" [arrowhead=halfopen];");
+        let _ = writeln!(
+            s,
+            "  \"body:{a}\" -> \"R:{a}-{b}\" -> \"body:{b}\" [arrowhead=halfopen];"
+        );
     }
     for v in t.vessels {
         vessel(&mut s, v);
     }
     for l in t.links {
         let id = format!("R:{}->{}", l.from, l.to);
-        let label = if l.chain { format!("R: {} (each j)", l.resistance) } else { format!("R: {}", l.resistance) };
-        let _ = writeln!(s, "  \"{id}\" [shape=plaintext, label=\"{}\"];", esc(&label));
+        let label = if l.chain {
+            format!("R: {} (each j)", l.resistance)
+        } else {
+            format!("R: {}", l.resistance)
+        };
+        let _ = writeln!(
+            s,
+            "  \"{id}\" [shape=plaintext, label=\"{}\"];",
+            esc(&label)
+        );
         let (from, to) = (base(l.from), base(l.to));
-        let _ = writeln!(s, "  \"gas:{from}\" -> \"{id}\" -> \"gas:{to}\" [arrowhead=halfopen, label=\"mdot, H\"];");
+        let _ = writeln!(
+            s,
+            "  \"gas:{from}\" -> \"{id}\" -> \"gas:{to}\" [arrowhead=halfopen, label=\"mdot, H\"];"
+        );
     }
     s.push_str("}\n");
     s
@@ -38,18 +55,43 @@ pub fn to_dot(t: &TopologyInfo) -> String {
 
 fn vessel(s: &mut String, v: &super::topology_info::VesselInfo) {
     let kind = if v.is_cv { "C" } else { "Se" };
-    let label = if v.array { format!("{kind}: {}[j], j < n", v.name) } else { format!("{kind}: {}", v.name) };
+    let label = if v.array {
+        format!("{kind}: {}[j], j < n", v.name)
+    } else {
+        format!("{kind}: {}", v.name)
+    };
     let shape = if v.is_cv { "ellipse" } else { "box" };
-    let _ = writeln!(s, "  \"gas:{}\" [shape={shape}, label=\"{}\"];", v.name, esc(&label));
+    let _ = writeln!(
+        s,
+        "  \"gas:{}\" [shape={shape}, label=\"{}\"];",
+        v.name,
+        esc(&label)
+    );
     for f in v.faces {
         let id = format!("TF:{}-{}", v.name, f.body);
-        let _ = writeln!(s, "  \"{id}\" [shape=plaintext, label=\"TF: {}\"];", esc(f.coeff));
-        let _ = writeln!(s, "  \"gas:{}\" -> \"{id}\" -> \"body:{}\" [arrowhead=halfopen, label=\"P, dV/dt\"];", v.name, f.body);
+        let _ = writeln!(
+            s,
+            "  \"{id}\" [shape=plaintext, label=\"TF: {}\"];",
+            esc(f.coeff)
+        );
+        let _ = writeln!(
+            s,
+            "  \"gas:{}\" -> \"{id}\" -> \"body:{}\" [arrowhead=halfopen, label=\"P, dV/dt\"];",
+            v.name, f.body
+        );
     }
     for p in v.ports {
         let id = format!("Se:{}.{}", v.name, p.name);
-        let _ = writeln!(s, "  \"{id}\" [shape=plaintext, label=\"Se: Tw = {}\"];", esc(p.wall));
-        let _ = writeln!(s, "  \"{id}\" -> \"gas:{}\" [arrowhead=halfopen, label=\"Q: {}\"];", v.name, p.name);
+        let _ = writeln!(
+            s,
+            "  \"{id}\" [shape=plaintext, label=\"Se: Tw = {}\"];",
+            esc(p.wall)
+        );
+        let _ = writeln!(
+            s,
+            "  \"{id}\" -> \"gas:{}\" [arrowhead=halfopen, label=\"Q: {}\"];",
+            v.name, p.name
+        );
     }
 }
 

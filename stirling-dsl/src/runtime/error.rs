@@ -5,5 +5,9 @@
 pub enum ModelError {
     /// `n` out of range.
     #[error("model `{model}`: n = {n} is not allowed ({why})")]
-    Sections { model: &'static str, n: usize, why: &'static str },
+    Sections {
+        model: &'static str,
+        n: usize,
+        why: &'static str,
+    },
 }

@@ -147,7 +147,15 @@ pub trait Model: Send + Sync {
     fn jacobian_dense(&self, p: &[f64], x: &[f64], t: f64) -> Vec<f64> {
         let n = self.n_states();
         let mut data = vec![0.0; n * n];
-        self.jacobian(p, x, t, &mut JacSink::Dense { data: &mut data, nrows: n });
+        self.jacobian(
+            p,
+            x,
+            t,
+            &mut JacSink::Dense {
+                data: &mut data,
+                nrows: n,
+            },
+        );
         data
     }
     /// Jacobian as coordinate triplets (entries at one position are to be summed).
@@ -160,7 +168,11 @@ pub trait Model: Send + Sync {
     fn sparsity(&self, p: &[f64]) -> Vec<(usize, usize)> {
         let mut x = vec![0.0; self.n_states()];
         self.equilibrium_guess(p, &mut x);
-        let mut rc: Vec<(usize, usize)> = self.jacobian_triplets(p, &x, 0.0).into_iter().map(|(r, c, _)| (r, c)).collect();
+        let mut rc: Vec<(usize, usize)> = self
+            .jacobian_triplets(p, &x, 0.0)
+            .into_iter()
+            .map(|(r, c, _)| (r, c))
+            .collect();
         rc.sort_unstable();
         rc.dedup();
         rc
@@ -169,7 +181,15 @@ pub trait Model: Send + Sync {
     fn param_jacobian_dense(&self, p: &[f64], x: &[f64], t: f64) -> Vec<f64> {
         let n = self.n_states();
         let mut data = vec![0.0; n * self.params().len()];
-        self.param_jacobian(p, x, t, &mut JacSink::Dense { data: &mut data, nrows: n });
+        self.param_jacobian(
+            p,
+            x,
+            t,
+            &mut JacSink::Dense {
+                data: &mut data,
+                nrows: n,
+            },
+        );
         data
     }
 }

@@ -56,7 +56,12 @@ impl<'t> Assembler<'t> {
             array_blocks[2 * nb + i] = c.array;
             array_blocks[2 * nb + ncv + i] = c.array;
         }
-        Self { t, closure, array_blocks, cv: Vec::new() }
+        Self {
+            t,
+            closure,
+            array_blocks,
+            cv: Vec::new(),
+        }
     }
 
     fn p_block(&self, i: usize) -> u32 {
@@ -97,27 +102,58 @@ impl<'t> Assembler<'t> {
         let rows = blocks.iter().map(|b| self.row(b)).collect();
         let init = blocks.iter().map(|b| self.init_row(b)).collect();
         let forces = (0..self.t.bodies.len()).map(|k| self.force(k)).collect();
-        let mut vessels: Vec<VesselTerms> = (0..self.t.cvs.len()).map(|i| self.cv_terms(i)).collect();
+        let mut vessels: Vec<VesselTerms> =
+            (0..self.t.cvs.len()).map(|i| self.cv_terms(i)).collect();
         vessels.extend((0..self.t.spaces.len()).map(|s| self.space_terms(s)));
         let (mech_energy, mech_power) = (self.mech_energy(), self.mech_power());
         let array_blocks = self.array_blocks.clone();
-        System { closure: self.closure, blocks, rows, init, forces, vessels, mech_energy, mech_power, array_blocks }
+        System {
+            closure: self.closure,
+            blocks,
+            rows,
+            init,
+            forces,
+            vessels,
+            mech_energy,
+            mech_power,
+            array_blocks,
+        }
     }
 
     fn blocks(&self) -> Vec<BlockInfo> {
         let mut out = Vec::new();
         for (k, b) in self.t.bodies.iter().enumerate() {
-            out.push(BlockInfo { sym: Topology::pos_block(k), name: b.pos.clone(), array: false, kind: BlockKind::Position(k) });
-            out.push(BlockInfo { sym: Topology::vel_block(k), name: b.vel.clone(), array: false, kind: BlockKind::Velocity(k) });
+            out.push(BlockInfo {
+                sym: Topology::pos_block(k),
+                name: b.pos.clone(),
+                array: false,
+                kind: BlockKind::Position(k),
+            });
+            out.push(BlockInfo {
+                sym: Topology::vel_block(k),
+                name: b.vel.clone(),
+                array: false,
+                kind: BlockKind::Velocity(k),
+            });
         }
         for (i, c) in self.t.cvs.iter().enumerate() {
             let name = format!("P_{}", c.name);
-            out.push(BlockInfo { sym: self.p_block(i), name, array: c.array, kind: BlockKind::Pressure(i) });
+            out.push(BlockInfo {
+                sym: self.p_block(i),
+                name,
+                array: c.array,
+                kind: BlockKind::Pressure(i),
+            });
         }
         for (i, c) in self.t.cvs.iter().enumerate() {
             if self.has_mass_state(i) {
                 let name = format!("m_{}", c.name);
-                out.push(BlockInfo { sym: self.m_block(i), name, array: c.array, kind: BlockKind::Mass(i) });
+                out.push(BlockInfo {
+                    sym: self.m_block(i),
+                    name,
+                    array: c.array,
+                    kind: BlockKind::Mass(i),
+                });
             }
         }
         out
@@ -126,7 +162,10 @@ impl<'t> Assembler<'t> {
     /// Position and velocity symbols of body `k`.
     fn body_syms(&mut self, k: usize) -> (Id, Id) {
         let a = &mut self.t.arena;
-        (a.sym(Sym::State(Topology::pos_block(k), At::Scalar)), a.sym(Sym::State(Topology::vel_block(k), At::Scalar)))
+        (
+            a.sym(Sym::State(Topology::pos_block(k), At::Scalar)),
+            a.sym(Sym::State(Topology::vel_block(k), At::Scalar)),
+        )
     }
 
     /// `sum coeff * q` and `sum coeff * v` over faces.
@@ -144,7 +183,9 @@ impl<'t> Assembler<'t> {
 
     /// Every state symbol set to zero: the rest position of section 6.
     fn at_rest(&mut self, id: Id) -> Id {
-        self.t.arena.subst(id, &mut |a, s| matches!(s, Sym::State(..)).then(|| a.num(0.0)))
+        self.t.arena.subst(id, &mut |a, s| {
+            matches!(s, Sym::State(..)).then(|| a.num(0.0))
+        })
     }
 
     fn cv_template(&mut self, i: usize) -> CvTemplate {
@@ -152,25 +193,46 @@ impl<'t> Assembler<'t> {
         let own = self.own(i);
         let (dv, vdot_raw) = self.face_sums(&c.faces);
         let v_raw = self.t.arena.add(c.volume, dv);
-        let (vl, vdl, tl, ql, m0l) =
-            (self.label(i, "V"), self.label(i, "Vdot"), self.label(i, "T"), self.label(i, "Q"), self.label(i, "m0"));
+        let (vl, vdl, tl, ql, m0l) = (
+            self.label(i, "V"),
+            self.label(i, "Vdot"),
+            self.label(i, "T"),
+            self.label(i, "Q"),
+            self.label(i, "m0"),
+        );
         let m0_raw = self.rest_mass(i, v_raw);
         let (pb, mb) = (self.p_block(i), self.m_block(i));
         let has_m = self.has_mass_state(i);
-        let gas = self.t.gas.clone().expect("checked: a model with CVs declares its gas");
+        let gas = self
+            .t
+            .gas
+            .clone()
+            .expect("checked: a model with CVs declares its gas");
         let a = &mut self.t.arena;
         let v = a.named(&vl, v_raw);
         let vdot = a.named(&vdl, vdot_raw);
         let m0 = a.named(&m0l, m0_raw);
         let p = a.sym(Sym::State(pb, own));
-        let m = if has_m { a.sym(Sym::State(mb, own)) } else { m0 };
+        let m = if has_m {
+            a.sym(Sym::State(mb, own))
+        } else {
+            m0
+        };
         let pv = a.mul(p, v);
         let mr = a.mul(m, gas.r);
         let t_raw = a.div(pv, mr);
         let t = a.named(&tl, t_raw);
         let q_raw = self.heat(&c.ports, t);
         let q = self.t.arena.named(&ql, q_raw);
-        CvTemplate { p, m, v, vdot, t, q, m0 }
+        CvTemplate {
+            p,
+            m,
+            v,
+            vdot,
+            t,
+            q,
+            m0,
+        }
     }
 
     /// `sum h A (Tw - T)`.
@@ -189,7 +251,11 @@ impl<'t> Assembler<'t> {
     /// `m_i0 = Pcharge V_i0 / (R T_i0)`, `T_i0 = sum h Aw Tw / sum h Aw` at rest.
     fn rest_mass(&mut self, i: usize, volume: Id) -> Id {
         let ports = self.t.cvs[i].ports.clone();
-        let gas = self.t.gas.clone().expect("checked: a model with CVs declares its gas");
+        let gas = self
+            .t
+            .gas
+            .clone()
+            .expect("checked: a model with CVs declares its gas");
         let (mut num, mut den) = (self.t.arena.num(0.0), self.t.arena.num(0.0));
         for port in &ports {
             let a = &mut self.t.arena;
@@ -303,7 +369,13 @@ impl<'t> Assembler<'t> {
         let gas = self.t.gas.clone().expect("checked");
         let a = &mut self.t.arena;
         let signed = |a: &mut crate::expr::Arena, start: Id, pick: &dyn Fn(&Flow) -> Id| {
-            flows.iter().fold(start, |acc, f| if f.into { a.add(acc, pick(f)) } else { a.sub(acc, pick(f)) })
+            flows.iter().fold(start, |acc, f| {
+                if f.into {
+                    a.add(acc, pick(f))
+                } else {
+                    a.sub(acc, pick(f))
+                }
+            })
         };
         if !want_p {
             let zero = a.num(0.0);
@@ -340,11 +412,15 @@ impl<'t> Assembler<'t> {
     fn flow(&mut self, l: &LinkDecl, row: RowAt, base: i32, into: bool) -> Flow {
         let (p_from, t_from, from_name) = self.end_state(l.from.vessel, l.from.at, row, base);
         let (p_to, t_to, to_name) = self.end_state(l.to.vessel, l.to.at, row, base);
-        let shift = if l.is_chain() { Place::Shift(-base) } else { Place::Own };
+        let shift = if l.is_chain() {
+            Place::Shift(-base)
+        } else {
+            Place::Own
+        };
         let r = self.placed(l.resistance, shift);
         let rq = l.quadratic.map(|q| self.placed(q, shift));
         let g = l.conductance.map(|g| self.placed(g, shift));
-        let name = if l.is_chain() { chain_name(&from_name, base) } else { format!("{from_name}_{to_name}") };
+        let name = format!("{from_name}_{to_name}");
         let gas = self.t.gas.clone().expect("checked");
         let a = &mut self.t.arena;
         let dp = a.sub(p_from, p_to);
@@ -364,14 +440,28 @@ impl<'t> Assembler<'t> {
         match vessel {
             Vessel::Space(s) => {
                 let sp = &self.t.spaces[s];
-                (sp.pressure, sp.temperature.expect("checked: a linked space has a temperature"), sp.name.clone())
+                (
+                    sp.pressure,
+                    sp.temperature
+                        .expect("checked: a linked space has a temperature"),
+                    sp.name.clone(),
+                )
             }
             Vessel::Cv(c) => {
                 let pl = end_place(c, at, row, base);
                 let tpl = self.cv[c];
                 let (p, t) = (self.placed(tpl.p, pl), self.placed(tpl.t, pl));
-                let at_shown = if pl == Place::Own && self.t.cvs[c].array { At::Rel(0) } else { at };
-                (p, t, end_name(&self.t.cvs[c].name, self.t.cvs[c].array, at_shown))
+                let shown = match pl {
+                    Place::Own => At::Rel(0),
+                    Place::Shift(k) => At::Rel(k),
+                    Place::First => At::First,
+                    Place::Last => At::Last,
+                };
+                (
+                    p,
+                    t,
+                    end_name(&self.t.cvs[c].name, self.t.cvs[c].array, shown),
+                )
             }
         }
     }
@@ -496,7 +586,9 @@ struct Flow {
 fn touches(at: At, row: RowAt, l: &LinkDecl) -> Option<i32> {
     match (at, row) {
         (At::Scalar, RowAt::Scalar) => Some(0),
-        (At::First, RowAt::Array(_, v)) => matches!(v, Variant::Single | Variant::First).then_some(0),
+        (At::First, RowAt::Array(_, v)) => {
+            matches!(v, Variant::Single | Variant::First).then_some(0)
+        }
         (At::Last, RowAt::Array(_, v)) => matches!(v, Variant::Single | Variant::Last).then_some(0),
         (At::Rel(r), RowAt::Array(_, v)) => {
             let upper = r > rel_min(l);
@@ -545,11 +637,6 @@ fn end_name(name: &str, array: bool, at: At) -> String {
     }
 }
 
-/// `mdot_regen[j]` is the chain flow from section `j` to `j+1`; seen from the upper section it is `[j-1]`.
-fn chain_name(array: &str, base: i32) -> String {
-    format!("{array}[{}]", super::frame::index_text(-base))
-}
-
 /// `dP = R mdot + Rq mdot |mdot|` solved for `mdot`: `2 dP / (R + sqrt(R^2 + 4 Rq |dP|))`.
 fn quadratic_flow(a: &mut crate::expr::Arena, dp: Id, r: Id, rq: Id) -> Id {
     let (two, four) = (a.num(2.0), a.num(4.0));
@@ -565,7 +652,13 @@ fn quadratic_flow(a: &mut crate::expr::Arena, dp: Id, r: Id, rq: Id) -> Id {
 }
 
 /// `H = cp mdot (s T_from + (1 - s) T_to)`, `s = (1 + tanh(mdot/eps))/2`, `cp = gamma R/(gamma-1)`.
-fn enthalpy(a: &mut crate::expr::Arena, mdot: Id, t_from: Id, t_to: Id, gas: &super::decl::GasDecl) -> Id {
+fn enthalpy(
+    a: &mut crate::expr::Arena,
+    mdot: Id,
+    t_from: Id,
+    t_to: Id,
+    gas: &super::decl::GasDecl,
+) -> Id {
     let (one, half) = (a.num(1.0), a.num(0.5));
     let ratio = a.div(mdot, gas.mdot_eps);
     let th = a.func(Func::Tanh, ratio);

@@ -155,7 +155,9 @@ impl Topology {
 
     /// Whether CV `i` takes part in a mass-flow link.
     pub fn cv_is_linked(&self, i: usize) -> bool {
-        self.links.iter().any(|l| l.from.vessel == Vessel::Cv(i) || l.to.vessel == Vessel::Cv(i))
+        self.links
+            .iter()
+            .any(|l| l.from.vessel == Vessel::Cv(i) || l.to.vessel == Vessel::Cv(i))
     }
 
     /// Whether any CV is an array.

@@ -17,7 +17,12 @@ pub enum Variant {
 }
 
 /// All variants, in the order of [`Row::Array`].
-pub const VARIANTS: [Variant; 4] = [Variant::Single, Variant::First, Variant::Interior, Variant::Last];
+pub const VARIANTS: [Variant; 4] = [
+    Variant::Single,
+    Variant::First,
+    Variant::Interior,
+    Variant::Last,
+];
 
 impl Variant {
     /// Human-readable range of sections.

@@ -8,28 +8,63 @@ use super::{DataError, Measured, CHANNELS};
 /// Read a measured record from a file.
 pub fn read_csv(path: &Path) -> Result<Measured, DataError> {
     let file = path.display().to_string();
-    let text = std::fs::read_to_string(path)
-        .map_err(|e| DataError { file: file.clone(), row: 0, column: String::new(), message: format!("cannot read the file: {e}") })?;
+    let text = std::fs::read_to_string(path).map_err(|e| DataError {
+        file: file.clone(),
+        row: 0,
+        column: String::new(),
+        message: format!("cannot read the file: {e}"),
+    })?;
     parse_csv(&file, &text)
 }
 
 /// Parse a measured record; `file` labels the errors.
 pub fn parse_csv(file: &str, text: &str) -> Result<Measured, DataError> {
-    let err = |row: usize, column: &str, message: String| DataError { file: file.to_string(), row, column: column.to_string(), message };
-    let mut lines = text.lines().enumerate().map(|(i, l)| (i + 1, l.trim())).filter(|(_, l)| !l.is_empty() && !l.starts_with('#'));
-    let Some((hrow, header)) = lines.next() else {
-        return Err(err(1, "t", "the file is empty: expected a header line with `t` and at least one of p, p_hot, x, y".into()));
+    let err = |row: usize, column: &str, message: String| DataError {
+        file: file.to_string(),
+        row,
+        column: column.to_string(),
+        message,
     };
-    let names: Vec<String> = header.split(',').map(|s| s.trim().trim_matches('"').to_string()).collect();
+    let mut lines = text
+        .lines()
+        .enumerate()
+        .map(|(i, l)| (i + 1, l.trim()))
+        .filter(|(_, l)| !l.is_empty() && !l.starts_with('#'));
+    let Some((hrow, header)) = lines.next() else {
+        return Err(err(
+            1,
+            "t",
+            "the file is empty: expected a header line with `t` and at least one of p, p_hot, x, y"
+                .into(),
+        ));
+    };
+    let names: Vec<String> = header
+        .split(',')
+        .map(|s| s.trim().trim_matches('"').to_string())
+        .collect();
     for (i, n) in names.iter().enumerate() {
         if names[..i].contains(n) && (n == "t" || CHANNELS.contains(&n.as_str())) {
-            return Err(err(hrow, n, format!("column `{n}` appears twice in the header")));
+            return Err(err(
+                hrow,
+                n,
+                format!("column `{n}` appears twice in the header"),
+            ));
         }
     }
     let Some(it) = names.iter().position(|n| n == "t") else {
-        return Err(err(hrow, "t", format!("missing column `t` (time in s); the header has: {}", names.join(", "))));
+        return Err(err(
+            hrow,
+            "t",
+            format!(
+                "missing column `t` (time in s); the header has: {}",
+                names.join(", ")
+            ),
+        ));
     };
-    let cols: Vec<(usize, &str)> = CHANNELS.iter().filter_map(|c| names.iter().position(|n| n == c).map(|i| (i, *c))).collect();
+    let cols: Vec<(usize, &str)> = CHANNELS
+        .iter()
+        .filter_map(|c| names.iter().position(|n| n == c).map(|i| (i, *c)))
+        .collect();
     if cols.is_empty() {
         return Err(err(hrow, "p", format!("no measured channel: expected at least one of the columns p, p_hot, x, y; the header has: {}", names.join(", "))));
     }
@@ -40,14 +75,28 @@ pub fn parse_csv(file: &str, text: &str) -> Result<Measured, DataError> {
         let fields: Vec<&str> = line.split(',').map(str::trim).collect();
         let get = |i: usize, name: &str| -> Result<f64, DataError> {
             let Some(s) = fields.get(i) else {
-                return Err(err(row, name, format!("the row has {} fields, the header {}: value of `{name}` missing", fields.len(), names.len())));
+                return Err(err(
+                    row,
+                    name,
+                    format!(
+                        "the row has {} fields, the header {}: value of `{name}` missing",
+                        fields.len(),
+                        names.len()
+                    ),
+                ));
             };
             if s.is_empty() {
                 return Err(err(row, name, "empty value: expected a number".into()));
             }
-            let v: f64 = s.parse().map_err(|_| err(row, name, format!("not a number: `{s}`")))?;
+            let v: f64 = s
+                .parse()
+                .map_err(|_| err(row, name, format!("not a number: `{s}`")))?;
             if !v.is_finite() {
-                return Err(err(row, name, format!("NaN or infinite value `{s}`: expected a finite number")));
+                return Err(err(
+                    row,
+                    name,
+                    format!("NaN or infinite value `{s}`: expected a finite number"),
+                ));
             }
             Ok(v)
         };
@@ -57,7 +106,11 @@ pub fn parse_csv(file: &str, text: &str) -> Result<Measured, DataError> {
                 return Err(err(row, "t", format!("duplicate time {tv} (same as the previous row): time must increase strictly")));
             }
             if tv < prev {
-                return Err(err(row, "t", format!("time goes backwards ({tv} after {prev}): time must increase strictly")));
+                return Err(err(
+                    row,
+                    "t",
+                    format!("time goes backwards ({tv} after {prev}): time must increase strictly"),
+                ));
             }
         }
         t.push(tv);
@@ -70,12 +123,26 @@ pub fn parse_csv(file: &str, text: &str) -> Result<Measured, DataError> {
         return Err(err(hrow + 1, "t", "no data rows after the header".into()));
     }
     if t.len() < 2 {
-        return Err(err(rows[0], "t", "only one data row: a record needs at least two samples".into()));
+        return Err(err(
+            rows[0],
+            "t",
+            "only one data row: a record needs at least two samples".into(),
+        ));
     }
-    let mut m = Measured { source: file.to_string(), t, ..Default::default() };
+    let mut m = Measured {
+        source: file.to_string(),
+        t,
+        ..Default::default()
+    };
     for (k, (_, name)) in cols.iter().enumerate() {
         let v = std::mem::take(&mut data[k]);
-        check_units(name, &v).map_err(|msg| err(rows[0], name, format!("{msg} (rows {}-{})", rows[0], rows[rows.len() - 1])))?;
+        check_units(name, &v).map_err(|msg| {
+            err(
+                rows[0],
+                name,
+                format!("{msg} (rows {}-{})", rows[0], rows[rows.len() - 1]),
+            )
+        })?;
         *match *name {
             "p" => &mut m.p,
             "p_hot" => &mut m.p_hot,

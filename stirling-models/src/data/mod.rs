@@ -30,7 +30,11 @@ pub struct DataError {
 
 impl fmt::Display for DataError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(f, "{}: row {}, column `{}`: {}", self.file, self.row, self.column, self.message)
+        write!(
+            f,
+            "{}: row {}, column `{}`: {}",
+            self.file, self.row, self.column, self.message
+        )
     }
 }
 
@@ -73,7 +77,10 @@ impl Measured {
 
     /// Names of the channels present.
     pub fn channels(&self) -> Vec<&'static str> {
-        CHANNELS.into_iter().filter(|c| self.channel(c).is_some()).collect()
+        CHANNELS
+            .into_iter()
+            .filter(|c| self.channel(c).is_some())
+            .collect()
     }
 
     /// Number of samples.
@@ -97,7 +104,14 @@ impl Measured {
     pub fn slice(&self, a: f64, b: f64) -> Measured {
         let (i0, i1) = self.range(a, b);
         let cut = |c: &Option<Vec<f64>>| c.as_ref().map(|v| v[i0..i1].to_vec());
-        Measured { source: self.source.clone(), t: self.t[i0..i1].to_vec(), p: cut(&self.p), p_hot: cut(&self.p_hot), x: cut(&self.x), y: cut(&self.y) }
+        Measured {
+            source: self.source.clone(),
+            t: self.t[i0..i1].to_vec(),
+            p: cut(&self.p),
+            p_hot: cut(&self.p_hot),
+            x: cut(&self.x),
+            y: cut(&self.y),
+        }
     }
 
     /// Mean sample interval.
@@ -111,19 +125,27 @@ impl Measured {
 
 /// `a:b` as two times (either may be empty: start or end of the record).
 pub fn parse_span(s: &str, rec: &Measured) -> Result<(f64, f64), String> {
-    let (a, b) = s.split_once(':').ok_or_else(|| format!("bad time span `{s}`: expected a:b in seconds, e.g. 0:0.6"))?;
+    let (a, b) = s
+        .split_once(':')
+        .ok_or_else(|| format!("bad time span `{s}`: expected a:b in seconds, e.g. 0:0.6"))?;
     let t0 = rec.t.first().copied().unwrap_or(0.0);
     let t1 = rec.t.last().copied().unwrap_or(0.0);
     let num = |x: &str, d: f64| -> Result<f64, String> {
         if x.trim().is_empty() {
             Ok(d)
         } else {
-            x.trim().parse::<f64>().ok().filter(|v| v.is_finite()).ok_or_else(|| format!("bad time `{x}` in span `{s}`"))
+            x.trim()
+                .parse::<f64>()
+                .ok()
+                .filter(|v| v.is_finite())
+                .ok_or_else(|| format!("bad time `{x}` in span `{s}`"))
         }
     };
     let (a, b) = (num(a, t0)?, num(b, t1)?);
     if !(b > a) {
-        return Err(format!("empty time span `{s}`: the end must be after the start"));
+        return Err(format!(
+            "empty time span `{s}`: the end must be after the start"
+        ));
     }
     Ok((a, b))
 }

@@ -19,8 +19,14 @@ pub fn cycle_mean(v: &[f64]) -> f64 {
     let mut s = v.to_vec();
     s.sort_by(f64::total_cmp);
     let med = s[s.len() / 2];
-    let ups: Vec<usize> = (1..v.len()).filter(|&i| v[i - 1] < med && v[i] >= med).collect();
-    let (a, b) = if ups.len() >= 2 { (ups[0], ups[ups.len() - 1]) } else { (0, v.len()) };
+    let ups: Vec<usize> = (1..v.len())
+        .filter(|&i| v[i - 1] < med && v[i] >= med)
+        .collect();
+    let (a, b) = if ups.len() >= 2 {
+        (ups[0], ups[ups.len() - 1])
+    } else {
+        (0, v.len())
+    };
     v[a..b].iter().sum::<f64>() / (b - a) as f64
 }
 

@@ -55,8 +55,18 @@ impl EffectInfo {
     }
 }
 
-const fn ep(name: &'static str, null: Option<f64>, typical: f64, unit: &'static str) -> EffectParam {
-    EffectParam { name, null, typical, unit }
+const fn ep(
+    name: &'static str,
+    null: Option<f64>,
+    typical: f64,
+    unit: &'static str,
+) -> EffectParam {
+    EffectParam {
+        name,
+        null,
+        typical,
+        unit,
+    }
 }
 
 /// The effect library.
@@ -72,7 +82,11 @@ pub const EFFECTS: &[EffectInfo] = &[
         name: "coulomb",
         summary: "Coulomb friction on both bodies, -Fc tanh(v / v_eps)",
         target: EffectTarget::Model,
-        params: &[ep("Fcd", Some(0.0), 0.3, "N"), ep("Fcp", Some(0.0), 1.0, "N"), ep("v_eps", None, 1.0e-3, "m/s")],
+        params: &[
+            ep("Fcd", Some(0.0), 0.3, "N"),
+            ep("Fcp", Some(0.0), 1.0, "N"),
+            ep("v_eps", None, 1.0e-3, "m/s"),
+        ],
         applies_to: &["cv1", "nsection"],
     },
     EffectInfo {
@@ -86,7 +100,11 @@ pub const EFFECTS: &[EffectInfo] = &[
         name: "end_stops",
         summary: "end stops, -kc relu(|q| - q_max) sign(q) on both bodies",
         target: EffectTarget::Model,
-        params: &[ep("kc", Some(0.0), 2.0e5, "N/m"), ep("xmax", None, 0.01, "m"), ep("ymax", None, 0.01, "m")],
+        params: &[
+            ep("kc", Some(0.0), 2.0e5, "N/m"),
+            ep("xmax", None, 0.01, "m"),
+            ep("ymax", None, 0.01, "m"),
+        ],
         applies_to: &["cv1", "nsection"],
     },
     EffectInfo {
@@ -100,7 +118,10 @@ pub const EFFECTS: &[EffectInfo] = &[
         name: "sensor_gain",
         summary: "position-sensor gain errors, x_meas = (1 + gain_x) x, y_meas = (1 + gain_y) y",
         target: EffectTarget::Sensor,
-        params: &[ep("gain_x", Some(0.0), 0.05, "-"), ep("gain_y", Some(0.0), 0.05, "-")],
+        params: &[
+            ep("gain_x", Some(0.0), 0.05, "-"),
+            ep("gain_y", Some(0.0), 0.05, "-"),
+        ],
         applies_to: &["cv1", "nsection"],
     },
 ];
@@ -111,7 +132,11 @@ pub enum EffectError {
     #[error("unknown effect or effect parameter `{0}`: expected one of {1}")]
     Unknown(String, String),
     #[error("effect `{effect}` does not apply to model `{model}` (it applies to {applies})")]
-    NotApplicable { effect: String, model: String, applies: String },
+    NotApplicable {
+        effect: String,
+        model: String,
+        applies: String,
+    },
     #[error("model `{0}` has no augmented member: effects are declared for cv1 and nsection (aliases order5, order7, order8)")]
     NoAugmented(String),
     #[error("bad effect setting `{0}`: expected NAME=VALUE with a finite number, e.g. leak=2e-8 or Gleak=2e-8")]
@@ -127,13 +152,18 @@ pub fn effect(name: &str) -> Option<&'static EffectInfo> {
 
 /// The effect that owns a parameter.
 pub fn effect_of_param(param: &str) -> Option<(&'static EffectInfo, &'static EffectParam)> {
-    EFFECTS.iter().find_map(|e| e.params.iter().find(|p| p.name == param).map(|p| (e, p)))
+    EFFECTS
+        .iter()
+        .find_map(|e| e.params.iter().find(|p| p.name == param).map(|p| (e, p)))
 }
 
 /// The effects that apply to a base model.
 pub fn effects_for(base: &str) -> Vec<&'static EffectInfo> {
     let base = canonical(base).map(|(b, _)| b).unwrap_or(base);
-    EFFECTS.iter().filter(|e| e.applies_to.contains(&base)).collect()
+    EFFECTS
+        .iter()
+        .filter(|e| e.applies_to.contains(&base))
+        .collect()
 }
 
 /// Canonical base name and the `n` an alias fixes.
@@ -148,7 +178,11 @@ fn canonical(name: &str) -> Option<(&'static str, Option<usize>)> {
 }
 
 /// The augmented model of a base model (`cv1` -> [`Cv1Fx`], `nsection` -> [`NSectionFx`]).
-pub fn augmented(base: &str, n: Option<usize>, closure: Closure) -> Result<Box<dyn Model>, EffectError> {
+pub fn augmented(
+    base: &str,
+    n: Option<usize>,
+    closure: Closure,
+) -> Result<Box<dyn Model>, EffectError> {
     let (b, fixed) = canonical(base).ok_or_else(|| EffectError::NoAugmented(base.to_string()))?;
     // reuse the registry's checks of n and aliases
     crate::registry::build(base, n, closure).map_err(|e| EffectError::Model(e.to_string()))?;
@@ -190,20 +224,40 @@ impl EffectSettings {
         let base_c = canonical(base).map(|(b, _)| b).unwrap_or(base);
         let mut out = EffectSettings::default();
         for s in settings {
-            let (k, v) = s.split_once('=').ok_or_else(|| EffectError::BadSetting(s.clone()))?;
+            let (k, v) = s
+                .split_once('=')
+                .ok_or_else(|| EffectError::BadSetting(s.clone()))?;
             let (k, v) = (k.trim(), v.trim());
-            let v: f64 = v.parse().ok().filter(|v: &f64| v.is_finite()).ok_or_else(|| EffectError::BadSetting(s.clone()))?;
+            let v: f64 = v
+                .parse()
+                .ok()
+                .filter(|v: &f64| v.is_finite())
+                .ok_or_else(|| EffectError::BadSetting(s.clone()))?;
             let (e, p) = match effect(k) {
                 Some(e) => (e, e.strength()),
                 None => effect_of_param(k).ok_or_else(|| {
-                    let names: Vec<String> = EFFECTS.iter().flat_map(|e| std::iter::once(e.name).chain(e.params.iter().map(|p| p.name))).map(String::from).collect();
+                    let names: Vec<String> = EFFECTS
+                        .iter()
+                        .flat_map(|e| {
+                            std::iter::once(e.name).chain(e.params.iter().map(|p| p.name))
+                        })
+                        .map(String::from)
+                        .collect();
                     EffectError::Unknown(k.to_string(), names.join(", "))
                 })?,
             };
             if !e.applies_to.contains(&base_c) {
-                return Err(EffectError::NotApplicable { effect: e.name.into(), model: base.into(), applies: e.applies_to.join(", ") });
+                return Err(EffectError::NotApplicable {
+                    effect: e.name.into(),
+                    model: base.into(),
+                    applies: e.applies_to.join(", "),
+                });
             }
-            let list = if e.target == EffectTarget::Model { &mut out.model } else { &mut out.sensor };
+            let list = if e.target == EffectTarget::Model {
+                &mut out.model
+            } else {
+                &mut out.sensor
+            };
             list.retain(|(n, _)| n != p.name);
             list.push((p.name.to_string(), v));
         }
@@ -212,13 +266,27 @@ impl EffectSettings {
 
     /// A sensor parameter's value (its null when not set).
     pub fn sensor_value(&self, name: &str) -> f64 {
-        self.sensor.iter().find(|(n, _)| n == name).map(|(_, v)| *v).unwrap_or_else(|| effect_of_param(name).and_then(|(_, p)| p.null).unwrap_or(0.0))
+        self.sensor
+            .iter()
+            .find(|(n, _)| n == name)
+            .map(|(_, v)| *v)
+            .unwrap_or_else(|| {
+                effect_of_param(name)
+                    .and_then(|(_, p)| p.null)
+                    .unwrap_or(0.0)
+            })
     }
 
     /// Apply the model settings to a parameter vector of the augmented model.
     pub fn apply(&self, model: &dyn Model, p: &mut [f64]) -> Result<(), EffectError> {
         for (k, v) in &self.model {
-            let i = model.param_index(k).ok_or_else(|| EffectError::NotApplicable { effect: k.clone(), model: model.name().into(), applies: String::new() })?;
+            let i = model
+                .param_index(k)
+                .ok_or_else(|| EffectError::NotApplicable {
+                    effect: k.clone(),
+                    model: model.name().into(),
+                    applies: String::new(),
+                })?;
             p[i] = *v;
         }
         Ok(())

@@ -27,12 +27,23 @@ pub fn savitzky_golay(y: &[f64], dt: f64, h: usize, degree: usize) -> (Vec<f64>,
     let w = 2 * h + 1;
     let deg = degree.min(w - 1);
     // weights for evaluation point at offset `c` from the window start
-    let a = DMatrix::from_fn(w, deg + 1, |i, k| ((i as f64 - h as f64) / h as f64).powi(k as i32));
-    let pinv = (a.transpose() * &a).try_inverse().expect("Vandermonde of distinct points") * a.transpose();
+    let a = DMatrix::from_fn(w, deg + 1, |i, k| {
+        ((i as f64 - h as f64) / h as f64).powi(k as i32)
+    });
+    let pinv = (a.transpose() * &a)
+        .try_inverse()
+        .expect("Vandermonde of distinct points")
+        * a.transpose();
     let weights = |c: usize| -> (DVector<f64>, DVector<f64>) {
         let s = (c as f64 - h as f64) / h as f64;
         let v = DVector::from_fn(deg + 1, |k, _| s.powi(k as i32));
-        let d = DVector::from_fn(deg + 1, |k, _| if k == 0 { 0.0 } else { k as f64 * s.powi(k as i32 - 1) / (h as f64 * dt) });
+        let d = DVector::from_fn(deg + 1, |k, _| {
+            if k == 0 {
+                0.0
+            } else {
+                k as f64 * s.powi(k as i32 - 1) / (h as f64 * dt)
+            }
+        });
         (pinv.transpose() * v, pinv.transpose() * d)
     };
     let mid = weights(h);
@@ -60,7 +71,9 @@ pub fn noise_sigma(y: &[f64]) -> f64 {
     if y.len() < 5 {
         return 0.0;
     }
-    let mut d: Vec<f64> = (0..y.len() - 3).map(|i| (y[i + 3] - 3.0 * y[i + 2] + 3.0 * y[i + 1] - y[i]).abs()).collect();
+    let mut d: Vec<f64> = (0..y.len() - 3)
+        .map(|i| (y[i + 3] - 3.0 * y[i + 2] + 3.0 * y[i + 1] - y[i]).abs())
+        .collect();
     d.sort_by(f64::total_cmp);
     d[d.len() / 2] / 0.6745 / 20f64.sqrt()
 }
@@ -111,6 +124,53 @@ pub struct Stage<'a> {
     pub t0: f64,
     pub dt: f64,
     pub sim: SimOptions,
+    /// Sub-cycle drift projected out of every output's residuals: the cosines
+    /// `cos(pi k (i + 1/2) / N)`, `k = 1..=drift`, on the `N` kept samples (0: none).
+    ///
+    /// Why: noise on a prescribed input is integrated by the driven subsystem (the power
+    /// piston, far below its running frequency, answers a slow force by `F / kp`), so the
+    /// model output carries a slow random wander the data do not have; least squares then
+    /// bends the parameters that set the low-frequency gain (`kp`) to suppress it
+    /// (errors-in-variables bias). Projecting the band below the running frequency out of the
+    /// residuals (and of the Jacobian) removes that band from the criterion; the mean stays
+    /// (carried by the offsets). The projection is exact least squares with `drift` nuisance
+    /// coefficients per output, so the statistics lose `drift` degrees of freedom per output.
+    pub drift: usize,
+}
+
+/// Remove the cosines `k = 1..=m` (DCT-II, orthogonal on the uniform grid) from `v`.
+pub fn project_drift(v: &mut [f64], m: usize) {
+    let n = v.len();
+    if n < 2 {
+        return;
+    }
+    for k in 1..=m.min(n - 1) {
+        let b: Vec<f64> = (0..n)
+            .map(|i| (std::f64::consts::PI * k as f64 * (i as f64 + 0.5) / n as f64).cos())
+            .collect();
+        let c = v.iter().zip(&b).map(|(a, b)| a * b).sum::<f64>() / (n as f64 / 2.0);
+        v.iter_mut().zip(&b).for_each(|(a, b)| *a -= c * b);
+    }
+}
+
+/// Number of cosines of [`project_drift`] below `f_cut` (Hz) on `n` samples of interval `dt`.
+pub fn drift_count(n: usize, dt: f64, f_cut: f64) -> usize {
+    if !(f_cut > 0.0) || n < 2 {
+        return 0;
+    }
+    ((2.0 * n as f64 * dt * f_cut).floor() as usize).min(n / 4)
+}
+
+/// Cycle frequency (Hz) from the upward crossings of the mean (`None`: fewer than 2 cycles).
+pub fn cycle_frequency(y: &[f64], dt: f64) -> Option<f64> {
+    let m = y.iter().sum::<f64>() / y.len().max(1) as f64;
+    let ups: Vec<usize> = (1..y.len())
+        .filter(|&i| y[i - 1] < m && y[i] >= m)
+        .collect();
+    if ups.len() < 3 {
+        return None;
+    }
+    Some((ups.len() - 1) as f64 / ((ups[ups.len() - 1] - ups[0]) as f64 * dt))
 }
 
 /// Simulated outputs (rows: samples of the window) and their derivatives.
@@ -125,11 +185,21 @@ pub struct StageRun {
 impl Stage<'_> {
     /// Values of the variables at `u`.
     pub fn values(&self, u: &[f64]) -> Vec<f64> {
-        self.vars.iter().zip(u).map(|(v, u)| v.initial + v.scale * u).collect()
+        self.vars
+            .iter()
+            .zip(u)
+            .map(|(v, u)| v.initial + v.scale * u)
+            .collect()
     }
 
     /// Simulate sample indices `first..last` (inclusive), with sensitivities if asked.
-    pub fn run(&self, u: &[f64], first: usize, last: usize, sens: bool) -> Result<StageRun, FitError> {
+    pub fn run(
+        &self,
+        u: &[f64],
+        first: usize,
+        last: usize,
+        sens: bool,
+    ) -> Result<StageRun, FitError> {
         let th = self.values(u);
         let mut p = self.p.clone();
         let mut z0 = self.z0.clone();
@@ -141,12 +211,18 @@ impl Stage<'_> {
                 VarKind::Param(i) => {
                     p[*i] = val;
                     col_of[k] = Some(columns.len());
-                    columns.push(Column::Param { index: *i, scale: v.scale });
+                    columns.push(Column::Param {
+                        index: *i,
+                        scale: v.scale,
+                    });
                 }
                 VarKind::Initial(pos) => {
                     z0[*pos] = val;
                     col_of[k] = Some(columns.len());
-                    columns.push(Column::Initial { pos: *pos, scale: v.scale });
+                    columns.push(Column::Initial {
+                        pos: *pos,
+                        scale: v.scale,
+                    });
                 }
                 VarKind::Offset { du, .. } => {
                     if !du.is_empty() {
@@ -154,7 +230,10 @@ impl Stage<'_> {
                             g.constant += d * val;
                         }
                         col_of[k] = Some(columns.len());
-                        columns.push(Column::Input { du: du.clone(), scale: v.scale });
+                        columns.push(Column::Input {
+                            du: du.clone(),
+                            scale: v.scale,
+                        });
                     }
                 }
             }
@@ -163,16 +242,33 @@ impl Stage<'_> {
             columns.clear();
         }
         let t_start = self.t0 + first as f64 * self.dt;
-        let signals: Vec<Signal> = self.signals.iter().map(|s| Signal { t0: s.t0 - t_start, ..s.clone() }).collect();
+        let signals: Vec<Signal> = self
+            .signals
+            .iter()
+            .map(|s| Signal {
+                t0: s.t0 - t_start,
+                ..s.clone()
+            })
+            .collect();
         let zscale: Vec<f64> = {
             let s = state_scale(self.model, &p);
             self.free.iter().map(|&i| s[i]).collect()
         };
-        let sys = Driven { model: self.model, p, base: self.base.clone(), free: self.free.clone(), given, signals, columns, zscale };
+        let sys = Driven {
+            model: self.model,
+            p,
+            base: self.base.clone(),
+            free: self.free.clone(),
+            given,
+            signals,
+            columns,
+            zscale,
+        };
         let x0 = sys.initial(&z0);
         let samples: Vec<f64> = (0..=last - first).map(|k| k as f64 * self.dt).collect();
         let t_end = samples[samples.len() - 1].max(self.dt);
-        let traj = integrate(&sys, &x0, t_end, &samples, &self.sim, Hooks::default()).map_err(|e| FitError::Sim(self.name.to_string(), e.to_string()))?;
+        let traj = integrate(&sys, &x0, t_end, &samples, &self.sim, Hooks::default())
+            .map_err(|e| FitError::Sim(self.name.to_string(), e.to_string()))?;
         let nz = self.free.len();
         let mut yhat = vec![Vec::new(); self.outputs.len()];
         let mut dyhat = vec![Vec::new(); self.outputs.len()];
@@ -205,7 +301,13 @@ impl Stage<'_> {
     }
 
     /// Weighted residuals and Jacobian on the sample indices `keep` (within `first..=last`).
-    pub fn residuals(&self, u: &[f64], first: usize, last: usize, keep: &[usize]) -> Result<(Vec<f64>, DMatrix<f64>), FitError> {
+    pub fn residuals(
+        &self,
+        u: &[f64],
+        first: usize,
+        last: usize,
+        keep: &[usize],
+    ) -> Result<(Vec<f64>, DMatrix<f64>), FitError> {
         let run = self.run(u, first, last, true)?;
         let nv = self.vars.len();
         let rows = keep.len() * self.outputs.len();
@@ -213,6 +315,7 @@ impl Stage<'_> {
         let mut j = DMatrix::zeros(rows, nv);
         let mut row = 0;
         for (o, out) in self.outputs.iter().enumerate() {
+            let start = row;
             for &i in keep {
                 let k = i - first;
                 r.push((run.yhat[o][k] - out.data[i]) / out.sigma);
@@ -220,6 +323,16 @@ impl Stage<'_> {
                     j[(row, v)] = run.dyhat[o][k][v] / out.sigma;
                 }
                 row += 1;
+            }
+            if self.drift > 0 {
+                project_drift(&mut r[start..row], self.drift);
+                for v in 0..nv {
+                    let mut col: Vec<f64> = (start..row).map(|i| j[(i, v)]).collect();
+                    project_drift(&mut col, self.drift);
+                    for (i, c) in (start..row).zip(col) {
+                        j[(i, v)] = c;
+                    }
+                }
             }
         }
         Ok((r, j))
@@ -241,7 +354,13 @@ pub fn split_states(model: &dyn Model) -> (Vec<usize>, Vec<usize>) {
 
 /// Indices of the pressure states, in CV order.
 pub fn pressure_states(model: &dyn Model) -> Vec<usize> {
-    model.states().iter().enumerate().filter(|(_, s)| matches!(s.kind, StateKind::Pressure(_))).map(|(i, _)| i).collect()
+    model
+        .states()
+        .iter()
+        .enumerate()
+        .filter(|(_, s)| matches!(s.kind, StateKind::Pressure(_)))
+        .map(|(i, _)| i)
+        .collect()
 }
 
 /// Weight of the cold-side channel in the prescribed pressure of CV `i` of `ncv` (hot = 0).
@@ -255,14 +374,28 @@ pub fn cold_weight(i: usize, ncv: usize, have_hot: bool) -> f64 {
 
 /// Static shift of the body positions per unit pressure offset on the cold and hot channels:
 /// `dq = -J_aq^-1 J_aP off` (rows: the velocity equations; columns: positions, pressures).
-pub fn static_shift(model: &dyn Model, p: &[f64], have_hot: bool) -> Result<[Vec<f64>; 2], FitError> {
+pub fn static_shift(
+    model: &dyn Model,
+    p: &[f64],
+    have_hot: bool,
+) -> Result<[Vec<f64>; 2], FitError> {
     let n = model.n_states();
     let mut eq = vec![0.0; n];
     model.equilibrium_guess(p, &mut eq);
     let j = model.jacobian_dense(p, &eq, 0.0);
     let st = model.states();
-    let pos: Vec<usize> = st.iter().enumerate().filter(|(_, s)| matches!(s.kind, StateKind::Position(_))).map(|(i, _)| i).collect();
-    let vel: Vec<usize> = st.iter().enumerate().filter(|(_, s)| matches!(s.kind, StateKind::Velocity(_))).map(|(i, _)| i).collect();
+    let pos: Vec<usize> = st
+        .iter()
+        .enumerate()
+        .filter(|(_, s)| matches!(s.kind, StateKind::Position(_)))
+        .map(|(i, _)| i)
+        .collect();
+    let vel: Vec<usize> = st
+        .iter()
+        .enumerate()
+        .filter(|(_, s)| matches!(s.kind, StateKind::Velocity(_)))
+        .map(|(i, _)| i)
+        .collect();
     let ps = pressure_states(model);
     let jaq = DMatrix::from_fn(vel.len(), pos.len(), |r, c| j[vel[r] + n * pos[c]]);
     let lu = jaq.lu();
@@ -277,7 +410,9 @@ pub fn static_shift(model: &dyn Model, p: &[f64], have_hot: bool) -> Result<[Vec
                 })
                 .sum::<f64>()
         });
-        let dq = lu.solve(&(-rhs)).ok_or_else(|| FitError::Bad("the static stiffness of the bodies is singular".into()))?;
+        let dq = lu.solve(&(-rhs)).ok_or_else(|| {
+            FitError::Bad("the static stiffness of the bodies is singular".into())
+        })?;
         *o = dq.iter().copied().collect();
     }
     Ok(out)

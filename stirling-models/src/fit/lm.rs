@@ -24,7 +24,12 @@ pub struct LmOptions {
 
 impl Default for LmOptions {
     fn default() -> Self {
-        Self { max_iter: 50, ftol: 1e-10, xtol: 1e-9, lambda0: 1e-3 }
+        Self {
+            max_iter: 50,
+            ftol: 1e-10,
+            xtol: 1e-9,
+            lambda0: 1e-3,
+        }
     }
 }
 
@@ -102,7 +107,15 @@ pub fn minimize(eval: &mut Eval, x0: &[f64], opts: &LmOptions) -> Option<LmResul
             break;
         }
     }
-    Some(LmResult { x, residuals: r, jacobian: jm, cost: c, iterations: it, evaluations: evals, converged })
+    Some(LmResult {
+        x,
+        residuals: r,
+        jacobian: jm,
+        cost: c,
+        iterations: it,
+        evaluations: evals,
+        converged,
+    })
 }
 
 #[cfg(test)]
@@ -115,12 +128,26 @@ mod tests {
         let t: Vec<f64> = (0..40).map(|k| k as f64 * 0.1).collect();
         let y: Vec<f64> = t.iter().map(|t| 2.0 * (-1.5 * t).exp()).collect();
         let mut f = |p: &[f64]| {
-            let r: Vec<f64> = t.iter().zip(&y).map(|(t, y)| p[0] * (p[1] * t).exp() - y).collect();
-            let j = DMatrix::from_fn(t.len(), 2, |i, k| if k == 0 { (p[1] * t[i]).exp() } else { p[0] * t[i] * (p[1] * t[i]).exp() });
+            let r: Vec<f64> = t
+                .iter()
+                .zip(&y)
+                .map(|(t, y)| p[0] * (p[1] * t).exp() - y)
+                .collect();
+            let j = DMatrix::from_fn(t.len(), 2, |i, k| {
+                if k == 0 {
+                    (p[1] * t[i]).exp()
+                } else {
+                    p[0] * t[i] * (p[1] * t[i]).exp()
+                }
+            });
             Some((r, j))
         };
         let res = minimize(&mut f, &[1.0, -0.5], &LmOptions::default()).unwrap();
-        assert!((res.x[0] - 2.0).abs() < 1e-8 && (res.x[1] + 1.5).abs() < 1e-8, "{:?}", res.x);
+        assert!(
+            (res.x[0] - 2.0).abs() < 1e-8 && (res.x[1] + 1.5).abs() < 1e-8,
+            "{:?}",
+            res.x
+        );
     }
 
     #[test]
@@ -130,7 +157,19 @@ mod tests {
             let j = DMatrix::from_row_slice(2, 2, &[-20.0 * p[0], 10.0, -1.0, 0.0]);
             Some((r, j))
         };
-        let res = minimize(&mut f, &[-1.2, 1.0], &LmOptions { max_iter: 200, ..Default::default() }).unwrap();
-        assert!((res.x[0] - 1.0).abs() < 1e-6 && (res.x[1] - 1.0).abs() < 1e-6, "{:?}", res.x);
+        let res = minimize(
+            &mut f,
+            &[-1.2, 1.0],
+            &LmOptions {
+                max_iter: 200,
+                ..Default::default()
+            },
+        )
+        .unwrap();
+        assert!(
+            (res.x[0] - 1.0).abs() < 1e-6 && (res.x[1] - 1.0).abs() < 1e-6,
+            "{:?}",
+            res.x
+        );
     }
 }

@@ -18,7 +18,10 @@ use stirling_dsl::{Model, StateKind};
 
 use crate::data::{cycle_mean, Measured};
 use crate::sim::SimOptions;
-use driven::{cold_weight, noise_sigma, pressure_states, savitzky_golay, split_states, static_shift, Output, Stage, Var, VarKind};
+use driven::{
+    cold_weight, noise_sigma, pressure_states, savitzky_golay, split_states, static_shift, Output,
+    Stage, Var, VarKind,
+};
 use report::{fit_percent, stats, ChannelFit, FitStats};
 use sensitivity::{Given, Signal};
 
@@ -62,8 +65,17 @@ impl Default for FitOptions {
             holdout: None,
             burn_in: 0.03,
             smooth: 0.006,
-            lm: lm::LmOptions { max_iter: 30, ftol: 1e-8, xtol: 1e-7, lambda0: 1e-3 },
-            sim: SimOptions { rtol: 1e-7, atol: 1e-7, ..Default::default() },
+            lm: lm::LmOptions {
+                max_iter: 30,
+                ftol: 1e-8,
+                xtol: 1e-7,
+                lambda0: 1e-3,
+            },
+            sim: SimOptions {
+                rtol: 1e-7,
+                atol: 1e-7,
+                ..Default::default()
+            },
             stage1: true,
             stage2: true,
         }
@@ -96,7 +108,10 @@ pub struct StageFit {
 impl StageFit {
     /// Fit percentage of a channel on a block (`train` or `holdout`).
     pub fn fit_percent(&self, channel: &str, block: &str) -> Option<f64> {
-        self.fits.iter().find(|f| f.channel == channel && f.block == block).map(|f| f.fit_percent)
+        self.fits
+            .iter()
+            .find(|f| f.channel == channel && f.block == block)
+            .map(|f| f.fit_percent)
     }
     /// The estimate of a quantity by name.
     pub fn estimate(&self, name: &str) -> Option<&report::Estimate> {
@@ -119,7 +134,11 @@ pub struct Identification {
 }
 
 /// Split the free parameters by the rows they enter: body rows -> stage 1, gas rows -> stage 2.
-pub fn classify(model: &dyn Model, p: &[f64], names: &[String]) -> Result<(Vec<usize>, Vec<usize>), FitError> {
+pub fn classify(
+    model: &dyn Model,
+    p: &[f64],
+    names: &[String],
+) -> Result<(Vec<usize>, Vec<usize>), FitError> {
     let n = model.n_states();
     let mut x = vec![0.0; n];
     model.equilibrium_guess(p, &mut x);
@@ -136,13 +155,25 @@ pub fn classify(model: &dyn Model, p: &[f64], names: &[String]) -> Result<(Vec<u
     let (mut mech, mut gas) = (Vec::new(), Vec::new());
     for name in names {
         let j = model.param_index(name).ok_or_else(|| {
-            FitError::Bad(format!("unknown parameter `{name}` of model `{}`: see `stirling info {}`", model.name(), model.name()))
+            FitError::Bad(format!(
+                "unknown parameter `{name}` of model `{}`: see `stirling info {}`",
+                model.name(),
+                model.name()
+            ))
         })?;
         let col = &jp[j * n..(j + 1) * n];
-        let body = st.iter().zip(col).any(|(s, v)| matches!(s.kind, StateKind::Velocity(_)) && *v != 0.0);
-        let g = st.iter().zip(col).any(|(s, v)| matches!(s.kind, StateKind::Pressure(_) | StateKind::Mass(_)) && *v != 0.0);
+        let body = st
+            .iter()
+            .zip(col)
+            .any(|(s, v)| matches!(s.kind, StateKind::Velocity(_)) && *v != 0.0);
+        let g = st.iter().zip(col).any(|(s, v)| {
+            matches!(s.kind, StateKind::Pressure(_) | StateKind::Mass(_)) && *v != 0.0
+        });
         if !body && !g {
-            return Err(FitError::Bad(format!("parameter `{name}` does not enter the equations of `{}`: it cannot be identified", model.name())));
+            return Err(FitError::Bad(format!(
+                "parameter `{name}` does not enter the equations of `{}`: it cannot be identified",
+                model.name()
+            )));
         }
         if body {
             mech.push(j);
@@ -156,18 +187,29 @@ pub fn classify(model: &dyn Model, p: &[f64], names: &[String]) -> Result<(Vec<u
 
 /// Default free parameters that the model uses.
 pub fn default_free(model: &dyn Model, p: &[f64]) -> Vec<String> {
-    ["kd", "kp", "bd", "bp", "hh", "hk", "Rf"].iter().map(|s| s.to_string()).filter(|s| classify(model, p, std::slice::from_ref(s)).is_ok()).collect()
+    ["kd", "kp", "bd", "bp", "hh", "hk", "Rf"]
+        .iter()
+        .map(|s| s.to_string())
+        .filter(|s| classify(model, p, std::slice::from_ref(s)).is_ok())
+        .collect()
 }
 
 fn uniform(data: &Measured) -> Result<(f64, f64), FitError> {
     if data.t.len() < 20 {
-        return Err(FitError::Bad(format!("{}: {} samples are too few to fit", data.source, data.t.len())));
+        return Err(FitError::Bad(format!(
+            "{}: {} samples are too few to fit",
+            data.source,
+            data.t.len()
+        )));
     }
     let dt = data.dt();
     for k in 1..data.t.len() {
         let d = data.t[k] - data.t[k - 1];
         if (d - dt).abs() > 1e-3 * dt {
-            return Err(FitError::Bad(format!("{}: the fit needs uniform sampling; the interval at t = {} is {d}, the mean {dt}", data.source, data.t[k])));
+            return Err(FitError::Bad(format!(
+                "{}: the fit needs uniform sampling; the interval at t = {} is {d}, the mean {dt}",
+                data.source, data.t[k]
+            )));
         }
     }
     Ok((data.t[0], dt))
@@ -179,7 +221,13 @@ fn signal(t0: f64, dt: f64, y: &[f64], h: usize) -> Signal {
 }
 
 /// Fit a stage on the training indices, then report train and holdout fits.
-fn fit_stage(stage: &Stage, train: (usize, usize), hold: Option<(usize, usize)>, burn: usize, lm_opts: &lm::LmOptions) -> Result<(StageFit, Vec<f64>), FitError> {
+fn fit_stage(
+    stage: &Stage,
+    train: (usize, usize),
+    hold: Option<(usize, usize)>,
+    burn: usize,
+    lm_opts: &lm::LmOptions,
+) -> Result<(StageFit, Vec<f64>), FitError> {
     let clock = Instant::now();
     let keep: Vec<usize> = ((train.0 + burn).min(train.1)..=train.1).collect();
     let mut last_err = None;
@@ -191,8 +239,16 @@ fn fit_stage(stage: &Stage, train: (usize, usize), hold: Option<(usize, usize)>,
         }
     };
     let u0 = vec![0.0; stage.vars.len()];
-    let res = lm::minimize(&mut eval, &u0, lm_opts).ok_or_else(|| last_err.clone().unwrap_or(FitError::Start(stage.name.into())))?;
-    let names: Vec<(String, bool)> = stage.vars.iter().map(|v| (v.name.clone(), matches!(v.kind, VarKind::Param(_)))).collect();
+    let res = lm::minimize(&mut eval, &u0, lm_opts).ok_or_else(|| {
+        last_err
+            .clone()
+            .unwrap_or(FitError::Start(stage.name.into()))
+    })?;
+    let names: Vec<(String, bool)> = stage
+        .vars
+        .iter()
+        .map(|v| (v.name.clone(), matches!(v.kind, VarKind::Param(_))))
+        .collect();
     let init: Vec<f64> = stage.vars.iter().map(|v| v.initial).collect();
     let scale: Vec<f64> = stage.vars.iter().map(|v| v.scale).collect();
     let st = stats(&names, &init, &scale, &res.x, &res.residuals, &res.jacobian);
@@ -205,7 +261,11 @@ fn fit_stage(stage: &Stage, train: (usize, usize), hold: Option<(usize, usize)>,
     let mut blocks = vec![("train", keep.clone(), &run)];
     let hrun;
     if let Some(h) = hold {
-        let idx: Vec<usize> = if whole { (h.0.max(train.0 + burn)..=h.1).collect() } else { ((h.0 + burn).min(h.1)..=h.1).collect() };
+        let idx: Vec<usize> = if whole {
+            (h.0.max(train.0 + burn)..=h.1).collect()
+        } else {
+            ((h.0 + burn).min(h.1)..=h.1).collect()
+        };
         if !whole {
             hrun = stage.run(&res.x, h.0, h.1, false)?;
             blocks.push(("holdout", idx, &hrun));
@@ -217,24 +277,59 @@ fn fit_stage(stage: &Stage, train: (usize, usize), hold: Option<(usize, usize)>,
         for (o, out) in stage.outputs.iter().enumerate() {
             let y: Vec<f64> = idx.iter().map(|&i| out.data[i]).collect();
             let yh: Vec<f64> = idx.iter().map(|&i| r.yhat[o][i - r.first]).collect();
-            let rms = (y.iter().zip(&yh).map(|(a, b)| (a - b) * (a - b)).sum::<f64>() / y.len().max(1) as f64).sqrt();
-            fits.push(ChannelFit { channel: out.channel.clone(), block: block.to_string(), fit_percent: fit_percent(&y, &yh), rms, samples: y.len() });
+            let rms = (y
+                .iter()
+                .zip(&yh)
+                .map(|(a, b)| (a - b) * (a - b))
+                .sum::<f64>()
+                / y.len().max(1) as f64)
+                .sqrt();
+            fits.push(ChannelFit {
+                channel: out.channel.clone(),
+                block: block.to_string(),
+                fit_percent: fit_percent(&y, &yh),
+                rms,
+                samples: y.len(),
+            });
         }
     }
     for (o, out) in stage.outputs.iter().enumerate() {
-        let t: Vec<f64> = (run.first..run.first + run.yhat[o].len()).map(|i| stage.t0 + i as f64 * stage.dt).collect();
-        let measured = (run.first..run.first + run.yhat[o].len()).map(|i| out.data[i]).collect();
-        series.push(Series { channel: out.channel.clone(), t, measured, model: run.yhat[o].clone() });
+        let t: Vec<f64> = (run.first..run.first + run.yhat[o].len())
+            .map(|i| stage.t0 + i as f64 * stage.dt)
+            .collect();
+        let measured = (run.first..run.first + run.yhat[o].len())
+            .map(|i| out.data[i])
+            .collect();
+        series.push(Series {
+            channel: out.channel.clone(),
+            t,
+            measured,
+            model: run.yhat[o].clone(),
+        });
     }
     let values = stage.values(&res.x);
     Ok((
-        StageFit { stage: stage.name.into(), stats: st, fits, iterations: res.iterations, evaluations: res.evaluations, converged: res.converged, seconds: clock.elapsed().as_secs_f64(), series },
+        StageFit {
+            stage: stage.name.into(),
+            stats: st,
+            fits,
+            iterations: res.iterations,
+            evaluations: res.evaluations,
+            converged: res.converged,
+            seconds: clock.elapsed().as_secs_f64(),
+            series,
+        },
         values,
     ))
 }
 
 /// The two-stage identification of `model` (starting from `p0`) on a measured record.
-pub fn identify(model: &dyn Model, p0: &[f64], data: &Measured, opts: &FitOptions) -> Result<Identification, FitError> {
+pub fn identify(
+    model: &dyn Model,
+    p0: &[f64],
+    data: &Measured,
+    opts: &FitOptions,
+) -> Result<Identification, FitError> {
     let clock = Instant::now();
     let (t0, dt) = uniform(data)?;
     let nt = data.t.len();
@@ -249,7 +344,10 @@ pub fn identify(model: &dyn Model, p0: &[f64], data: &Measured, opts: &FitOption
     let tr = (idx(train.0), idx(train.1));
     let ho = holdout.map(|h| (idx(h.0), idx(h.1)));
     if tr.1 < tr.0 + 10 {
-        return Err(FitError::Bad(format!("the training block {}:{} holds fewer than 10 samples", train.0, train.1)));
+        return Err(FitError::Bad(format!(
+            "the training block {}:{} holds fewer than 10 samples",
+            train.0, train.1
+        )));
     }
     let free = opts.free.clone().unwrap_or_else(|| default_free(model, p0));
     let mut p = p0.to_vec();
@@ -261,23 +359,46 @@ pub fn identify(model: &dyn Model, p0: &[f64], data: &Measured, opts: &FitOption
     let mut eq = vec![0.0; model.n_states()];
     model.equilibrium_guess(&p, &mut eq);
     let pmean = ps.first().map(|&i| eq[i]).unwrap_or(0.0);
-    let pos_states: Vec<usize> = bodies.iter().copied().filter(|&i| matches!(model.states()[i].kind, StateKind::Position(_))).collect();
+    let pos_states: Vec<usize> = bodies
+        .iter()
+        .copied()
+        .filter(|&i| matches!(model.states()[i].kind, StateKind::Position(_)))
+        .collect();
     let (x_meas, y_meas) = (data.x.as_ref(), data.y.as_ref());
-    let mut x_off = [x_meas.map(|v| cycle_mean(v)).unwrap_or(0.0), y_meas.map(|v| cycle_mean(v)).unwrap_or(0.0)];
+    let mut x_off = [
+        x_meas.map(|v| cycle_mean(v)).unwrap_or(0.0),
+        y_meas.map(|v| cycle_mean(v)).unwrap_or(0.0),
+    ];
     let mut stage1 = None;
     let sim = opts.sim;
     // pressure-offset guesses: the whole-cycle mean minus the charge pressure (refined in stage 2)
-    let p_off0 = data.p.as_ref().map(|v| cycle_mean(v) - pmean).unwrap_or(0.0);
-    let ph_off0 = data.p_hot.as_ref().map(|v| cycle_mean(v) - pmean).unwrap_or(0.0);
+    let p_off0 = data
+        .p
+        .as_ref()
+        .map(|v| cycle_mean(v) - pmean)
+        .unwrap_or(0.0);
+    let ph_off0 = data
+        .p_hot
+        .as_ref()
+        .map(|v| cycle_mean(v) - pmean)
+        .unwrap_or(0.0);
     let sig_p = data.p.as_ref().map(|v| signal(t0, dt, v, (h / 2).max(3)));
-    let sig_ph = data.p_hot.as_ref().map(|v| signal(t0, dt, v, (h / 2).max(3)));
+    let sig_ph = data
+        .p_hot
+        .as_ref()
+        .map(|v| signal(t0, dt, v, (h / 2).max(3)));
 
     if opts.stage1 && !mech.is_empty() {
         let (Some(xm), Some(ym), Some(sp)) = (x_meas, y_meas, sig_p.as_ref()) else {
-            return Err(FitError::Bad(format!("{}: stage 1 (mechanics) needs the columns p, x and y", data.source)));
+            return Err(FitError::Bad(format!(
+                "{}: stage 1 (mechanics) needs the columns p, x and y",
+                data.source
+            )));
         };
         if pos_states.len() != 2 {
-            return Err(FitError::Bad("stage 1 expects two bodies (displacer x, piston y)".into()));
+            return Err(FitError::Bad(
+                "stage 1 expects two bodies (displacer x, piston y)".into(),
+            ));
         }
         let mut signals = vec![sp.clone()];
         if have_hot {
@@ -292,25 +413,81 @@ pub fn identify(model: &dyn Model, p0: &[f64], data: &Measured, opts: &FitOption
                 if have_hot {
                     terms.push((1, 1.0 - wc, false));
                 }
-                Given { state: s, terms, constant: -wc * p_off0 - if have_hot { (1.0 - wc) * ph_off0 } else { 0.0 } }
+                Given {
+                    state: s,
+                    terms,
+                    constant: -wc * p_off0 - if have_hot { (1.0 - wc) * ph_off0 } else { 0.0 },
+                }
             })
             .collect();
         let sx = signal(t0, dt, xm, h);
         let sy = signal(t0, dt, ym, h);
         let ta = tr.0;
-        let z0 = vec![sx.val[ta] - x_off[0], sx.der[ta], sy.val[ta] - x_off[1], sy.der[ta]];
-        let mut vars: Vec<Var> = mech.iter().map(|&j| Var { name: model.params()[j].name.into(), initial: p[j], scale: p[j].abs().max(1e-12), kind: VarKind::Param(j) }).collect();
+        let z0 = vec![
+            sx.val[ta] - x_off[0],
+            sx.der[ta],
+            sy.val[ta] - x_off[1],
+            sy.der[ta],
+        ];
+        let mut vars: Vec<Var> = mech
+            .iter()
+            .map(|&j| Var {
+                name: model.params()[j].name.into(),
+                initial: p[j],
+                scale: p[j].abs().max(1e-12),
+                kind: VarKind::Param(j),
+            })
+            .collect();
         let names = ["x(0)", "v(0)", "y(0)", "w(0)"];
         for (k, nm) in names.iter().enumerate() {
-            vars.push(Var { name: nm.to_string(), initial: z0[k], scale: if k % 2 == 0 { 1e-3 } else { 0.05 }, kind: VarKind::Initial(k) });
+            vars.push(Var {
+                name: nm.to_string(),
+                initial: z0[k],
+                scale: if k % 2 == 0 { 1e-3 } else { 0.05 },
+                kind: VarKind::Initial(k),
+            });
         }
-        vars.push(Var { name: "x_offset".into(), initial: x_off[0], scale: 1e-3, kind: VarKind::Offset { out: 0, du: vec![] } });
-        vars.push(Var { name: "y_offset".into(), initial: x_off[1], scale: 1e-3, kind: VarKind::Offset { out: 1, du: vec![] } });
+        vars.push(Var {
+            name: "x_offset".into(),
+            initial: x_off[0],
+            scale: 1e-3,
+            kind: VarKind::Offset { out: 0, du: vec![] },
+        });
+        vars.push(Var {
+            name: "y_offset".into(),
+            initial: x_off[1],
+            scale: 1e-3,
+            kind: VarKind::Offset { out: 1, du: vec![] },
+        });
         let outputs = vec![
-            Output { channel: "x".into(), pos: 0, data: xm.clone(), sigma: noise_sigma(xm).max(1e-9) },
-            Output { channel: "y".into(), pos: 2, data: ym.clone(), sigma: noise_sigma(ym).max(1e-9) },
+            Output {
+                channel: "x".into(),
+                pos: 0,
+                data: xm.clone(),
+                sigma: noise_sigma(xm).max(1e-9),
+            },
+            Output {
+                channel: "y".into(),
+                pos: 2,
+                data: ym.clone(),
+                sigma: noise_sigma(ym).max(1e-9),
+            },
         ];
-        let stage = Stage { name: "stage 1 (mechanics driven by measured pressure)", model, p: p.clone(), base: eq.clone(), free: bodies.clone(), given, signals, z0, vars, outputs, t0, dt, sim };
+        let stage = Stage {
+            name: "stage 1 (mechanics driven by measured pressure)",
+            model,
+            p: p.clone(),
+            base: eq.clone(),
+            free: bodies.clone(),
+            given,
+            signals,
+            z0,
+            vars,
+            outputs,
+            t0,
+            dt,
+            sim,
+        };
         let (fit, values) = fit_stage(&stage, tr, ho, 0, &opts.lm)?;
         for (v, val) in stage.vars.iter().zip(&values) {
             match v.kind {
@@ -325,34 +502,94 @@ pub fn identify(model: &dyn Model, p0: &[f64], data: &Measured, opts: &FitOption
     let mut stage2 = None;
     if opts.stage2 && !gas.is_empty() {
         let (Some(xm), Some(ym), Some(sp)) = (x_meas, y_meas, sig_p.as_ref()) else {
-            return Err(FitError::Bad(format!("{}: stage 2 (gas) needs the columns p, x and y", data.source)));
+            return Err(FitError::Bad(format!(
+                "{}: stage 2 (gas) needs the columns p, x and y",
+                data.source
+            )));
         };
         model.equilibrium_guess(&p, &mut eq);
         let shift = static_shift(model, &p, have_hot)?;
         let sx = signal(t0, dt, xm, h);
         let sy = signal(t0, dt, ym, h);
         let signals = vec![sx.clone(), sy.clone()];
-        let vel_states: Vec<usize> = bodies.iter().copied().filter(|&i| matches!(model.states()[i].kind, StateKind::Velocity(_))).collect();
+        let vel_states: Vec<usize> = bodies
+            .iter()
+            .copied()
+            .filter(|&i| matches!(model.states()[i].kind, StateKind::Velocity(_)))
+            .collect();
         // stage 1 ran with the pressure offsets (p_off0, ph_off0); an offset `off` moves the
         // true positions by -dq (off - off0) relative to the stage-1 offsets
-        let used = [shift[0][0] * p_off0 + shift[1][0] * ph_off0, shift[0][1] * p_off0 + shift[1][1] * ph_off0];
+        let used = [
+            shift[0][0] * p_off0 + shift[1][0] * ph_off0,
+            shift[0][1] * p_off0 + shift[1][1] * ph_off0,
+        ];
         let given = vec![
-            Given { state: pos_states[0], terms: vec![(0, 1.0, false)], constant: -x_off[0] + used[0] },
-            Given { state: vel_states[0], terms: vec![(0, 1.0, true)], constant: 0.0 },
-            Given { state: pos_states[1], terms: vec![(1, 1.0, false)], constant: -x_off[1] + used[1] },
-            Given { state: vel_states[1], terms: vec![(1, 1.0, true)], constant: 0.0 },
+            Given {
+                state: pos_states[0],
+                terms: vec![(0, 1.0, false)],
+                constant: -x_off[0] + used[0],
+            },
+            Given {
+                state: vel_states[0],
+                terms: vec![(0, 1.0, true)],
+                constant: 0.0,
+            },
+            Given {
+                state: pos_states[1],
+                terms: vec![(1, 1.0, false)],
+                constant: -x_off[1] + used[1],
+            },
+            Given {
+                state: vel_states[1],
+                terms: vec![(1, 1.0, true)],
+                constant: 0.0,
+            },
         ];
         let du = |ch: usize| vec![-shift[ch][0], 0.0, -shift[ch][1], 0.0];
         let pm = data.p.as_ref().expect("checked");
-        let cold_pos = gas_states.iter().position(|&i| i == *ps.last().expect("CVs")).expect("pressure is a gas state");
-        let hot_pos = gas_states.iter().position(|&i| i == ps[0]).expect("pressure is a gas state");
-        let mut vars: Vec<Var> = gas.iter().map(|&j| Var { name: model.params()[j].name.into(), initial: p[j], scale: p[j].abs().max(1e-12), kind: VarKind::Param(j) }).collect();
-        vars.push(Var { name: "p_offset".into(), initial: p_off0, scale: 100.0, kind: VarKind::Offset { out: 0, du: du(0) } });
-        let mut outputs = vec![Output { channel: "p".into(), pos: cold_pos, data: pm.clone(), sigma: noise_sigma(pm).max(1e-6 * pmean) }];
+        let cold_pos = gas_states
+            .iter()
+            .position(|&i| i == *ps.last().expect("CVs"))
+            .expect("pressure is a gas state");
+        let hot_pos = gas_states
+            .iter()
+            .position(|&i| i == ps[0])
+            .expect("pressure is a gas state");
+        let mut vars: Vec<Var> = gas
+            .iter()
+            .map(|&j| Var {
+                name: model.params()[j].name.into(),
+                initial: p[j],
+                scale: p[j].abs().max(1e-12),
+                kind: VarKind::Param(j),
+            })
+            .collect();
+        vars.push(Var {
+            name: "p_offset".into(),
+            initial: p_off0,
+            scale: 100.0,
+            kind: VarKind::Offset { out: 0, du: du(0) },
+        });
+        let mut outputs = vec![Output {
+            channel: "p".into(),
+            pos: cold_pos,
+            data: pm.clone(),
+            sigma: noise_sigma(pm).max(1e-6 * pmean),
+        }];
         if have_hot {
             let ph = data.p_hot.as_ref().expect("have_hot");
-            vars.push(Var { name: "p_hot_offset".into(), initial: ph_off0, scale: 100.0, kind: VarKind::Offset { out: 1, du: du(1) } });
-            outputs.push(Output { channel: "p_hot".into(), pos: hot_pos, data: ph.clone(), sigma: noise_sigma(ph).max(1e-6 * pmean) });
+            vars.push(Var {
+                name: "p_hot_offset".into(),
+                initial: ph_off0,
+                scale: 100.0,
+                kind: VarKind::Offset { out: 1, du: du(1) },
+            });
+            outputs.push(Output {
+                channel: "p_hot".into(),
+                pos: hot_pos,
+                data: ph.clone(),
+                sigma: noise_sigma(ph).max(1e-6 * pmean),
+            });
         }
         // initial gas state at the window start: measured pressures, masses sharing the
         // model's inventory in proportion to P V / T_rest
@@ -367,16 +604,28 @@ pub fn identify(model: &dyn Model, p0: &[f64], data: &Measured, opts: &FitOption
         model.temperatures(&p, &eq, &mut t_rest);
         for (i, &s) in ps.iter().enumerate() {
             let wc = cold_weight(i, ncv, have_hot);
-            let hot = sig_ph.as_ref().filter(|_| have_hot).map(|s| s.val[ta] - ph_off0).unwrap_or(0.0);
+            let hot = sig_ph
+                .as_ref()
+                .filter(|_| have_hot)
+                .map(|s| s.val[ta] - ph_off0)
+                .unwrap_or(0.0);
             x_start[s] = wc * (sp.val[ta] - p_off0) + (1.0 - wc) * hot;
         }
-        let masses: Vec<usize> = model.states().iter().enumerate().filter(|(_, s)| matches!(s.kind, StateKind::Mass(_))).map(|(i, _)| i).collect();
+        let masses: Vec<usize> = model
+            .states()
+            .iter()
+            .enumerate()
+            .filter(|(_, s)| matches!(s.kind, StateKind::Mass(_)))
+            .map(|(i, _)| i)
+            .collect();
         if !masses.is_empty() {
             let nv = model.vessel_names().len();
             let (mut pr, mut vol) = (vec![0.0; nv], vec![0.0; nv]);
             model.pv(&p, &x_start, &mut pr, &mut vol);
             let total: f64 = masses.iter().map(|&i| eq[i]).sum();
-            let share: Vec<f64> = (0..ncv).map(|i| x_start[ps[i]] * vol[i] / t_rest[i]).collect();
+            let share: Vec<f64> = (0..ncv)
+                .map(|i| x_start[ps[i]] * vol[i] / t_rest[i])
+                .collect();
             let ssum: f64 = share.iter().sum();
             for (k, &mi) in masses.iter().enumerate() {
                 x_start[mi] = total * share[k] / ssum;
@@ -384,7 +633,21 @@ pub fn identify(model: &dyn Model, p0: &[f64], data: &Measured, opts: &FitOption
         }
         let z0: Vec<f64> = gas_states.iter().map(|&i| x_start[i]).collect();
         let burn = ((opts.burn_in / dt).round() as usize).min(tr.1 - tr.0 - 5);
-        let stage = Stage { name: "stage 2 (gas driven by measured displacements)", model, p: p.clone(), base: eq.clone(), free: gas_states.clone(), given, signals, z0, vars, outputs, t0, dt, sim };
+        let stage = Stage {
+            name: "stage 2 (gas driven by measured displacements)",
+            model,
+            p: p.clone(),
+            base: eq.clone(),
+            free: gas_states.clone(),
+            given,
+            signals,
+            z0,
+            vars,
+            outputs,
+            t0,
+            dt,
+            sim,
+        };
         let (fit, values) = fit_stage(&stage, tr, ho, burn, &opts.lm)?;
         for (v, val) in stage.vars.iter().zip(&values) {
             if let VarKind::Param(j) = v.kind {
@@ -396,7 +659,12 @@ pub fn identify(model: &dyn Model, p0: &[f64], data: &Measured, opts: &FitOption
     Ok(Identification {
         model: model.name().into(),
         n: model.n(),
-        params: model.params().iter().zip(&p).map(|(i, v)| (i.name.to_string(), *v)).collect(),
+        params: model
+            .params()
+            .iter()
+            .zip(&p)
+            .map(|(i, v)| (i.name.to_string(), *v))
+            .collect(),
         stage1,
         stage2,
         train,

@@ -49,30 +49,73 @@ pub struct FitStats {
 /// `100 (1 - |y - yhat| / |y - mean y|)`.
 pub fn fit_percent(y: &[f64], yhat: &[f64]) -> f64 {
     let m = y.iter().sum::<f64>() / y.len().max(1) as f64;
-    let e: f64 = y.iter().zip(yhat).map(|(a, b)| (a - b) * (a - b)).sum::<f64>().sqrt();
+    let e: f64 = y
+        .iter()
+        .zip(yhat)
+        .map(|(a, b)| (a - b) * (a - b))
+        .sum::<f64>()
+        .sqrt();
     let d: f64 = y.iter().map(|a| (a - m) * (a - m)).sum::<f64>().sqrt();
     100.0 * (1.0 - e / d)
 }
 
 /// Estimates and correlations from the Jacobian of the weighted residuals `r` with respect to
 /// variables `u`, where quantity `k` is `initial_k + scale_k u_k`.
-pub fn stats(names: &[(String, bool)], initial: &[f64], scale: &[f64], u: &[f64], r: &[f64], j: &DMatrix<f64>) -> FitStats {
+pub fn stats(
+    names: &[(String, bool)],
+    initial: &[f64],
+    scale: &[f64],
+    u: &[f64],
+    r: &[f64],
+    j: &DMatrix<f64>,
+) -> FitStats {
+    stats_with_nuisance(names, initial, scale, u, r, j, 0)
+}
+
+/// [`stats`] when `nuisance` further linear coefficients were projected out of `r` and `j`
+/// (they cost degrees of freedom but are not reported).
+pub fn stats_with_nuisance(
+    names: &[(String, bool)],
+    initial: &[f64],
+    scale: &[f64],
+    u: &[f64],
+    r: &[f64],
+    j: &DMatrix<f64>,
+    nuisance: usize,
+) -> FitStats {
     let (nr, k) = (r.len(), u.len());
     let rss: f64 = r.iter().map(|v| v * v).sum();
-    let sigma2 = rss / (nr.saturating_sub(k)).max(1) as f64;
+    let sigma2 = rss / (nr.saturating_sub(k + nuisance)).max(1) as f64;
     let jtj = j.transpose() * j;
     // invert on the unit-diagonal scaling for conditioning
     let d: Vec<f64> = (0..k).map(|i| jtj[(i, i)].max(1e-300).sqrt()).collect();
     let scaled = DMatrix::from_fn(k, k, |a, b| jtj[(a, b)] / (d[a] * d[b]));
-    let inv = scaled.clone().try_inverse().unwrap_or_else(|| scaled.clone().pseudo_inverse(1e-14).expect("svd"));
+    let inv = scaled
+        .clone()
+        .try_inverse()
+        .unwrap_or_else(|| scaled.clone().pseudo_inverse(1e-14).expect("svd"));
     let cov = DMatrix::from_fn(k, k, |a, b| sigma2 * inv[(a, b)] / (d[a] * d[b]));
     let mut estimates = Vec::new();
     for i in 0..k {
         let se = cov[(i, i)].max(0.0).sqrt() * scale[i].abs();
         let v = initial[i] + scale[i] * u[i];
-        estimates.push(Estimate { name: names[i].0.clone(), initial: initial[i], value: v, std_error: se, ci_low: v - 1.96 * se, ci_high: v + 1.96 * se, model_param: names[i].1 });
+        estimates.push(Estimate {
+            name: names[i].0.clone(),
+            initial: initial[i],
+            value: v,
+            std_error: se,
+            ci_low: v - 1.96 * se,
+            ci_high: v + 1.96 * se,
+            model_param: names[i].1,
+        });
     }
-    let correlation: Vec<Vec<f64>> = (0..k).map(|a| (0..k).map(|b| cov[(a, b)] / (cov[(a, a)] * cov[(b, b)]).sqrt()).collect()).collect();
+    let correlation: Vec<Vec<f64>> = (0..k)
+        .map(|a| {
+            (0..k)
+                .map(|b| cov[(a, b)] / (cov[(a, a)] * cov[(b, b)]).sqrt())
+                .collect()
+        })
+        .collect();
     let mut warnings = Vec::new();
     for a in 0..k {
         for b in a + 1..k {
@@ -85,11 +128,19 @@ pub fn stats(names: &[(String, bool)], initial: &[f64], scale: &[f64], u: &[f64]
         }
     }
     let ev = scaled.symmetric_eigen().eigenvalues;
-    let (lo, hi) = ev.iter().fold((f64::INFINITY, 0.0f64), |(l, h), &e| (l.min(e), h.max(e)));
+    let (lo, hi) = ev
+        .iter()
+        .fold((f64::INFINITY, 0.0f64), |(l, h), &e| (l.min(e), h.max(e)));
     if lo <= hi * 1e-10 {
         warnings.push(format!("the scaled information matrix is ill-conditioned (condition number {:.2e}): some combination of the free parameters is not identifiable", hi / lo.max(1e-300)));
     }
-    FitStats { estimates, correlation, warnings, sigma2, samples: nr }
+    FitStats {
+        estimates,
+        correlation,
+        warnings,
+        sigma2,
+        samples: nr,
+    }
 }
 
 /// Measured vs model against time (the seed's Figures 4 and 5), one SVG per channel.
@@ -97,8 +148,17 @@ pub fn plot_series(path: &std::path::Path, title: &str, s: &super::Series) -> Re
     use plotters::prelude::*;
     let root = SVGBackend::new(path, (900, 360)).into_drawing_area();
     root.fill(&WHITE).map_err(|e| e.to_string())?;
-    let (t0, t1) = (s.t.first().copied().unwrap_or(0.0), s.t.last().copied().unwrap_or(1.0));
-    let (lo, hi) = s.measured.iter().chain(&s.model).fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), &v| (l.min(v), h.max(v)));
+    let (t0, t1) = (
+        s.t.first().copied().unwrap_or(0.0),
+        s.t.last().copied().unwrap_or(1.0),
+    );
+    let (lo, hi) = s
+        .measured
+        .iter()
+        .chain(&s.model)
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), &v| {
+            (l.min(v), h.max(v))
+        });
     let pad = 0.05 * (hi - lo).max(1e-12);
     let mut chart = ChartBuilder::on(&root)
         .caption(title, ("sans-serif", 18))
@@ -107,17 +167,34 @@ pub fn plot_series(path: &std::path::Path, title: &str, s: &super::Series) -> Re
         .y_label_area_size(70)
         .build_cartesian_2d(t0..t1, (lo - pad)..(hi + pad))
         .map_err(|e| e.to_string())?;
-    chart.configure_mesh().x_desc("t (s)").y_desc(s.channel.as_str()).draw().map_err(|e| e.to_string())?;
     chart
-        .draw_series(s.t.iter().zip(&s.measured).map(|(&t, &v)| Circle::new((t, v), 1, RGBColor(120, 120, 120).filled())))
+        .configure_mesh()
+        .x_desc("t (s)")
+        .y_desc(s.channel.as_str())
+        .draw()
+        .map_err(|e| e.to_string())?;
+    chart
+        .draw_series(
+            s.t.iter()
+                .zip(&s.measured)
+                .map(|(&t, &v)| Circle::new((t, v), 1, RGBColor(120, 120, 120).filled())),
+        )
         .map_err(|e| e.to_string())?
         .label("measured")
         .legend(|(x, y)| Circle::new((x, y), 3, RGBColor(120, 120, 120).filled()));
     chart
-        .draw_series(LineSeries::new(s.t.iter().copied().zip(s.model.iter().copied()), RED.stroke_width(2)))
+        .draw_series(LineSeries::new(
+            s.t.iter().copied().zip(s.model.iter().copied()),
+            RED.stroke_width(2),
+        ))
         .map_err(|e| e.to_string())?
         .label("model")
         .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], RED));
-    chart.configure_series_labels().background_style(WHITE.mix(0.8)).border_style(BLACK).draw().map_err(|e| e.to_string())?;
+    chart
+        .configure_series_labels()
+        .background_style(WHITE.mix(0.8))
+        .border_style(BLACK)
+        .draw()
+        .map_err(|e| e.to_string())?;
     root.present().map_err(|e| e.to_string())
 }

@@ -27,10 +27,22 @@ impl Signal {
         let s = ((t - self.t0) / self.dt).clamp(0.0, (n - 1) as f64);
         let k = (s.floor() as usize).min(n - 2);
         let u = s - k as f64;
-        let (y0, y1, d0, d1) = (self.val[k], self.val[k + 1], self.der[k] * self.dt, self.der[k + 1] * self.dt);
+        let (y0, y1, d0, d1) = (
+            self.val[k],
+            self.val[k + 1],
+            self.der[k] * self.dt,
+            self.der[k + 1] * self.dt,
+        );
         let (u2, u3) = (u * u, u * u * u);
-        let v = (2.0 * u3 - 3.0 * u2 + 1.0) * y0 + (u3 - 2.0 * u2 + u) * d0 + (-2.0 * u3 + 3.0 * u2) * y1 + (u3 - u2) * d1;
-        let dv = ((6.0 * u2 - 6.0 * u) * y0 + (3.0 * u2 - 4.0 * u + 1.0) * d0 + (-6.0 * u2 + 6.0 * u) * y1 + (3.0 * u2 - 2.0 * u) * d1) / self.dt;
+        let v = (2.0 * u3 - 3.0 * u2 + 1.0) * y0
+            + (u3 - 2.0 * u2 + u) * d0
+            + (-2.0 * u3 + 3.0 * u2) * y1
+            + (u3 - u2) * d1;
+        let dv = ((6.0 * u2 - 6.0 * u) * y0
+            + (3.0 * u2 - 4.0 * u + 1.0) * d0
+            + (-6.0 * u2 + 6.0 * u) * y1
+            + (3.0 * u2 - 2.0 * u) * d1)
+            / self.dt;
         (v, dv)
     }
 }
@@ -120,8 +132,15 @@ impl OdeSystem for Driven<'_> {
             return;
         }
         let j = self.model.jacobian_dense(&self.p, &x, t);
-        let need_p = self.columns.iter().any(|c| matches!(c, Column::Param { .. }));
-        let jp = if need_p { self.model.param_jacobian_dense(&self.p, &x, t) } else { Vec::new() };
+        let need_p = self
+            .columns
+            .iter()
+            .any(|c| matches!(c, Column::Param { .. }));
+        let jp = if need_p {
+            self.model.param_jacobian_dense(&self.p, &x, t)
+        } else {
+            Vec::new()
+        };
         for (k, c) in self.columns.iter().enumerate() {
             let s = &xa[nz + k * nz..nz + (k + 1) * nz];
             let o = &mut out[nz + k * nz..nz + (k + 1) * nz];
@@ -133,7 +152,14 @@ impl OdeSystem for Driven<'_> {
                 acc += match c {
                     Column::Param { index, scale } => jp[ir + n * index] * scale,
                     Column::Initial { .. } => 0.0,
-                    Column::Input { du, scale } => self.given.iter().zip(du).map(|(g, d)| j[ir + n * g.state] * d).sum::<f64>() * scale,
+                    Column::Input { du, scale } => {
+                        self.given
+                            .iter()
+                            .zip(du)
+                            .map(|(g, d)| j[ir + n * g.state] * d)
+                            .sum::<f64>()
+                            * scale
+                    }
                 };
                 o[r] = acc;
             }
@@ -146,7 +172,15 @@ impl OdeSystem for Driven<'_> {
         let d = self.dim();
         let x = self.full_state(t, &xa[..nz]);
         let mut j = vec![0.0; n * n];
-        self.model.jacobian(&self.p, &x, t, &mut JacSink::Dense { data: &mut j, nrows: n });
+        self.model.jacobian(
+            &self.p,
+            &x,
+            t,
+            &mut JacSink::Dense {
+                data: &mut j,
+                nrows: n,
+            },
+        );
         for b in 0..=self.columns.len() {
             let off = b * nz;
             for (c, &ic) in self.free.iter().enumerate() {

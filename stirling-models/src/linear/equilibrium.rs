@@ -26,7 +26,10 @@ pub struct NewtonOptions {
 
 impl Default for NewtonOptions {
     fn default() -> Self {
-        Self { tol: 1e-8, max_iter: 50 }
+        Self {
+            tol: 1e-8,
+            max_iter: 50,
+        }
     }
 }
 
@@ -63,18 +66,31 @@ pub fn state_scales(model: &dyn Model, x: &[f64]) -> Vec<f64> {
 
 /// Indices of the mass states (empty unless the closure is `full`).
 pub fn mass_states(model: &dyn Model) -> Vec<usize> {
-    model.states().iter().enumerate().filter(|(_, s)| matches!(s.kind, StateKind::Mass(_))).map(|(i, _)| i).collect()
+    model
+        .states()
+        .iter()
+        .enumerate()
+        .filter(|(_, s)| matches!(s.kind, StateKind::Mass(_)))
+        .map(|(i, _)| i)
+        .collect()
 }
 
 /// Solve from the model's own guess.
-pub fn solve(model: &dyn Model, p: &[f64], opts: &NewtonOptions) -> Result<Equilibrium, LinearError> {
+pub fn solve(
+    model: &dyn Model,
+    p: &[f64],
+    opts: &NewtonOptions,
+) -> Result<Equilibrium, LinearError> {
     let mut x0 = vec![0.0; model.n_states()];
     model.equilibrium_guess(p, &mut x0);
     solve_from(model, p, &x0, opts)
 }
 
 fn scaled(f: &[f64], s: &[f64]) -> f64 {
-    f.iter().zip(s).map(|(f, s)| (f / s).abs()).fold(0.0, f64::max)
+    f.iter()
+        .zip(s)
+        .map(|(f, s)| (f / s).abs())
+        .fold(0.0, f64::max)
 }
 
 fn eval(model: &dyn Model, p: &[f64], x: &[f64]) -> Result<Vec<f64>, LinearError> {
@@ -83,12 +99,19 @@ fn eval(model: &dyn Model, p: &[f64], x: &[f64]) -> Result<Vec<f64>, LinearError
     if f.iter().all(|v| v.is_finite()) {
         Ok(f)
     } else {
-        Err(LinearError::NonFinite { what: "right-hand side" })
+        Err(LinearError::NonFinite {
+            what: "right-hand side",
+        })
     }
 }
 
 /// Solve from a given start `x0`; with mass states its total charge is kept.
-pub fn solve_from(model: &dyn Model, p: &[f64], x0: &[f64], opts: &NewtonOptions) -> Result<Equilibrium, LinearError> {
+pub fn solve_from(
+    model: &dyn Model,
+    p: &[f64],
+    x0: &[f64],
+    opts: &NewtonOptions,
+) -> Result<Equilibrium, LinearError> {
     let s = state_scales(model, x0);
     let masses = mass_states(model);
     let charge: f64 = masses.iter().map(|&i| x0[i]).sum();
@@ -98,20 +121,37 @@ pub fn solve_from(model: &dyn Model, p: &[f64], x0: &[f64], opts: &NewtonOptions
     let mut it = 0;
     while r > opts.tol {
         if it == opts.max_iter {
-            return Err(LinearError::NoConvergence { iterations: it, residual: r, tol: opts.tol });
+            return Err(LinearError::NoConvergence {
+                iterations: it,
+                residual: r,
+                tol: opts.tol,
+            });
         }
         it += 1;
-        let dx = newton_step(model, p, &x, &f, &masses, charge).ok_or(LinearError::Singular { iteration: it })?;
+        let dx = newton_step(model, p, &x, &f, &masses, charge)
+            .ok_or(LinearError::Singular { iteration: it })?;
         let (xn, fnew, rn) = line_search(model, p, &x, &dx, &s, r)?;
         x = xn;
         f = fnew;
         r = rn;
     }
     let residual = f.iter().fold(0.0, |m: f64, v| m.max(v.abs()));
-    Ok(Equilibrium { x, residual, scaled_residual: r, iterations: it })
+    Ok(Equilibrium {
+        x,
+        residual,
+        scaled_residual: r,
+        iterations: it,
+    })
 }
 
-fn newton_step(model: &dyn Model, p: &[f64], x: &[f64], f: &[f64], masses: &[usize], charge: f64) -> Option<DVector<f64>> {
+fn newton_step(
+    model: &dyn Model,
+    p: &[f64],
+    x: &[f64],
+    f: &[f64],
+    masses: &[usize],
+    charge: f64,
+) -> Option<DVector<f64>> {
     let n = x.len();
     let mut j = DMatrix::from_vec(n, n, model.jacobian_dense(p, x, 0.0));
     let mut rhs = DVector::from_iterator(n, f.iter().map(|v| -v));
@@ -127,11 +167,22 @@ fn newton_step(model: &dyn Model, p: &[f64], x: &[f64], f: &[f64], masses: &[usi
 
 type Trial = (Vec<f64>, Vec<f64>, f64);
 
-fn line_search(model: &dyn Model, p: &[f64], x: &[f64], dx: &DVector<f64>, s: &[f64], r: f64) -> Result<Trial, LinearError> {
+fn line_search(
+    model: &dyn Model,
+    p: &[f64],
+    x: &[f64],
+    dx: &DVector<f64>,
+    s: &[f64],
+    r: f64,
+) -> Result<Trial, LinearError> {
     let mut lambda = 1.0;
     let mut best: Option<Trial> = None;
     for _ in 0..30 {
-        let xn: Vec<f64> = x.iter().zip(dx.iter()).map(|(a, d)| a + lambda * d).collect();
+        let xn: Vec<f64> = x
+            .iter()
+            .zip(dx.iter())
+            .map(|(a, d)| a + lambda * d)
+            .collect();
         if let Ok(f) = eval(model, p, &xn) {
             let rn = scaled(&f, s);
             if rn < r {
@@ -143,5 +194,7 @@ fn line_search(model: &dyn Model, p: &[f64], x: &[f64], dx: &DVector<f64>, s: &[
         }
         lambda *= 0.5;
     }
-    best.ok_or(LinearError::NonFinite { what: "right-hand side along the Newton step" })
+    best.ok_or(LinearError::NonFinite {
+        what: "right-hand side along the Newton step",
+    })
 }

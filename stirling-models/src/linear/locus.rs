@@ -30,17 +30,32 @@ pub fn linspace(from: f64, to: f64, steps: usize) -> Vec<f64> {
     match steps {
         0 => Vec::new(),
         1 => vec![from],
-        k => (0..k).map(|i| from + (to - from) * i as f64 / (k - 1) as f64).collect(),
+        k => (0..k)
+            .map(|i| from + (to - from) * i as f64 / (k - 1) as f64)
+            .collect(),
     }
 }
 
 /// The locus of `param` over `values`, the other parameters as in `p`.
-pub fn locus(model: &dyn Model, p: &[f64], param: &str, values: &[f64], newton: &NewtonOptions) -> Result<Locus, LinearError> {
-    let k = model.param_index(param).ok_or_else(|| LinearError::UnknownParam {
-        name: param.to_string(),
-        model: model.name().to_string(),
-        valid: model.params().iter().map(|p| p.name).collect::<Vec<_>>().join(", "),
-    })?;
+pub fn locus(
+    model: &dyn Model,
+    p: &[f64],
+    param: &str,
+    values: &[f64],
+    newton: &NewtonOptions,
+) -> Result<Locus, LinearError> {
+    let k = model
+        .param_index(param)
+        .ok_or_else(|| LinearError::UnknownParam {
+            name: param.to_string(),
+            model: model.name().to_string(),
+            valid: model
+                .params()
+                .iter()
+                .map(|p| p.name)
+                .collect::<Vec<_>>()
+                .join(", "),
+        })?;
     if values.is_empty() {
         return Err(LinearError::EmptyRange);
     }
@@ -50,7 +65,15 @@ pub fn locus(model: &dyn Model, p: &[f64], param: &str, values: &[f64], newton: 
         q[k] = v;
         crate::params::validate(model, &q).map_err(|e| LinearError::Param(e.to_string()))?;
         let d = dynamic_poles(model, &q, newton)?;
-        points.push(LocusPoint { value: v, poles: d.poles, residual: d.equilibrium.residual });
+        points.push(LocusPoint {
+            value: v,
+            poles: d.poles,
+            residual: d.equilibrium.residual,
+        });
     }
-    Ok(Locus { model: model.name().to_string(), param: param.to_string(), points })
+    Ok(Locus {
+        model: model.name().to_string(),
+        param: param.to_string(),
+        points,
+    })
 }

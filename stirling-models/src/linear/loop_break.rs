@@ -65,16 +65,28 @@ pub fn channel_names(model: &dyn Model, p: &[f64], x: &[f64]) -> Vec<String> {
 }
 
 /// Parse a channel name (`pressure` or a body name).
-pub fn parse_channel(model: &dyn Model, p: &[f64], x: &[f64], name: &str) -> Result<Channel, LinearError> {
+pub fn parse_channel(
+    model: &dyn Model,
+    p: &[f64],
+    x: &[f64],
+    name: &str,
+) -> Result<Channel, LinearError> {
     let unknown = || LinearError::UnknownChannel {
         name: name.to_string(),
         model: model.name().to_string(),
         valid: channel_names(model, p, x).join(", "),
     };
     if name == "pressure" {
-        return pressure_split(model, p, x).map(|_| Channel::Pressure).map_err(|_| unknown());
+        return pressure_split(model, p, x)
+            .map(|_| Channel::Pressure)
+            .map_err(|_| unknown());
     }
-    model.bodies().iter().position(|b| b.name == name).map(Channel::Body).ok_or_else(unknown)
+    model
+        .bodies()
+        .iter()
+        .position(|b| b.name == name)
+        .map(Channel::Body)
+        .ok_or_else(unknown)
 }
 
 /// The default: the common pressure where there is one (it reproduces the seed's Figure 8 for
@@ -84,11 +96,20 @@ pub fn default_channel(model: &dyn Model, p: &[f64], x: &[f64]) -> Channel {
         return Channel::Pressure;
     }
     let bodies = model.bodies();
-    Channel::Body(bodies.iter().position(|b| b.name == "piston").unwrap_or(bodies.len().saturating_sub(1)))
+    Channel::Body(
+        bodies
+            .iter()
+            .position(|b| b.name == "piston")
+            .unwrap_or(bodies.len().saturating_sub(1)),
+    )
 }
 
 fn velocity_index(model: &dyn Model, k: usize) -> usize {
-    model.states().iter().position(|s| s.kind == StateKind::Velocity(k)).expect("every body has a velocity state")
+    model
+        .states()
+        .iter()
+        .position(|s| s.kind == StateKind::Velocity(k))
+        .expect("every body has a velocity state")
 }
 
 fn gradient(model: &dyn Model, k: usize, p: &[f64], x: &[f64]) -> DVector<f64> {
@@ -98,17 +119,26 @@ fn gradient(model: &dyn Model, k: usize, p: &[f64], x: &[f64]) -> DVector<f64> {
 }
 
 /// Break the loop of `j` (the Jacobian at `x`) at `channel`.
-pub fn break_loop(model: &dyn Model, p: &[f64], x: &[f64], j: &DMatrix<f64>, channel: Channel) -> Result<LoopBreak, LinearError> {
+pub fn break_loop(
+    model: &dyn Model,
+    p: &[f64],
+    x: &[f64],
+    j: &DMatrix<f64>,
+    channel: Channel,
+) -> Result<LoopBreak, LinearError> {
     let n = x.len();
     let mut masses = vec![0.0; model.bodies().len()];
     model.body_masses(p, &mut masses);
     let (b, c, name, unit) = match channel {
         Channel::Body(k) => {
-            let body = model.bodies().get(k).ok_or_else(|| LinearError::UnknownChannel {
-                name: format!("body #{k}"),
-                model: model.name().to_string(),
-                valid: channel_names(model, p, x).join(", "),
-            })?;
+            let body = model
+                .bodies()
+                .get(k)
+                .ok_or_else(|| LinearError::UnknownChannel {
+                    name: format!("body #{k}"),
+                    model: model.name().to_string(),
+                    valid: channel_names(model, p, x).join(", "),
+                })?;
             let mut b = DVector::zeros(n);
             b[velocity_index(model, k)] = 1.0 / masses[k];
             (b, gradient(model, k, p, x), body.name.to_string(), "N")
@@ -124,14 +154,31 @@ pub fn break_loop(model: &dyn Model, p: &[f64], x: &[f64], j: &DMatrix<f64>, cha
     };
     let mut a = j.clone();
     a.ger(-1.0, &b, &c, 1.0);
-    Ok(LoopBreak { channel, name, unit, a, b, c })
+    Ok(LoopBreak {
+        channel,
+        name,
+        unit,
+        a,
+        b,
+        c,
+    })
 }
 
 /// For a single-pressure model: the face sums `a_k` (`F_k = a_k P + const`) and `grad P`.
-fn pressure_split(model: &dyn Model, p: &[f64], x: &[f64]) -> Result<(Vec<f64>, DVector<f64>), LinearError> {
-    let not_single = || LinearError::NotSinglePressure { model: model.name().to_string() };
-    let grads: Vec<DVector<f64>> = (0..model.bodies().len()).map(|k| gradient(model, k, p, x)).collect();
-    let r = (0..grads.len()).max_by(|&a, &b| grads[a].norm().total_cmp(&grads[b].norm())).ok_or_else(not_single)?;
+fn pressure_split(
+    model: &dyn Model,
+    p: &[f64],
+    x: &[f64],
+) -> Result<(Vec<f64>, DVector<f64>), LinearError> {
+    let not_single = || LinearError::NotSinglePressure {
+        model: model.name().to_string(),
+    };
+    let grads: Vec<DVector<f64>> = (0..model.bodies().len())
+        .map(|k| gradient(model, k, p, x))
+        .collect();
+    let r = (0..grads.len())
+        .max_by(|&a, &b| grads[a].norm().total_cmp(&grads[b].norm()))
+        .ok_or_else(not_single)?;
     let gr = &grads[r];
     let gg = gr.norm_squared();
     if gg == 0.0 {
@@ -155,10 +202,19 @@ fn pressure_split(model: &dyn Model, p: &[f64], x: &[f64]) -> Result<(Vec<f64>, 
 fn pressure_slope(model: &dyn Model, p: &[f64], x: &[f64], g: &DVector<f64>) -> Option<f64> {
     let d = g / g.norm();
     let s = state_scales(model, x);
-    let h = d.iter().zip(&s).filter(|(di, _)| **di != 0.0).map(|(di, si)| 1e-6 * si / di.abs()).fold(f64::INFINITY, f64::min);
+    let h = d
+        .iter()
+        .zip(&s)
+        .filter(|(di, _)| **di != 0.0)
+        .map(|(di, si)| 1e-6 * si / di.abs())
+        .fold(f64::INFINITY, f64::min);
     let nv = model.vessel_names().len();
     let at = |sign: f64| {
-        let xs: Vec<f64> = x.iter().zip(d.iter()).map(|(a, b)| a + sign * h * b).collect();
+        let xs: Vec<f64> = x
+            .iter()
+            .zip(d.iter())
+            .map(|(a, b)| a + sign * h * b)
+            .collect();
         let (mut pr, mut vol) = (vec![0.0; nv], vec![0.0; nv]);
         model.pv(p, &xs, &mut pr, &mut vol);
         pr

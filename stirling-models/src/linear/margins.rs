@@ -53,19 +53,29 @@ pub fn margins(l: &dyn Fn(f64) -> Complex<f64>, grid: &[f64]) -> Margins {
             let w = refine(&|w| l(w).im, w0, w1, l0.im, l1.im);
             let lw = l(w);
             if lw.re < 0.0 {
-                all_gain.push(GainMargin { gain_db: -20.0 * lw.norm().log10(), phase_crossover_rad_s: w });
+                all_gain.push(GainMargin {
+                    gain_db: -20.0 * lw.norm().log10(),
+                    phase_crossover_rad_s: w,
+                });
             }
         }
         let (g0, g1) = (l0.norm().ln(), l1.norm().ln());
         if g0.signum() != g1.signum() || g1 == 0.0 {
             let w = refine(&|w| l(w).norm().ln(), w0, w1, g0, g1);
-            all_phase.push(PhaseMargin { phase_deg: wrap_deg(180.0 + l(w).arg().to_degrees()), gain_crossover_rad_s: w });
+            all_phase.push(PhaseMargin {
+                phase_deg: wrap_deg(180.0 + l(w).arg().to_degrees()),
+                gain_crossover_rad_s: w,
+            });
         }
     }
     dedup(&mut all_gain, |g| g.phase_crossover_rad_s);
     dedup(&mut all_phase, |p| p.gain_crossover_rad_s);
-    let gm = all_gain.iter().min_by(|a, b| a.gain_db.abs().total_cmp(&b.gain_db.abs()));
-    let pm = all_phase.iter().min_by(|a, b| a.phase_deg.abs().total_cmp(&b.phase_deg.abs()));
+    let gm = all_gain
+        .iter()
+        .min_by(|a, b| a.gain_db.abs().total_cmp(&b.gain_db.abs()));
+    let pm = all_phase
+        .iter()
+        .min_by(|a, b| a.phase_deg.abs().total_cmp(&b.phase_deg.abs()));
     Margins {
         gain_db: gm.map(|g| g.gain_db),
         phase_crossover_rad_s: gm.map(|g| g.phase_crossover_rad_s),
@@ -78,8 +88,10 @@ pub fn margins(l: &dyn Fn(f64) -> Complex<f64>, grid: &[f64]) -> Margins {
 
 fn at_zero(l: &dyn Fn(f64) -> Complex<f64>) -> Option<GainMargin> {
     let l0 = l(0.0);
-    (l0.re.is_finite() && l0.re < 0.0 && l0.im.abs() <= 1e-12 * l0.re.abs())
-        .then(|| GainMargin { gain_db: -20.0 * l0.norm().log10(), phase_crossover_rad_s: 0.0 })
+    (l0.re.is_finite() && l0.re < 0.0 && l0.im.abs() <= 1e-12 * l0.re.abs()).then(|| GainMargin {
+        gain_db: -20.0 * l0.norm().log10(),
+        phase_crossover_rad_s: 0.0,
+    })
 }
 
 /// Angle wrapped into `(-180, 180]` degrees.
@@ -104,7 +116,11 @@ pub fn refine(f: &dyn Fn(f64) -> f64, mut a: f64, mut b: f64, mut fa: f64, mut f
     let mut side = 0;
     for _ in 0..200 {
         let c = (a * fb - b * fa) / (fb - fa);
-        let c = if c.is_finite() && c > a.min(b) && c < a.max(b) { c } else { 0.5 * (a + b) };
+        let c = if c.is_finite() && c > a.min(b) && c < a.max(b) {
+            c
+        } else {
+            0.5 * (a + b)
+        };
         let fc = f(c);
         if fc == 0.0 || (b - a).abs() <= 1e-12 * c.abs() {
             return c;

@@ -27,13 +27,13 @@ use nalgebra::{DMatrix, DVector};
 use serde::{Deserialize, Serialize};
 use stirling_dsl::Model;
 
-/// The matrix crate of the public API (`DMatrix`, `DVector`, `Complex`).
-pub use nalgebra;
 pub use bode::{Bode, Nyquist};
 pub use equilibrium::{Equilibrium, NewtonOptions};
 pub use locus::{Locus, LocusPoint};
 pub use loop_break::{Channel, LoopBreak};
 pub use margins::{GainMargin, Margins, PhaseMargin};
+/// The matrix crate of the public API (`DMatrix`, `DVector`, `Complex`).
+pub use nalgebra;
 pub use poles::Pole;
 pub use reduce::{InventoryMode, Reduction};
 pub use response::FrequencyResponse;
@@ -42,17 +42,29 @@ pub use response::FrequencyResponse;
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum LinearError {
     #[error("equilibrium: Newton did not converge in {iterations} iterations (scaled residual {residual:.3e} 1/s, tolerance {tol:.1e})")]
-    NoConvergence { iterations: usize, residual: f64, tol: f64 },
+    NoConvergence {
+        iterations: usize,
+        residual: f64,
+        tol: f64,
+    },
     #[error("equilibrium: the Newton system is singular at iteration {iteration}")]
     Singular { iteration: usize },
     #[error("non-finite values in the {what}")]
     NonFinite { what: &'static str },
     #[error("loop channel `{name}` does not exist for model `{model}`; valid channels: {valid}")]
-    UnknownChannel { name: String, model: String, valid: String },
+    UnknownChannel {
+        name: String,
+        model: String,
+        valid: String,
+    },
     #[error("channel `pressure` needs a single-pressure model; the bodies of `{model}` see different pressures (choose a body channel)")]
     NotSinglePressure { model: String },
     #[error("unknown parameter `{name}` for model `{model}`; valid parameters: {valid}")]
-    UnknownParam { name: String, model: String, valid: String },
+    UnknownParam {
+        name: String,
+        model: String,
+        valid: String,
+    },
     #[error("the parameter range is empty (use at least one step)")]
     EmptyRange,
     #[error("{0}")]
@@ -73,7 +85,11 @@ pub struct LinearOptions {
 
 impl Default for LinearOptions {
     fn default() -> Self {
-        Self { channel: None, newton: NewtonOptions::default(), per_decade: 100 }
+        Self {
+            channel: None,
+            newton: NewtonOptions::default(),
+            per_decade: 100,
+        }
     }
 }
 
@@ -89,13 +105,22 @@ pub struct DynamicPoles {
 }
 
 /// Steps 1-4: equilibrium, Jacobian, inventory reduction and poles.
-pub fn dynamic_poles(model: &dyn Model, p: &[f64], newton: &NewtonOptions) -> Result<DynamicPoles, LinearError> {
+pub fn dynamic_poles(
+    model: &dyn Model,
+    p: &[f64],
+    newton: &NewtonOptions,
+) -> Result<DynamicPoles, LinearError> {
     let equilibrium = equilibrium::solve(model, p, newton)?;
     let n = model.n_states();
     let jacobian = DMatrix::from_vec(n, n, model.jacobian_dense(p, &equilibrium.x, 0.0));
     let reduction = reduce::reduce(&jacobian, &equilibrium::mass_states(model));
     let poles = poles::poles(&reduction.a)?;
-    Ok(DynamicPoles { equilibrium, jacobian, reduction, poles })
+    Ok(DynamicPoles {
+        equilibrium,
+        jacobian,
+        reduction,
+        poles,
+    })
 }
 
 /// The loop broken at one channel, reduced on the inventory.
@@ -130,7 +155,11 @@ pub struct Linearization {
 }
 
 /// The whole pipeline.
-pub fn linearize(model: &dyn Model, p: &[f64], opts: &LinearOptions) -> Result<Linearization, LinearError> {
+pub fn linearize(
+    model: &dyn Model,
+    p: &[f64],
+    opts: &LinearOptions,
+) -> Result<Linearization, LinearError> {
     let dynamics = dynamic_poles(model, p, &opts.newton)?;
     let x = &dynamics.equilibrium.x;
     let channel = match &opts.channel {
@@ -139,15 +168,40 @@ pub fn linearize(model: &dyn Model, p: &[f64], opts: &LinearOptions) -> Result<L
     };
     let full = loop_break::break_loop(model, p, x, &dynamics.jacobian, channel)?;
     let red = &dynamics.reduction;
-    let (a, b, k) = (red.reduce(&full.a), red.project(&full.b), red.project(&full.k()));
+    let (a, b, k) = (
+        red.reduce(&full.a),
+        red.project(&full.b),
+        red.project(&full.k()),
+    );
     let ol_poles = poles::poles(&a)?;
     let response = FrequencyResponse::new(&a, &b, &k);
-    let open_loop = OpenLoop { full, a, b, k, poles: ol_poles, response };
-    let all: Vec<Pole> = dynamics.poles.iter().chain(&open_loop.poles).copied().collect();
-    let per_decade = if model.n_states() > 400 { opts.per_decade.min(20) } else { opts.per_decade };
+    let open_loop = OpenLoop {
+        full,
+        a,
+        b,
+        k,
+        poles: ol_poles,
+        response,
+    };
+    let all: Vec<Pole> = dynamics
+        .poles
+        .iter()
+        .chain(&open_loop.poles)
+        .copied()
+        .collect();
+    let per_decade = if model.n_states() > 400 {
+        opts.per_decade.min(20)
+    } else {
+        opts.per_decade
+    };
     let grid = bode::frequency_grid(&all, per_decade);
     let margins = margins::margins(&|w| open_loop.at(w), &grid);
-    Ok(Linearization { dynamics, open_loop, grid, margins })
+    Ok(Linearization {
+        dynamics,
+        open_loop,
+        grid,
+        margins,
+    })
 }
 
 impl Linearization {

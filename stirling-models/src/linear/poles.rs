@@ -55,11 +55,15 @@ pub fn eigenvalues(a: &DMatrix<f64>) -> Result<Vec<(f64, f64)>, LinearError> {
         return Ok(Vec::new());
     }
     if a.iter().any(|v| !v.is_finite()) {
-        return Err(LinearError::NonFinite { what: "state matrix" });
+        return Err(LinearError::NonFinite {
+            what: "state matrix",
+        });
     }
     let (b, _) = balance(a);
     let m = Mat::<f64>::from_fn(n, n, |i, j| b[(i, j)]);
-    let ev = m.eigenvalues().map_err(|e| LinearError::Eigen(format!("{e:?}")))?;
+    let ev = m
+        .eigenvalues()
+        .map_err(|e| LinearError::Eigen(format!("{e:?}")))?;
     Ok(ev.into_iter().map(|c| (c.re, c.im)).collect())
 }
 
@@ -76,16 +80,26 @@ pub fn to_poles(mut ev: Vec<(f64, f64)>) -> Vec<Pole> {
         }
     }
     // Symmetrize pairs: average each upper-half eigenvalue with its nearest lower-half partner.
-    let (mut upper, lower): (Vec<_>, Vec<_>) = ev.iter().copied().filter(|e| e.1 != 0.0).partition(|e| e.1 > 0.0);
+    let (mut upper, lower): (Vec<_>, Vec<_>) = ev
+        .iter()
+        .copied()
+        .filter(|e| e.1 != 0.0)
+        .partition(|e| e.1 > 0.0);
     let mut used = vec![false; lower.len()];
     for u in &mut upper {
-        let best = (0..lower.len()).filter(|&k| !used[k]).min_by(|&a, &b| dist(*u, lower[a]).total_cmp(&dist(*u, lower[b])));
+        let best = (0..lower.len())
+            .filter(|&k| !used[k])
+            .min_by(|&a, &b| dist(*u, lower[a]).total_cmp(&dist(*u, lower[b])));
         if let Some(k) = best {
             used[k] = true;
             *u = ((u.0 + lower[k].0) / 2.0, (u.1 - lower[k].1) / 2.0);
         }
     }
-    let mut out: Vec<Pole> = ev.iter().filter(|e| e.1 == 0.0).map(|e| Pole::new(e.0, 0.0)).collect();
+    let mut out: Vec<Pole> = ev
+        .iter()
+        .filter(|e| e.1 == 0.0)
+        .map(|e| Pole::new(e.0, 0.0))
+        .collect();
     for u in upper {
         out.push(Pole::new(u.0, u.1));
         out.push(Pole::new(u.0, -u.1));

@@ -94,33 +94,52 @@ pub struct Reduction {
 impl Reduction {
     /// `T' v`, or `v` without mass states.
     pub fn project(&self, v: &DVector<f64>) -> DVector<f64> {
-        self.basis.as_ref().map_or_else(|| v.clone(), |t| t.project(v))
+        self.basis
+            .as_ref()
+            .map_or_else(|| v.clone(), |t| t.project(v))
     }
 
     /// `T z`, or `z` without mass states.
     pub fn expand(&self, z: &DVector<f64>) -> DVector<f64> {
-        self.basis.as_ref().map_or_else(|| z.clone(), |t| t.expand(z))
+        self.basis
+            .as_ref()
+            .map_or_else(|| z.clone(), |t| t.expand(z))
     }
 
     /// `T' A T` for another matrix on the same states (e.g. the open-loop `A`).
     pub fn reduce(&self, a: &DMatrix<f64>) -> DMatrix<f64> {
-        self.basis.as_ref().map_or_else(|| a.clone(), |t| t.reduce(a))
+        self.basis
+            .as_ref()
+            .map_or_else(|| a.clone(), |t| t.reduce(a))
     }
 }
 
 /// Reduce `j` on `ker c`, `c` = ones on `mass` (no reduction when `mass` is empty).
 pub fn reduce(j: &DMatrix<f64>, mass: &[usize]) -> Reduction {
     if mass.is_empty() {
-        return Reduction { a: j.clone(), basis: None, inventory: None };
+        return Reduction {
+            a: j.clone(),
+            basis: None,
+            inventory: None,
+        };
     }
     let n = j.nrows();
     let basis = KernelBasis::new(n, mass);
     let a = basis.reduce(j);
     let inventory = inventory_mode(j, mass, &basis, &a);
-    Reduction { a, basis: Some(basis), inventory: Some(inventory) }
+    Reduction {
+        a,
+        basis: Some(basis),
+        inventory: Some(inventory),
+    }
 }
 
-fn inventory_mode(j: &DMatrix<f64>, mass: &[usize], basis: &KernelBasis, a: &DMatrix<f64>) -> InventoryMode {
+fn inventory_mode(
+    j: &DMatrix<f64>,
+    mass: &[usize],
+    basis: &KernelBasis,
+    a: &DMatrix<f64>,
+) -> InventoryMode {
     let n = j.nrows();
     let mut c = DVector::zeros(n);
     for &i in mass {

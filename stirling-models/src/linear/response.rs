@@ -23,7 +23,11 @@ impl FrequencyResponse {
         let bb = DVector::from_iterator(b.len(), b.iter().zip(&d).map(|(v, d)| v / d));
         let kb = DVector::from_iterator(k.len(), k.iter().zip(&d).map(|(v, d)| v * d));
         let (q, h) = ab.hessenberg().unpack();
-        Self { h, b: q.tr_mul(&bb), k: q.tr_mul(&kb) }
+        Self {
+            h,
+            b: q.tr_mul(&bb),
+            k: q.tr_mul(&kb),
+        }
     }
 
     /// `L(s)`.
@@ -39,13 +43,22 @@ impl FrequencyResponse {
 }
 
 /// Solve `(s I - H) z = b` for upper Hessenberg `H`.
-fn solve_shifted_hessenberg(h: &DMatrix<f64>, s: Complex<f64>, b: &DVector<f64>) -> Vec<Complex<f64>> {
+fn solve_shifted_hessenberg(
+    h: &DMatrix<f64>,
+    s: Complex<f64>,
+    b: &DVector<f64>,
+) -> Vec<Complex<f64>> {
     let n = h.nrows();
     // Row-major band: row i holds columns lo(i)..n, lo(i) = max(i - 1, 0).
     let lo = |i: usize| i.saturating_sub(1);
     let zero = Complex::new(0.0, 0.0);
-    let mut m: Vec<Vec<Complex<f64>>> =
-        (0..n).map(|i| (lo(i)..n).map(|j| if i == j { s } else { zero } - h[(i, j)]).collect()).collect();
+    let mut m: Vec<Vec<Complex<f64>>> = (0..n)
+        .map(|i| {
+            (lo(i)..n)
+                .map(|j| if i == j { s } else { zero } - h[(i, j)])
+                .collect()
+        })
+        .collect();
     let mut r: Vec<Complex<f64>> = b.iter().map(|&v| Complex::new(v, 0.0)).collect();
     for i in 0..n.saturating_sub(1) {
         let (top, bottom) = m.split_at_mut(i + 1);
@@ -89,7 +102,8 @@ mod tests {
 
     #[test]
     fn matches_a_dense_solve() {
-        let a = DMatrix::from_row_slice(3, 3, &[-1.0, 2.0, 0.5, -3.0, -0.2, 1e3, 0.01, -1e-3, -50.0]);
+        let a =
+            DMatrix::from_row_slice(3, 3, &[-1.0, 2.0, 0.5, -3.0, -0.2, 1e3, 0.01, -1e-3, -50.0]);
         let b = DVector::from_vec(vec![0.0, 1.0, 2.0]);
         let k = DVector::from_vec(vec![1.0, -1.0, 0.3]);
         let fr = FrequencyResponse::new(&a, &b, &k);

@@ -14,8 +14,14 @@ pub fn root_locus(path: &Path, locus: &Locus) -> Result<(), DrawError> {
     let ((x0, x1, y1), out) = frame(locus.points.iter().flat_map(|p| p.poles.iter()));
     let root = SVGBackend::new(path, (800, 600)).into_drawing_area();
     root.fill(&WHITE).map_err(|e| err(e.to_string()))?;
-    let (first, last) = (locus.points.first().map_or(0.0, |p| p.value), locus.points.last().map_or(0.0, |p| p.value));
-    let mut title = format!("{}: root locus over {} = {first} .. {last} (blue -> red)", locus.model, locus.param);
+    let (first, last) = (
+        locus.points.first().map_or(0.0, |p| p.value),
+        locus.points.last().map_or(0.0, |p| p.value),
+    );
+    let mut title = format!(
+        "{}: root locus over {} = {first} .. {last} (blue -> red)",
+        locus.model, locus.param
+    );
     if out > 0 {
         title.push_str(&format!(", {out} stiff poles off frame"));
     }
@@ -33,10 +39,19 @@ pub fn root_locus(path: &Path, locus: &Locus) -> Result<(), DrawError> {
         .draw()
         .map_err(|e| err(e.to_string()))?;
     let shade = RGBColor(255, 210, 210).filled();
-    chart.draw_series(std::iter::once(Rectangle::new([(0.0, -y1), (x1, y1)], shade))).map_err(|e| err(e.to_string()))?;
+    chart
+        .draw_series(std::iter::once(Rectangle::new(
+            [(0.0, -y1), (x1, y1)],
+            shade,
+        )))
+        .map_err(|e| err(e.to_string()))?;
     let axis = BLACK.mix(0.5);
-    chart.draw_series(LineSeries::new([(x0, 0.0), (x1, 0.0)], axis)).map_err(|e| err(e.to_string()))?;
-    chart.draw_series(LineSeries::new([(0.0, -y1), (0.0, y1)], axis)).map_err(|e| err(e.to_string()))?;
+    chart
+        .draw_series(LineSeries::new([(x0, 0.0), (x1, 0.0)], axis))
+        .map_err(|e| err(e.to_string()))?;
+    chart
+        .draw_series(LineSeries::new([(0.0, -y1), (0.0, y1)], axis))
+        .map_err(|e| err(e.to_string()))?;
     let k = locus.points.len().max(2) - 1;
     for (i, pt) in locus.points.iter().enumerate() {
         let t = i as f64 / k as f64;

@@ -6,7 +6,7 @@ pub mod bode;
 pub mod locus;
 /// Pole map with the right half plane shaded (seed Figure 6).
 pub mod poles;
-/// Start-up time response (x, y, pressures against time).
-pub mod timeseries;
 /// PV diagram per vessel over one cycle.
 pub mod pv;
+/// Start-up time response (x, y, pressures against time).
+pub mod timeseries;

@@ -18,17 +18,32 @@ pub struct DrawError {
 
 impl DrawError {
     pub(crate) fn at(path: &Path) -> impl Fn(String) -> DrawError + '_ {
-        move |why| DrawError { path: path.display().to_string(), why }
+        move |why| DrawError {
+            path: path.display().to_string(),
+            why,
+        }
     }
 }
 
 /// The frame `(re_min, re_max, im_max)` holding the slow poles, and the poles outside it.
 pub(crate) fn frame<'a>(poles: impl Iterator<Item = &'a Pole> + Clone) -> ((f64, f64, f64), usize) {
-    let im_max = poles.clone().map(|p| p.im.abs()).fold(0.0, f64::max).max(10.0);
+    let im_max = poles
+        .clone()
+        .map(|p| p.im.abs())
+        .fold(0.0, f64::max)
+        .max(10.0);
     let limit = 5.0 * im_max.max(200.0);
     let inside = |p: &&Pole| p.natural_rad_s <= limit;
-    let re_min = poles.clone().filter(inside).map(|p| p.re).fold(-10.0, f64::min);
-    let re_max = poles.clone().filter(inside).map(|p| p.re).fold(10.0, f64::max);
+    let re_min = poles
+        .clone()
+        .filter(inside)
+        .map(|p| p.re)
+        .fold(-10.0, f64::min);
+    let re_max = poles
+        .clone()
+        .filter(inside)
+        .map(|p| p.re)
+        .fold(10.0, f64::max);
     let out = poles.filter(|p| !inside(p)).count();
     ((re_min * 1.15, re_max * 1.3, im_max * 1.2), out)
 }
@@ -39,7 +54,11 @@ pub fn pole_map(path: &Path, title: &str, closed: &[Pole], open: &[Pole]) -> Res
     let ((x0, x1, y1), out) = frame(closed.iter().chain(open));
     let root = SVGBackend::new(path, (800, 600)).into_drawing_area();
     root.fill(&WHITE).map_err(|e| err(e.to_string()))?;
-    let caption = if out > 0 { format!("{title} ({out} stiff poles left of the frame)") } else { title.to_string() };
+    let caption = if out > 0 {
+        format!("{title} ({out} stiff poles left of the frame)")
+    } else {
+        title.to_string()
+    };
     let mut chart = ChartBuilder::on(&root)
         .caption(caption, ("sans-serif", 20))
         .margin(15)
@@ -54,18 +73,36 @@ pub fn pole_map(path: &Path, title: &str, closed: &[Pole], open: &[Pole]) -> Res
         .draw()
         .map_err(|e| err(e.to_string()))?;
     let shade = RGBColor(255, 210, 210).filled();
-    chart.draw_series(std::iter::once(Rectangle::new([(0.0, -y1), (x1, y1)], shade))).map_err(|e| err(e.to_string()))?;
+    chart
+        .draw_series(std::iter::once(Rectangle::new(
+            [(0.0, -y1), (x1, y1)],
+            shade,
+        )))
+        .map_err(|e| err(e.to_string()))?;
     let axis = BLACK.mix(0.5);
-    chart.draw_series(LineSeries::new([(x0, 0.0), (x1, 0.0)], axis)).map_err(|e| err(e.to_string()))?;
-    chart.draw_series(LineSeries::new([(0.0, -y1), (0.0, y1)], axis)).map_err(|e| err(e.to_string()))?;
+    chart
+        .draw_series(LineSeries::new([(x0, 0.0), (x1, 0.0)], axis))
+        .map_err(|e| err(e.to_string()))?;
+    chart
+        .draw_series(LineSeries::new([(0.0, -y1), (0.0, y1)], axis))
+        .map_err(|e| err(e.to_string()))?;
     let visible = |p: &&Pole| p.re >= x0 && p.im.abs() <= y1;
     chart
-        .draw_series(open.iter().filter(visible).map(|p| Circle::new((p.re, p.im), 6, BLUE.stroke_width(2))))
+        .draw_series(
+            open.iter()
+                .filter(visible)
+                .map(|p| Circle::new((p.re, p.im), 6, BLUE.stroke_width(2))),
+        )
         .map_err(|e| err(e.to_string()))?
         .label("open loop")
         .legend(|(x, y)| Circle::new((x, y), 5, BLUE.stroke_width(2)));
     chart
-        .draw_series(closed.iter().filter(visible).map(|p| Cross::new((p.re, p.im), 7, RED.stroke_width(2))))
+        .draw_series(
+            closed
+                .iter()
+                .filter(visible)
+                .map(|p| Cross::new((p.re, p.im), 7, RED.stroke_width(2))),
+        )
         .map_err(|e| err(e.to_string()))?
         .label("closed loop")
         .legend(|(x, y)| Cross::new((x, y), 5, RED.stroke_width(2)));

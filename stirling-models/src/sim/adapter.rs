@@ -11,8 +11,9 @@
 use std::cell::{Cell, RefCell};
 
 use diffsol::{
-    op::OpStatistics, ConstantOp, FaerContext, FaerSparseMat, FaerVec, Matrix, NalgebraContext, NalgebraMat, NalgebraVec, NonLinearOp,
-    NonLinearOpJacobian, OdeEquations, OdeEquationsRef, Op, UnitCallable, Vector, VectorCommon,
+    op::OpStatistics, ConstantOp, FaerContext, FaerSparseMat, FaerVec, Matrix, NalgebraContext,
+    NalgebraMat, NalgebraVec, NonLinearOp, NonLinearOpJacobian, OdeEquations, OdeEquationsRef, Op,
+    UnitCallable, Vector, VectorCommon,
 };
 use faer::sparse::{Pair, SymbolicSparseColMat};
 
@@ -64,7 +65,9 @@ impl Backend for SparseM {
     }
     fn pattern(sys: &dyn OdeSystem, x0: &[f64]) -> Option<Self::Sparsity> {
         let n = sys.dim();
-        let mut rc = sys.sparsity().unwrap_or_else(|| (0..n).flat_map(|c| (0..n).map(move |r| (r, c))).collect());
+        let mut rc = sys
+            .sparsity()
+            .unwrap_or_else(|| (0..n).flat_map(|c| (0..n).map(move |r| (r, c))).collect());
         let mut trip = Vec::new();
         sys.jac_triplets(0.0, x0, &mut trip);
         rc.extend(trip.iter().map(|&(r, c, _)| (r, c)));
@@ -72,7 +75,11 @@ impl Backend for SparseM {
         rc.sort_unstable();
         rc.dedup();
         let pairs: Vec<Pair<usize, usize>> = rc.into_iter().map(|(r, c)| Pair::new(r, c)).collect();
-        Some(SymbolicSparseColMat::try_new_from_indices(n, n, &pairs).expect("a valid Jacobian pattern").0)
+        Some(
+            SymbolicSparseColMat::try_new_from_indices(n, n, &pairs)
+                .expect("a valid Jacobian pattern")
+                .0,
+        )
     }
     fn fill(eqn: &Eqn<'_, Self>, t: f64, x: &[f64], m: &mut Self) {
         let mut trip = eqn.trip.borrow_mut();
@@ -86,7 +93,12 @@ impl Backend for SparseM {
 
 /// Add triplets into CSC values (sorted rows per column). Panics on an entry
 /// outside the pattern: the structural pattern must cover every Jacobian entry.
-pub(crate) fn scatter(col_ptr: &[usize], row_idx: &[usize], vals: &mut [f64], trip: &[(usize, usize, f64)]) {
+pub(crate) fn scatter(
+    col_ptr: &[usize],
+    row_idx: &[usize],
+    vals: &mut [f64],
+    trip: &[(usize, usize, f64)],
+) {
     for &(r, c, v) in trip {
         let (a, b) = (col_ptr[c], col_ptr[c + 1]);
         match row_idx[a..b].binary_search(&r) {
@@ -114,7 +126,15 @@ pub(crate) struct Eqn<'s, M: Backend> {
 impl<'s, M: Backend> Eqn<'s, M> {
     pub fn new(sys: &'s dyn OdeSystem, y0: Vec<f64>) -> Self {
         let sparsity = M::pattern(sys, &y0);
-        Self { sys, y0, ctx: M::new_ctx(), sparsity, n_rhs: Cell::new(0), n_jac: Cell::new(0), trip: RefCell::new(Vec::new()) }
+        Self {
+            sys,
+            y0,
+            ctx: M::new_ctx(),
+            sparsity,
+            n_rhs: Cell::new(0),
+            n_jac: Cell::new(0),
+            trip: RefCell::new(Vec::new()),
+        }
     }
 }
 

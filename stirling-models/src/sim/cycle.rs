@@ -21,7 +21,12 @@ pub fn periodic(crossings: &[Crossing], scale: &[f64], cycles: usize, tol: f64) 
     let tp = *periods.last()?;
     let same_period = periods.iter().all(|q| (q - tp).abs() <= tol * tp);
     let end = &last[last.len() - 1].x;
-    let same_state = last.iter().all(|c| c.x.iter().zip(end).zip(scale).all(|((a, b), s)| (a - b).abs() <= tol * s));
+    let same_state = last.iter().all(|c| {
+        c.x.iter()
+            .zip(end)
+            .zip(scale)
+            .all(|((a, b), s)| (a - b).abs() <= tol * s)
+    });
     (same_period && same_state).then_some(tp)
 }
 
@@ -49,7 +54,9 @@ pub fn figures(model: &dyn Model, p: &[f64], period: f64, states: &[Vec<f64>]) -
     let xs = pos(0).map(col).unwrap_or_default();
     let ys = pos(1).map(col).unwrap_or_default();
     let pressures: Vec<Vec<f64>> = {
-        let pk: Vec<usize> = (0..kinds.len()).filter(|&i| matches!(kinds[i].kind, StateKind::Pressure(_))).collect();
+        let pk: Vec<usize> = (0..kinds.len())
+            .filter(|&i| matches!(kinds[i].kind, StateKind::Pressure(_)))
+            .collect();
         if pk.is_empty() {
             // algebraic pressure (schmidt): the first vessel of `pv`
             let nv = model.vessel_names().len();
@@ -65,7 +72,10 @@ pub fn figures(model: &dyn Model, p: &[f64], period: f64, states: &[Vec<f64>]) -
             pk.into_iter().map(col).collect()
         }
     };
-    let amp = |s: &[f64]| (s.iter().cloned().fold(f64::MIN, f64::max) - s.iter().cloned().fold(f64::MAX, f64::min)) / 2.0;
+    let amp = |s: &[f64]| {
+        (s.iter().cloned().fold(f64::MIN, f64::max) - s.iter().cloned().fold(f64::MAX, f64::min))
+            / 2.0
+    };
     let phase = (harmonic_phase(&xs) - harmonic_phase(&ys)).to_degrees();
     CycleFigures {
         period,
@@ -132,7 +142,9 @@ pub fn settle(
         .states()
         .iter()
         .position(|s| s.kind == StateKind::Position(1))
-        .ok_or_else(|| super::SimError::BadOption("cycle detection needs the power piston position".into()))?;
+        .ok_or_else(|| {
+            super::SimError::BadOption("cycle detection needs the power piston position".into())
+        })?;
     let scale = state_scale(model, p);
     let mut found = None;
     let mut on_crossing = |c: &[Crossing]| {
@@ -146,11 +158,25 @@ pub fn settle(
             f(t)
         }
     };
-    let hooks = Hooks { crossing: Some(iy), on_crossing: Some(&mut on_crossing), check: Some(&check), progress: Some(&mut prog), on_step: None };
+    let hooks = Hooks {
+        crossing: Some(iy),
+        on_crossing: Some(&mut on_crossing),
+        check: Some(&check),
+        progress: Some(&mut prog),
+        on_step: None,
+    };
     let tr = integrate(&ModelSystem { model, p }, x0, t_max, samples, opts, hooks)?;
     let last = tr.crossings.last().cloned();
     match (found, last) {
-        (Some(period), Some(c)) => Ok(Settled { x0: c.x, t: c.t, period, trajectory: tr }),
-        _ => Err(super::SimError::NotPeriodic { t: tr.t_end, crossings: tr.crossings.len() }),
+        (Some(period), Some(c)) => Ok(Settled {
+            x0: c.x,
+            t: c.t,
+            period,
+            trajectory: tr,
+        }),
+        _ => Err(super::SimError::NotPeriodic {
+            t: tr.t_end,
+            crossings: tr.crossings.len(),
+        }),
     }
 }

@@ -11,7 +11,10 @@
 //! [`OdeSystem::sparsity`] for systems of more than [`SPARSE_THRESHOLD`] states
 //! (by default; `nsection` at n = 1000, 2008 states, needs it).
 
-use diffsol::{error::OdeSolverError, DiffsolError, FaerSparseLU, NalgebraLU, OdeBuilder, OdeSolverMethod, OdeSolverStopReason};
+use diffsol::{
+    error::OdeSolverError, DiffsolError, FaerSparseLU, NalgebraLU, OdeBuilder, OdeSolverMethod,
+    OdeSolverStopReason,
+};
 use serde::Serialize;
 use stirling_dsl::Model;
 
@@ -36,7 +39,13 @@ pub struct SimOptions {
 
 impl Default for SimOptions {
     fn default() -> Self {
-        Self { rtol: 1e-7, atol: 1e-7, min_step: 1e-13, max_steps: 5_000_000, linear_solver: LinearSolverKind::Auto }
+        Self {
+            rtol: 1e-7,
+            atol: 1e-7,
+            min_step: 1e-13,
+            max_steps: 5_000_000,
+            linear_solver: LinearSolverKind::Auto,
+        }
     }
 }
 
@@ -126,19 +135,32 @@ pub struct Hooks<'h> {
     /// Called after every accepted step with `(t_prev, t, dense)`: `dense(s, out)`
     /// writes the state at any `s` in `[t_prev, t]` (the solver's dense output).
     #[allow(clippy::type_complexity)]
-    pub on_step: Option<&'h mut dyn FnMut(f64, f64, &dyn Fn(f64, &mut [f64])) -> Result<(), SimError>>,
+    pub on_step:
+        Option<&'h mut dyn FnMut(f64, f64, &dyn Fn(f64, &mut [f64])) -> Result<(), SimError>>,
 }
 
 /// Uniform sample times `0, dt, .., t_end` (`count + 1` points).
 pub fn uniform_samples(t_end: f64, count: usize) -> Vec<f64> {
-    (0..=count).map(|k| t_end * k as f64 / count.max(1) as f64).collect()
+    (0..=count)
+        .map(|k| t_end * k as f64 / count.max(1) as f64)
+        .collect()
 }
 
 /// Simulate a model from `x0` to `t_end`, sampling at `samples`, rejecting nonphysical states.
-pub fn simulate(model: &dyn Model, p: &[f64], x0: &[f64], t_end: f64, samples: &[f64], opts: &SimOptions) -> Result<Trajectory, SimError> {
+pub fn simulate(
+    model: &dyn Model,
+    p: &[f64],
+    x0: &[f64],
+    t_end: f64,
+    samples: &[f64],
+    opts: &SimOptions,
+) -> Result<Trajectory, SimError> {
     let checker = super::physical::PhysicalCheck::new(model, p);
     let check = |t: f64, x: &[f64]| checker.check(t, x);
-    let hooks = Hooks { check: Some(&check), ..Default::default() };
+    let hooks = Hooks {
+        check: Some(&check),
+        ..Default::default()
+    };
     integrate(&ModelSystem { model, p }, x0, t_end, samples, opts, hooks)
 }
 
@@ -150,7 +172,10 @@ macro_rules! run {
             .rtol($opts.rtol)
             .atol($atol)
             .build_from_eqn(eqn)
-            .map_err(|e| SimError::SolverFailure { t: 0.0, why: e.to_string() })?;
+            .map_err(|e| SimError::SolverFailure {
+                t: 0.0,
+                why: e.to_string(),
+            })?;
         problem.ode_options.min_timestep = $opts.min_step;
         // diffsol counts Newton failures over the whole run, not per step: with the sharp
         // upwind switch of the enthalpy flows they add up on long runs. Step-size collapse
@@ -163,26 +188,67 @@ macro_rules! run {
 }
 
 /// Integrate any system from `x0` at `t = 0` to `t_end`.
-pub fn integrate(sys: &dyn OdeSystem, x0: &[f64], t_end: f64, samples: &[f64], opts: &SimOptions, hooks: Hooks) -> Result<Trajectory, SimError> {
+pub fn integrate(
+    sys: &dyn OdeSystem,
+    x0: &[f64],
+    t_end: f64,
+    samples: &[f64],
+    opts: &SimOptions,
+    hooks: Hooks,
+) -> Result<Trajectory, SimError> {
     if x0.len() != sys.dim() {
-        return Err(SimError::DimensionMismatch { expected: sys.dim(), found: x0.len() });
+        return Err(SimError::DimensionMismatch {
+            expected: sys.dim(),
+            found: x0.len(),
+        });
     }
     if !(t_end > 0.0 && t_end.is_finite()) {
-        return Err(SimError::BadOption(format!("the end time must be positive and finite, found {t_end}")));
+        return Err(SimError::BadOption(format!(
+            "the end time must be positive and finite, found {t_end}"
+        )));
     }
     if let Some(check) = hooks.check {
         check(0.0, x0)?;
     }
     let atol: Vec<f64> = sys.scale().iter().map(|s| opts.atol * s).collect();
-    if opts.linear_solver.use_sparse(sys.dim(), sys.sparsity().is_some()) {
-        run!(SparseM, FaerSparseLU<f64>, sys, x0, t_end, samples, opts, atol, hooks)
+    if opts
+        .linear_solver
+        .use_sparse(sys.dim(), sys.sparsity().is_some())
+    {
+        run!(
+            SparseM,
+            FaerSparseLU<f64>,
+            sys,
+            x0,
+            t_end,
+            samples,
+            opts,
+            atol,
+            hooks
+        )
     } else {
-        run!(DenseM, NalgebraLU<f64>, sys, x0, t_end, samples, opts, atol, hooks)
+        run!(
+            DenseM,
+            NalgebraLU<f64>,
+            sys,
+            x0,
+            t_end,
+            samples,
+            opts,
+            atol,
+            hooks
+        )
     }
 }
 
-
-fn step_loop<'a, 's: 'a, M: Backend, S: OdeSolverMethod<'a, Eqn<'s, M>>>(solver: &mut S, x0: &[f64], t_end: f64, samples: &[f64], opts: &SimOptions, mut hooks: Hooks) -> Result<Trajectory, SimError> {
+fn step_loop<'a, 's: 'a, M: Backend, S: OdeSolverMethod<'a, Eqn<'s, M>>>(
+    solver: &mut S,
+    x0: &[f64],
+    t_end: f64,
+    samples: &[f64],
+    opts: &SimOptions,
+    mut hooks: Hooks,
+) -> Result<Trajectory, SimError> {
     let mut out = Trajectory::default();
     let mut next = 0;
     while next < samples.len() && samples[next] <= 0.0 {
@@ -192,7 +258,9 @@ fn step_loop<'a, 's: 'a, M: Backend, S: OdeSolverMethod<'a, Eqn<'s, M>>>(solver:
     }
     let (mut t_prev, mut x_prev) = (0.0, x0.to_vec());
     let mut stopped = false;
-    let interp = |y: Result<M::V, DiffsolError>, t: f64| -> Result<Vec<f64>, SimError> { y.map(|v| M::slice(&v).to_vec()).map_err(|e| map_err(e, t)) };
+    let interp = |y: Result<M::V, DiffsolError>, t: f64| -> Result<Vec<f64>, SimError> {
+        y.map(|v| M::slice(&v).to_vec()).map_err(|e| map_err(e, t))
+    };
     for _ in 0..opts.max_steps {
         let reason = solver.step().map_err(|e| map_err(e, solver.state().t))?;
         let t = solver.state().t;
@@ -208,7 +276,10 @@ fn step_loop<'a, 's: 'a, M: Backend, S: OdeSolverMethod<'a, Eqn<'s, M>>>(solver:
         if let Some(k) = hooks.crossing {
             if x_prev[k] < 0.0 && x[k] >= 0.0 {
                 let tc = refine_crossing::<M, S>(solver, k, (t_prev, x_prev[k]), (t, x[k]));
-                out.crossings.push(Crossing { t: tc, x: interp(solver.interpolate(tc), t)? });
+                out.crossings.push(Crossing {
+                    t: tc,
+                    x: interp(solver.interpolate(tc), t)?,
+                });
                 if let Some(f) = hooks.on_crossing.as_mut() {
                     if f(&out.crossings) {
                         stopped = true;
@@ -233,7 +304,10 @@ fn step_loop<'a, 's: 'a, M: Backend, S: OdeSolverMethod<'a, Eqn<'s, M>>>(solver:
         }
     }
     if !stopped && t_prev < t_end {
-        return Err(SimError::TooManySteps { t: t_prev, max_steps: opts.max_steps });
+        return Err(SimError::TooManySteps {
+            t: t_prev,
+            max_steps: opts.max_steps,
+        });
     }
     out.t_end = t_prev;
     out.x_end = x_prev;
@@ -250,7 +324,12 @@ fn step_loop<'a, 's: 'a, M: Backend, S: OdeSolverMethod<'a, Eqn<'s, M>>>(solver:
 }
 
 /// Illinois regula falsi on the dense output for the zero of state `k` in `(a, b)`.
-fn refine_crossing<'a, 's: 'a, M: Backend, S: OdeSolverMethod<'a, Eqn<'s, M>>>(solver: &S, k: usize, a: (f64, f64), b: (f64, f64)) -> f64 {
+fn refine_crossing<'a, 's: 'a, M: Backend, S: OdeSolverMethod<'a, Eqn<'s, M>>>(
+    solver: &S,
+    k: usize,
+    a: (f64, f64),
+    b: (f64, f64),
+) -> f64 {
     let (mut ta, mut ga) = a;
     let (mut tb, mut gb) = b;
     let mut side = 0;
@@ -285,14 +364,27 @@ fn refine_crossing<'a, 's: 'a, M: Backend, S: OdeSolverMethod<'a, Eqn<'s, M>>>(s
 
 fn map_err(e: DiffsolError, t: f64) -> SimError {
     match e {
-        DiffsolError::OdeSolverError(OdeSolverError::StepSizeTooSmall { time }) => SimError::StepSizeCollapse { t: time },
-        DiffsolError::OdeSolverError(OdeSolverError::TooManyNonlinearSolverFailures { time, num_failures }) => {
-            SimError::SolverFailure { t: time, why: format!("Newton failed to converge ({num_failures} failures in the run)") }
+        DiffsolError::OdeSolverError(OdeSolverError::StepSizeTooSmall { time }) => {
+            SimError::StepSizeCollapse { t: time }
         }
-        DiffsolError::OdeSolverError(OdeSolverError::TooManyErrorTestFailures { time, num_failures }) => {
-            SimError::SolverFailure { t: time, why: format!("{num_failures} consecutive error-test failures") }
-        }
-        other => SimError::SolverFailure { t, why: other.to_string() },
+        DiffsolError::OdeSolverError(OdeSolverError::TooManyNonlinearSolverFailures {
+            time,
+            num_failures,
+        }) => SimError::SolverFailure {
+            t: time,
+            why: format!("Newton failed to converge ({num_failures} failures in the run)"),
+        },
+        DiffsolError::OdeSolverError(OdeSolverError::TooManyErrorTestFailures {
+            time,
+            num_failures,
+        }) => SimError::SolverFailure {
+            t: time,
+            why: format!("{num_failures} consecutive error-test failures"),
+        },
+        other => SimError::SolverFailure {
+            t,
+            why: other.to_string(),
+        },
     }
 }
 

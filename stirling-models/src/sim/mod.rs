@@ -16,8 +16,8 @@
 mod adapter;
 pub mod cycle;
 pub mod integrate;
-pub mod physical;
 pub mod monodromy;
+pub mod physical;
 pub mod shooting;
 pub mod system;
 pub mod work;
@@ -26,9 +26,15 @@ use serde::Serialize;
 use stirling_dsl::Model;
 
 pub use cycle::{figures, periodic, settle, CycleFigures, Settled};
+pub use integrate::{
+    check_physical, integrate, simulate, uniform_samples, Crossing, Hooks, LinearSolverKind,
+    SimOptions, SolverStats, Trajectory, SPARSE_THRESHOLD,
+};
 pub use physical::PhysicalCheck;
-pub use integrate::{check_physical, integrate, simulate, uniform_samples, Crossing, Hooks, LinearSolverKind, SimOptions, SolverStats, Trajectory, SPARSE_THRESHOLD};
-pub use shooting::{floquet_multipliers, floquet_multipliers_scaled, flow_with_monodromy, flow_with_monodromy_by, shoot, LimitCycle, MonodromyMethod, ShootingOptions};
+pub use shooting::{
+    floquet_multipliers, floquet_multipliers_scaled, flow_with_monodromy, flow_with_monodromy_by,
+    shoot, LimitCycle, MonodromyMethod, ShootingOptions,
+};
 pub use system::{state_scale, EnergySystem, ModelSystem, OdeSystem, VariationalSystem};
 pub use work::{cycle_work, indicated_power, CycleWork};
 
@@ -36,7 +42,11 @@ pub use work::{cycle_work, indicated_power, CycleWork};
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum SimError {
     #[error("nonphysical state at t = {t:.6e} s: {quantity} = {value:.6e}")]
-    Nonphysical { t: f64, quantity: String, value: f64 },
+    Nonphysical {
+        t: f64,
+        quantity: String,
+        value: f64,
+    },
     #[error("step size collapsed below the minimum at t = {t:.6e} s (the solution is singular or leaves the physical range there)")]
     StepSizeCollapse { t: f64 },
     #[error("solver failure at t = {t:.6e} s: {why}")]
@@ -48,7 +58,11 @@ pub enum SimError {
     #[error("no periodic motion by t = {t:.4} s ({crossings} upward piston crossings); run longer or start closer to the cycle")]
     NotPeriodic { t: f64, crossings: usize },
     #[error("shooting failed after {iterations} Newton iterations (scaled residual {residual:.3e}): {why}")]
-    ShootingFailed { iterations: usize, residual: f64, why: String },
+    ShootingFailed {
+        iterations: usize,
+        residual: f64,
+        why: String,
+    },
     #[error("{0}")]
     BadOption(String),
 }
@@ -85,7 +99,15 @@ pub enum Shooting {
 }
 
 /// Settle from `x0` (at most `t_max`), refine by shooting, and measure the cycle.
-pub fn limit_cycle(model: &dyn Model, p: &[f64], x0: &[f64], t_max: f64, samples: &[f64], opts: &SimOptions, progress: Option<&mut dyn FnMut(f64)>) -> Result<LimitCycleReport, SimError> {
+pub fn limit_cycle(
+    model: &dyn Model,
+    p: &[f64],
+    x0: &[f64],
+    t_max: f64,
+    samples: &[f64],
+    opts: &SimOptions,
+    progress: Option<&mut dyn FnMut(f64)>,
+) -> Result<LimitCycleReport, SimError> {
     limit_cycle_with(model, p, x0, t_max, samples, opts, Shooting::Auto, progress)
 }
 
@@ -108,7 +130,13 @@ pub fn limit_cycle_with(
         Shooting::Always => true,
         Shooting::Never => false,
     };
-    let sh = ShootingOptions { sim: SimOptions { linear_solver: opts.linear_solver, ..ShootingOptions::default().sim }, ..ShootingOptions::default() };
+    let sh = ShootingOptions {
+        sim: SimOptions {
+            linear_solver: opts.linear_solver,
+            ..ShootingOptions::default().sim
+        },
+        ..ShootingOptions::default()
+    };
     let n_orbit = 512;
     let (cycle, orbit_run) = if do_shoot {
         let cycle = shoot(model, p, &settled.x0, settled.period, &sh)?;
@@ -119,8 +147,22 @@ pub fn limit_cycle_with(
         let orbit_t = uniform_samples(settled.period, n_orbit);
         let orbit_run = simulate(model, p, &settled.x0, settled.period, &orbit_t, opts)?;
         let s = state_scale(model, p);
-        let residual = orbit_run.x_end.iter().zip(&settled.x0).zip(&s).map(|((a, b), w)| ((a - b) / w).abs()).fold(0.0, f64::max);
-        let cycle = LimitCycle { x0: settled.x0.clone(), period: settled.period, monodromy: vec![], floquet: vec![], iterations: 0, residual, stats: SolverStats::default() };
+        let residual = orbit_run
+            .x_end
+            .iter()
+            .zip(&settled.x0)
+            .zip(&s)
+            .map(|((a, b), w)| ((a - b) / w).abs())
+            .fold(0.0, f64::max);
+        let cycle = LimitCycle {
+            x0: settled.x0.clone(),
+            period: settled.period,
+            monodromy: vec![],
+            floquet: vec![],
+            iterations: 0,
+            residual,
+            stats: SolverStats::default(),
+        };
         (cycle, orbit_run)
     };
     let fig = figures(model, p, cycle.period, &orbit_run.x);
@@ -128,7 +170,14 @@ pub fn limit_cycle_with(
     let mut stats = settled.trajectory.stats;
     stats.add(&cycle.stats);
     stats.add(&orbit_run.stats);
-    Ok(LimitCycleReport { settled, cycle, figures: fig, work, orbit: orbit_run.x, stats })
+    Ok(LimitCycleReport {
+        settled,
+        cycle,
+        figures: fig,
+        work,
+        orbit: orbit_run.x,
+        stats,
+    })
 }
 
 /// Machine-readable summary of a run (the `--json` of `stirling simulate`).
@@ -195,9 +244,17 @@ impl SimSummary {
         self.p_amp = Some(f.p_amp.clone());
         self.phase_deg = Some(f.phase_deg);
         self.work_per_cycle_j = Some(lc.work.total);
-        self.work_per_vessel_j = Some(lc.work.vessels.iter().cloned().zip(lc.work.per_vessel.iter().cloned()).collect());
+        self.work_per_vessel_j = Some(
+            lc.work
+                .vessels
+                .iter()
+                .cloned()
+                .zip(lc.work.per_vessel.iter().cloned())
+                .collect(),
+        );
         self.power_w = Some(indicated_power(lc.work.total, f.frequency_hz));
-        self.floquet = (!lc.cycle.floquet.is_empty()).then(|| lc.cycle.floquet.iter().map(|&(re, im)| [re, im]).collect());
+        self.floquet = (!lc.cycle.floquet.is_empty())
+            .then(|| lc.cycle.floquet.iter().map(|&(re, im)| [re, im]).collect());
         self.steps = lc.stats.steps;
         self.rhs_calls = lc.stats.rhs_calls;
         self.jacobian_calls = lc.stats.jacobian_calls;

@@ -40,8 +40,16 @@ fn radau3() -> ([f64; 3], [[f64; 3]; 3]) {
     let s6 = 6f64.sqrt();
     let c = [(4.0 - s6) / 10.0, (4.0 + s6) / 10.0, 1.0];
     let a = [
-        [(88.0 - 7.0 * s6) / 360.0, (296.0 - 169.0 * s6) / 1800.0, (-2.0 + 3.0 * s6) / 225.0],
-        [(296.0 + 169.0 * s6) / 1800.0, (88.0 + 7.0 * s6) / 360.0, (-2.0 - 3.0 * s6) / 225.0],
+        [
+            (88.0 - 7.0 * s6) / 360.0,
+            (296.0 - 169.0 * s6) / 1800.0,
+            (-2.0 + 3.0 * s6) / 225.0,
+        ],
+        [
+            (296.0 + 169.0 * s6) / 1800.0,
+            (88.0 + 7.0 * s6) / 360.0,
+            (-2.0 - 3.0 * s6) / 225.0,
+        ],
         [(16.0 - s6) / 36.0, (16.0 + s6) / 36.0, 1.0 / 9.0],
     ];
     (c, a)
@@ -62,17 +70,35 @@ impl SparseStage {
         let mut idx = Vec::with_capacity(9 * pattern.len() + 3 * n);
         for bi in 0..3 {
             for bj in 0..3 {
-                idx.extend(pattern.iter().map(|&(r, c)| Pair::new(bi * n + r, bj * n + c)));
+                idx.extend(
+                    pattern
+                        .iter()
+                        .map(|&(r, c)| Pair::new(bi * n + r, bj * n + c)),
+                );
             }
             idx.extend((0..n).map(|k| Pair::new(bi * n + k, bi * n + k)));
         }
-        let bad = |e: String| SimError::SolverFailure { t: 0.0, why: format!("monodromy stage matrix: {e}") };
-        let (sym, _) = SymbolicSparseColMat::try_new_from_indices(3 * n, 3 * n, &idx).map_err(|e| bad(format!("{e:?}")))?;
-        let symbolic = factorize_symbolic_lu(sym.rb(), Default::default()).map_err(|e| bad(format!("{e:?}")))?;
-        let factor_scratch = MemBuffer::new(symbolic.factorize_numeric_lu_scratch::<f64>(Par::Seq, Default::default()));
+        let bad = |e: String| SimError::SolverFailure {
+            t: 0.0,
+            why: format!("monodromy stage matrix: {e}"),
+        };
+        let (sym, _) = SymbolicSparseColMat::try_new_from_indices(3 * n, 3 * n, &idx)
+            .map_err(|e| bad(format!("{e:?}")))?;
+        let symbolic = factorize_symbolic_lu(sym.rb(), Default::default())
+            .map_err(|e| bad(format!("{e:?}")))?;
+        let factor_scratch = MemBuffer::new(
+            symbolic.factorize_numeric_lu_scratch::<f64>(Par::Seq, Default::default()),
+        );
         let solve_scratch = MemBuffer::new(symbolic.solve_in_place_scratch::<f64>(n, Par::Seq));
         let nnz = sym.row_idx().len();
-        Ok(Self { mat: SparseColMat::new(sym, vec![0.0; nnz]), symbolic, numeric: NumericLu::new(), factor_scratch, solve_scratch, rhs: Mat::zeros(3 * n, n) })
+        Ok(Self {
+            mat: SparseColMat::new(sym, vec![0.0; nnz]),
+            symbolic,
+            numeric: NumericLu::new(),
+            factor_scratch,
+            solve_scratch,
+            rhs: Mat::zeros(3 * n, n),
+        })
     }
 }
 
@@ -97,7 +123,11 @@ impl Propagator<'_> {
         let m = self.substeps.max(1);
         for k in 0..m {
             let a = t0 + (t1 - t0) * k as f64 / m as f64;
-            let b = if k + 1 == m { t1 } else { t0 + (t1 - t0) * (k + 1) as f64 / m as f64 };
+            let b = if k + 1 == m {
+                t1
+            } else {
+                t0 + (t1 - t0) * (k + 1) as f64 / m as f64
+            };
             self.radau(a, b, dense)?;
         }
         Ok(())
@@ -114,7 +144,10 @@ impl Propagator<'_> {
             let tj = t0 + c[j] * h;
             dense(tj, &mut self.x);
             if self.x.iter().any(|v| !v.is_finite()) {
-                return Err(SimError::SolverFailure { t: tj, why: "no dense output for the monodromy stage".into() });
+                return Err(SimError::SolverFailure {
+                    t: tj,
+                    why: "no dense output for the monodromy stage".into(),
+                });
             }
             self.trip[j].clear();
             self.sys.jac_triplets(tj, &self.x, &mut self.trip[j]);
@@ -124,7 +157,10 @@ impl Propagator<'_> {
             self.jac_calls += 1;
         }
         self.lu += 1;
-        let fail = |why: String| SimError::SolverFailure { t: t0, why: format!("monodromy step: {why}") };
+        let fail = |why: String| SimError::SolverFailure {
+            t: t0,
+            why: format!("monodromy step: {why}"),
+        };
         if let Some(sp) = self.sparse.as_mut() {
             let (sym, vals) = sp.mat.parts_mut();
             vals.fill(0.0);
@@ -132,7 +168,11 @@ impl Propagator<'_> {
             for i in 0..3 {
                 for j in 0..3 {
                     shifted.clear();
-                    shifted.extend(self.trip[j].iter().map(|&(r, cc, v)| (i * n + r, j * n + cc, -h * a[i][j] * v)));
+                    shifted.extend(
+                        self.trip[j]
+                            .iter()
+                            .map(|&(r, cc, v)| (i * n + r, j * n + cc, -h * a[i][j] * v)),
+                    );
                     scatter(sym.col_ptr(), sym.row_idx(), vals, &shifted);
                 }
                 shifted.clear();
@@ -141,7 +181,13 @@ impl Propagator<'_> {
             }
             let lu = sp
                 .symbolic
-                .factorize_numeric_lu(&mut sp.numeric, sp.mat.rb(), Par::Seq, MemStack::new(&mut sp.factor_scratch), Default::default())
+                .factorize_numeric_lu(
+                    &mut sp.numeric,
+                    sp.mat.rb(),
+                    Par::Seq,
+                    MemStack::new(&mut sp.factor_scratch),
+                    Default::default(),
+                )
                 .map_err(|e| fail(format!("{e:?}")))?;
             for col in 0..n {
                 for i in 0..3 {
@@ -150,7 +196,12 @@ impl Propagator<'_> {
                     }
                 }
             }
-            lu.solve_in_place_with_conj(Conj::No, sp.rhs.as_mut(), Par::Seq, MemStack::new(&mut sp.solve_scratch));
+            lu.solve_in_place_with_conj(
+                Conj::No,
+                sp.rhs.as_mut(),
+                Par::Seq,
+                MemStack::new(&mut sp.solve_scratch),
+            );
             for col in 0..n {
                 for r in 0..n {
                     self.phi[r + col * n] = sp.rhs[(2 * n + r, col)];
@@ -188,19 +239,45 @@ impl Propagator<'_> {
 
 /// The flow `phi(x0, T)` and its monodromy matrix (column-major `n x n`), with
 /// `substeps` Radau IIA steps per accepted BDF step.
-pub fn flow_with_monodromy_radau(model: &dyn Model, p: &[f64], x0: &[f64], period: f64, opts: &SimOptions, substeps: usize) -> Result<(Vec<f64>, Vec<f64>, SolverStats), SimError> {
+pub fn flow_with_monodromy_radau(
+    model: &dyn Model,
+    p: &[f64],
+    x0: &[f64],
+    period: f64,
+    opts: &SimOptions,
+    substeps: usize,
+) -> Result<(Vec<f64>, Vec<f64>, SolverStats), SimError> {
     let n = model.n_states();
     let sys = ModelSystem { model, p };
-    let sparse = if opts.linear_solver.use_sparse(n, true) { Some(SparseStage::new(n, &model.sparsity(p))?) } else { None };
+    let sparse = if opts.linear_solver.use_sparse(n, true) {
+        Some(SparseStage::new(n, &model.sparsity(p))?)
+    } else {
+        None
+    };
     let mut phi = vec![0.0; n * n];
     for k in 0..n {
         phi[k + k * n] = 1.0;
     }
-    let mut prop = Propagator { sys: ModelSystem { model, p }, n, substeps, phi, sparse, trip: Default::default(), x: vec![0.0; n], scale: state_scale(model, p), jac_calls: 0, lu: 0 };
+    let mut prop = Propagator {
+        sys: ModelSystem { model, p },
+        n,
+        substeps,
+        phi,
+        sparse,
+        trip: Default::default(),
+        x: vec![0.0; n],
+        scale: state_scale(model, p),
+        jac_calls: 0,
+        lu: 0,
+    };
     let mut on_step = |t0: f64, t1: f64, dense: &dyn Fn(f64, &mut [f64])| prop.step(t0, t1, dense);
     let checker = super::physical::PhysicalCheck::new(model, p);
     let check = |t: f64, x: &[f64]| checker.check(t, x);
-    let hooks = Hooks { check: Some(&check), on_step: Some(&mut on_step), ..Default::default() };
+    let hooks = Hooks {
+        check: Some(&check),
+        on_step: Some(&mut on_step),
+        ..Default::default()
+    };
     let tr = integrate(&sys, x0, period, &[period], opts, hooks)?;
     let x_end = tr.x.last().cloned().unwrap_or(tr.x_end);
     let mut stats = tr.stats;

@@ -30,10 +30,22 @@ impl<'m> PhysicalCheck<'m> {
         let (mut pr, mut rest) = (vec![0.0; nv], vec![0.0; nv]);
         model.pv(p, &eq, &mut pr, &mut rest);
         let states = model.states();
-        let masses = (0..states.len()).filter(|&i| matches!(states[i].kind, StateKind::Mass(_))).collect();
-        let n_cv = states.iter().filter(|s| matches!(s.kind, StateKind::Pressure(_))).count();
+        let masses = (0..states.len())
+            .filter(|&i| matches!(states[i].kind, StateKind::Mass(_)))
+            .collect();
+        let n_cv = states
+            .iter()
+            .filter(|s| matches!(s.kind, StateKind::Pressure(_)))
+            .count();
         let buffers = RefCell::new((vec![0.0; nv], vec![0.0; nv], vec![0.0; n_cv]));
-        Self { model, p, rest, masses, n_cv, buffers }
+        Self {
+            model,
+            p,
+            rest,
+            masses,
+            n_cv,
+            buffers,
+        }
     }
 
     /// `Ok` if `x` is physical at time `t`.
@@ -55,7 +67,10 @@ impl<'m> PhysicalCheck<'m> {
             }
         }
         if let Some(&i) = self.masses.iter().find(|&&i| !(x[i] > 0.0)) {
-            return bad(format!("gas mass `{}` (kg)", self.model.state_names()[i]), x[i]);
+            return bad(
+                format!("gas mass `{}` (kg)", self.model.state_names()[i]),
+                x[i],
+            );
         }
         if self.n_cv > 0 {
             self.model.temperatures(self.p, x, temp);
@@ -67,7 +82,11 @@ impl<'m> PhysicalCheck<'m> {
     }
 
     fn vessel(&self, i: usize) -> String {
-        self.model.vessel_names().get(i).cloned().unwrap_or_else(|| format!("vessel {i}"))
+        self.model
+            .vessel_names()
+            .get(i)
+            .cloned()
+            .unwrap_or_else(|| format!("vessel {i}"))
     }
 }
 

@@ -47,7 +47,16 @@ pub struct ShootingOptions {
 
 impl Default for ShootingOptions {
     fn default() -> Self {
-        Self { tol: 1e-7, max_iter: 12, sim: SimOptions { rtol: 1e-10, atol: 1e-10, ..SimOptions::default() }, monodromy: MonodromyMethod::default() }
+        Self {
+            tol: 1e-7,
+            max_iter: 12,
+            sim: SimOptions {
+                rtol: 1e-10,
+                atol: 1e-10,
+                ..SimOptions::default()
+            },
+            monodromy: MonodromyMethod::default(),
+        }
     }
 }
 
@@ -88,27 +97,53 @@ pub struct LimitCycle {
 impl LimitCycle {
     /// Distance of the multiplier nearest to 1 from 1 (the trivial multiplier).
     pub fn trivial_multiplier_error(&self) -> f64 {
-        self.floquet.iter().map(|&(re, im)| ((re - 1.0).powi(2) + im * im).sqrt()).fold(f64::MAX, f64::min)
+        self.floquet
+            .iter()
+            .map(|&(re, im)| ((re - 1.0).powi(2) + im * im).sqrt())
+            .fold(f64::MAX, f64::min)
     }
 }
 
 /// The flow `phi(x0, T)` and its monodromy matrix by `method`.
-pub fn flow_with_monodromy_by(model: &dyn Model, p: &[f64], x0: &[f64], period: f64, opts: &SimOptions, method: MonodromyMethod) -> Result<(Vec<f64>, Vec<f64>, SolverStats), SimError> {
+pub fn flow_with_monodromy_by(
+    model: &dyn Model,
+    p: &[f64],
+    x0: &[f64],
+    period: f64,
+    opts: &SimOptions,
+    method: MonodromyMethod,
+) -> Result<(Vec<f64>, Vec<f64>, SolverStats), SimError> {
     match method {
-        MonodromyMethod::Radau { substeps } => flow_with_monodromy_radau(model, p, x0, period, opts, substeps),
+        MonodromyMethod::Radau { substeps } => {
+            flow_with_monodromy_radau(model, p, x0, period, opts, substeps)
+        }
         MonodromyMethod::Variational => flow_with_monodromy_variational(model, p, x0, period, opts),
     }
 }
 
 /// The flow `phi(x0, T)` and its monodromy matrix (the default route).
-pub fn flow_with_monodromy(model: &dyn Model, p: &[f64], x0: &[f64], period: f64, opts: &SimOptions) -> Result<(Vec<f64>, Vec<f64>, SolverStats), SimError> {
+pub fn flow_with_monodromy(
+    model: &dyn Model,
+    p: &[f64],
+    x0: &[f64],
+    period: f64,
+    opts: &SimOptions,
+) -> Result<(Vec<f64>, Vec<f64>, SolverStats), SimError> {
     flow_with_monodromy_by(model, p, x0, period, opts, MonodromyMethod::default())
 }
 
 /// The flow `phi(x0, T)` and its monodromy matrix from the variational system.
-pub fn flow_with_monodromy_variational(model: &dyn Model, p: &[f64], x0: &[f64], period: f64, opts: &SimOptions) -> Result<(Vec<f64>, Vec<f64>, SolverStats), SimError> {
+pub fn flow_with_monodromy_variational(
+    model: &dyn Model,
+    p: &[f64],
+    x0: &[f64],
+    period: f64,
+    opts: &SimOptions,
+) -> Result<(Vec<f64>, Vec<f64>, SolverStats), SimError> {
     let n = model.n_states();
-    let sys = VariationalSystem { inner: ModelSystem { model, p } };
+    let sys = VariationalSystem {
+        inner: ModelSystem { model, p },
+    };
     let mut z0 = x0.to_vec();
     for k in 0..n {
         for r in 0..n {
@@ -117,28 +152,44 @@ pub fn flow_with_monodromy_variational(model: &dyn Model, p: &[f64], x0: &[f64],
     }
     let checker = super::physical::PhysicalCheck::new(model, p);
     let check = |t: f64, z: &[f64]| checker.check(t, &z[..n]);
-    let hooks = Hooks { check: Some(&check), ..Default::default() };
+    let hooks = Hooks {
+        check: Some(&check),
+        ..Default::default()
+    };
     let tr = integrate(&sys, &z0, period, &[period], opts, hooks)?;
     let z = tr.x.last().cloned().unwrap_or(tr.x_end);
     Ok((z[..n].to_vec(), z[n..].to_vec(), tr.stats))
 }
 
 /// Refine a periodic-orbit guess `(x0, period)` by Newton on the return map.
-pub fn shoot(model: &dyn Model, p: &[f64], x0: &[f64], period: f64, opts: &ShootingOptions) -> Result<LimitCycle, SimError> {
+pub fn shoot(
+    model: &dyn Model,
+    p: &[f64],
+    x0: &[f64],
+    period: f64,
+    opts: &ShootingOptions,
+) -> Result<LimitCycle, SimError> {
     let n = model.n_states();
     let kinds = model.states();
     let iy = kinds
         .iter()
         .position(|s| s.kind == StateKind::Position(1))
-        .ok_or_else(|| SimError::BadOption("shooting needs a second body (the power piston) for its section".into()))?;
-    let masses: Vec<usize> = (0..n).filter(|&i| matches!(kinds[i].kind, StateKind::Mass(_))).collect();
+        .ok_or_else(|| {
+            SimError::BadOption(
+                "shooting needs a second body (the power piston) for its section".into(),
+            )
+        })?;
+    let masses: Vec<usize> = (0..n)
+        .filter(|&i| matches!(kinds[i].kind, StateKind::Mass(_)))
+        .collect();
     let s = state_scale(model, p);
     let m_total: f64 = masses.iter().map(|&i| x0[i]).sum();
     let (mut x, mut t_per) = (x0.to_vec(), period);
     let mut stats = SolverStats::default();
     let mut f = vec![0.0; n];
     for it in 1..=opts.max_iter {
-        let (phi, mono, st) = flow_with_monodromy_by(model, p, &x, t_per, &opts.sim, opts.monodromy)?;
+        let (phi, mono, st) =
+            flow_with_monodromy_by(model, p, &x, t_per, &opts.sim, opts.monodromy)?;
         stats.add(&st);
         let r: Vec<f64> = (0..n).map(|i| (phi[i] - x[i]) / s[i]).collect();
         let res = r.iter().fold(0.0f64, |a, v| a.max(v.abs()));
@@ -167,22 +218,53 @@ pub fn shoot(model: &dyn Model, p: &[f64], x0: &[f64], period: f64, opts: &Shoot
         let dz = a
             .svd(true, true)
             .solve(&b, 1e-12)
-            .map_err(|e| SimError::ShootingFailed { iterations: it, residual: res, why: e.to_string() })?;
+            .map_err(|e| SimError::ShootingFailed {
+                iterations: it,
+                residual: res,
+                why: e.to_string(),
+            })?;
         for j in 0..n {
             x[j] += dz[j] * s[j];
         }
         t_per *= 1.0 + dz[n];
         if !(t_per > 0.0) {
-            return Err(SimError::ShootingFailed { iterations: it, residual: res, why: "the period became non-positive".into() });
+            return Err(SimError::ShootingFailed {
+                iterations: it,
+                residual: res,
+                why: "the period became non-positive".into(),
+            });
         }
     }
     let (phi, _, _) = flow_with_monodromy_by(model, p, &x, t_per, &opts.sim, opts.monodromy)?;
-    let res = (0..n).map(|i| ((phi[i] - x[i]) / s[i]).abs()).fold(0.0, f64::max);
-    Err(SimError::ShootingFailed { iterations: opts.max_iter, residual: res, why: "Newton did not converge".into() })
+    let res = (0..n)
+        .map(|i| ((phi[i] - x[i]) / s[i]).abs())
+        .fold(0.0, f64::max);
+    Err(SimError::ShootingFailed {
+        iterations: opts.max_iter,
+        residual: res,
+        why: "Newton did not converge".into(),
+    })
 }
 
-fn finish(x: Vec<f64>, period: f64, mono: Vec<f64>, iterations: usize, residual: f64, stats: SolverStats, n: usize, scale: &[f64]) -> LimitCycle {
-    LimitCycle { floquet: floquet_multipliers_scaled(&mono, n, scale), x0: x, period, monodromy: mono, iterations, residual, stats }
+fn finish(
+    x: Vec<f64>,
+    period: f64,
+    mono: Vec<f64>,
+    iterations: usize,
+    residual: f64,
+    stats: SolverStats,
+    n: usize,
+    scale: &[f64],
+) -> LimitCycle {
+    LimitCycle {
+        floquet: floquet_multipliers_scaled(&mono, n, scale),
+        x0: x,
+        period,
+        monodromy: mono,
+        iterations,
+        residual,
+        stats,
+    }
 }
 
 /// Eigenvalues of `D^-1 Phi D` (`D = diag(scale)`, the same spectrum as `Phi`),
@@ -204,7 +286,11 @@ pub fn floquet_multipliers_scaled(mono: &[f64], n: usize, scale: &[f64]) -> Vec<
 /// Eigenvalues of a column-major `n x n` monodromy matrix, largest modulus first.
 pub fn floquet_multipliers(mono: &[f64], n: usize) -> Vec<(f64, f64)> {
     let m = DMatrix::from_column_slice(n, n, mono);
-    let mut ev: Vec<(f64, f64)> = m.complex_eigenvalues().iter().map(|c| (c.re, c.im)).collect();
+    let mut ev: Vec<(f64, f64)> = m
+        .complex_eigenvalues()
+        .iter()
+        .map(|c| (c.re, c.im))
+        .collect();
     ev.sort_by(|a, b| b.0.hypot(b.1).total_cmp(&a.0.hypot(a.1)));
     ev
 }

@@ -70,7 +70,15 @@ impl OdeSystem for ModelSystem<'_> {
     }
     fn jac(&self, t: f64, x: &[f64], jac: &mut [f64]) {
         let n = self.dim();
-        self.model.jacobian(self.p, x, t, &mut JacSink::Dense { data: jac, nrows: n });
+        self.model.jacobian(
+            self.p,
+            x,
+            t,
+            &mut JacSink::Dense {
+                data: jac,
+                nrows: n,
+            },
+        );
     }
     fn scale(&self) -> Vec<f64> {
         state_scale(self.model, self.p)
@@ -79,7 +87,8 @@ impl OdeSystem for ModelSystem<'_> {
         Some(self.model.sparsity(self.p))
     }
     fn jac_triplets(&self, t: f64, x: &[f64], out: &mut Vec<(usize, usize, f64)>) {
-        self.model.jacobian(self.p, x, t, &mut JacSink::Triplets(out));
+        self.model
+            .jacobian(self.p, x, t, &mut JacSink::Triplets(out));
     }
 }
 

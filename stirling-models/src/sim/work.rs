@@ -25,7 +25,8 @@ pub fn cycle_work(model: &dyn Model, p: &[f64], period: f64, states: &[Vec<f64>]
     let n = states.len().saturating_sub(1).max(1);
     let dt = period / n as f64;
     let mut per_vessel = vec![0.0; nv];
-    let (mut pr, mut v, mut pr2, mut v2) = (vec![0.0; nv], vec![0.0; nv], vec![0.0; nv], vec![0.0; nv]);
+    let (mut pr, mut v, mut pr2, mut v2) =
+        (vec![0.0; nv], vec![0.0; nv], vec![0.0; nv], vec![0.0; nv]);
     let mut f = vec![0.0; model.n_states()];
     for x in states.iter().take(n) {
         model.pv(p, x, &mut pr, &mut v);
@@ -38,7 +39,11 @@ pub fn cycle_work(model: &dyn Model, p: &[f64], period: f64, states: &[Vec<f64>]
         }
     }
     let total = per_vessel.iter().sum();
-    CycleWork { vessels, per_vessel, total }
+    CycleWork {
+        vessels,
+        per_vessel,
+        total,
+    }
 }
 
 /// Indicated power (W) of a cycle of work `w` (J) at `frequency_hz`.

@@ -1,0 +1,268 @@
+//! The self-check: for each effect of the library, rig data with that effect (at one or two
+//! strengths) is diagnosed against the nominal model from perturbed starting parameters; the
+//! withheld effect must rank first, and data with no added effect must give
+//! `no_significant_gap`. The diagnosis sees only the CSV the rig writes (read back from a
+//! temporary file), never the truth sidecar.
+
+use std::time::Instant;
+
+use serde::Serialize;
+
+use super::{diagnose, nominal_model, DiagnoseError, DiagnoseOptions, Diagnosis};
+use crate::data::{read_csv, write_csv};
+use crate::effects::{effect, effects_for};
+use crate::rig::{self, RigConfig};
+
+/// What the self-check runs.
+#[derive(Clone, Debug)]
+pub struct SelfCheckOptions {
+    pub model: String,
+    pub n: Option<usize>,
+    /// Effects to withhold (`None`: all that apply).
+    pub effects: Option<Vec<String>>,
+    /// Strengths as multiples of each effect's typical value.
+    pub strengths: Vec<f64>,
+    pub t_end: f64,
+    pub settle: f64,
+    pub rate: f64,
+    pub seed: u64,
+    /// Relative perturbation of the nominal starting parameters (kd, kp, bd, bp, hh, hk).
+    pub perturb: f64,
+    pub diagnose: DiagnoseOptions,
+}
+
+impl Default for SelfCheckOptions {
+    fn default() -> Self {
+        Self {
+            model: "cv1".into(),
+            n: None,
+            effects: None,
+            strengths: vec![0.5, 1.0],
+            t_end: 1.0,
+            settle: 0.3,
+            rate: 1000.0,
+            seed: 5,
+            perturb: 0.08,
+            diagnose: DiagnoseOptions::default(),
+        }
+    }
+}
+
+/// One case of the self-check.
+#[derive(Clone, Debug, Serialize)]
+pub struct Case {
+    /// The withheld effect (`none` for clean data).
+    pub truth: String,
+    /// Strength as a multiple of the typical value.
+    pub strength: f64,
+    pub settings: Vec<String>,
+    /// `effect` name, `unexplained` or `no_significant_gap`.
+    pub verdict: String,
+    /// Rank of the withheld effect (1 = first), if it was a candidate.
+    pub truth_rank: Option<usize>,
+    pub top: Option<String>,
+    pub closure_fraction: Option<f64>,
+    pub ci_low: Option<f64>,
+    pub ci_high: Option<f64>,
+    /// Fitted parameters of the withheld effect (value, interval) vs truth.
+    pub fitted: Vec<(String, f64, f64, f64, f64)>,
+    pub pass: bool,
+    pub seconds: f64,
+    pub fits: usize,
+    #[serde(skip)]
+    pub diagnosis: Option<Box<Diagnosis>>,
+}
+
+/// The self-check result.
+#[derive(Clone, Debug, Serialize)]
+pub struct SelfCheck {
+    pub model: String,
+    pub cases: Vec<Case>,
+    /// Labels of rows (truth) and columns (verdict).
+    pub labels: Vec<String>,
+    /// `matrix[truth][verdict]` counts; the last two columns are `unexplained` and `no_significant_gap`.
+    pub matrix: Vec<Vec<usize>>,
+    pub columns: Vec<String>,
+    pub passed: usize,
+    pub total: usize,
+    pub seconds: f64,
+}
+
+/// Rig settings for an effect at `m` times its typical strength.
+pub fn settings(name: &str, m: f64) -> Vec<String> {
+    let Some(e) = effect(name) else { return vec![] };
+    let mut out: Vec<String> = e
+        .params
+        .iter()
+        .filter(|q| q.null.is_some())
+        .map(|q| format!("{}={}", q.name, m * q.typical))
+        .collect();
+    if name == "end_stops" {
+        // stops inside the recorded stroke, so that they act
+        out.push("xmax=0.003".into());
+        out.push("ymax=0.0025".into());
+    }
+    out
+}
+
+/// Run the self-check.
+pub fn run(
+    opts: &SelfCheckOptions,
+    mut progress: impl FnMut(&Case),
+) -> Result<SelfCheck, DiagnoseError> {
+    let clock = Instant::now();
+    let names: Vec<String> = match &opts.effects {
+        Some(v) => v.clone(),
+        None => effects_for(&opts.model)
+            .iter()
+            .map(|e| e.name.to_string())
+            .collect(),
+    };
+    let mut plan: Vec<(String, f64)> = vec![("none".into(), 0.0)];
+    for n in &names {
+        for &s in &opts.strengths {
+            plan.push((n.clone(), s));
+        }
+    }
+    let (model, p_nom) = nominal_model(&opts.model, opts.n)?;
+    let mut p0 = p_nom.clone();
+    for (k, (name, sign)) in [
+        ("kd", 1.0),
+        ("kp", -1.0),
+        ("bd", 1.0),
+        ("bp", -1.0),
+        ("hh", 1.0),
+        ("hk", -1.0),
+    ]
+    .iter()
+    .enumerate()
+    {
+        if let Some(i) = model.param_index(name) {
+            p0[i] *= 1.0 + sign * opts.perturb * (1.0 - 0.1 * k as f64);
+        }
+    }
+    let dir = std::env::temp_dir().join(format!("stirling-selfcheck-{}", std::process::id()));
+    std::fs::create_dir_all(&dir)
+        .map_err(|e| DiagnoseError::Bad(format!("cannot create {}: {e}", dir.display())))?;
+    let mut cases = Vec::new();
+    for (k, (truth, strength)) in plan.iter().enumerate() {
+        let t = Instant::now();
+        let set = if truth == "none" {
+            vec![]
+        } else {
+            settings(truth, *strength)
+        };
+        let cfg = RigConfig {
+            model: opts.model.clone(),
+            n: opts.n,
+            effects: set.clone(),
+            t_end: opts.t_end,
+            settle: opts.settle,
+            rate: opts.rate,
+            seed: opts.seed + k as u64,
+            ..Default::default()
+        };
+        let out = rig::run(&cfg).map_err(|e| DiagnoseError::Bad(format!("rig ({truth}): {e}")))?;
+        // only the CSV crosses over: written, then read back like any measured file
+        let path = dir.join(format!("case{k}.csv"));
+        write_csv(&path, &out.data, &[])
+            .map_err(|e| DiagnoseError::Bad(format!("cannot write {}: {e}", path.display())))?;
+        drop(out);
+        let data = read_csv(&path).map_err(|e| DiagnoseError::Bad(e.to_string()))?;
+        let _ = std::fs::remove_file(&path);
+        let d = diagnose(model.as_ref(), &p0, &data, &opts.diagnose)?;
+        let truth_rank = d
+            .ranking
+            .iter()
+            .position(|r| &r.effect == truth)
+            .map(|i| i + 1);
+        let verdict = d
+            .verdict
+            .effect
+            .clone()
+            .filter(|_| d.verdict.verdict == "effect")
+            .unwrap_or_else(|| d.verdict.verdict.clone());
+        let entry = d.ranking.iter().find(|r| &r.effect == truth);
+        let fitted = entry
+            .map(|r| {
+                r.params
+                    .iter()
+                    .map(|q| {
+                        let tv = effect(truth)
+                            .and_then(|e| e.params.iter().find(|p| p.name == q.name))
+                            .map(|p| strength * p.typical)
+                            .unwrap_or(f64::NAN);
+                        (q.name.clone(), tv, q.value, q.ci_low, q.ci_high)
+                    })
+                    .collect()
+            })
+            .unwrap_or_default();
+        let pass = if truth == "none" {
+            verdict == "no_significant_gap"
+        } else {
+            truth_rank == Some(1)
+        };
+        let case = Case {
+            truth: truth.clone(),
+            strength: *strength,
+            settings: set,
+            verdict,
+            truth_rank,
+            top: d.ranking.first().map(|r| r.effect.clone()),
+            closure_fraction: entry.and_then(|r| r.closure_fraction),
+            ci_low: entry.and_then(|r| r.ci_low),
+            ci_high: entry.and_then(|r| r.ci_high),
+            fitted,
+            pass,
+            seconds: t.elapsed().as_secs_f64(),
+            fits: d.fits,
+            diagnosis: Some(Box::new(d)),
+        };
+        progress(&case);
+        cases.push(case);
+    }
+    let _ = std::fs::remove_dir(&dir);
+    let mut labels = vec!["none".to_string()];
+    labels.extend(names.iter().cloned());
+    let mut columns: Vec<String> = names.clone();
+    columns.push("unexplained".into());
+    columns.push("no_significant_gap".into());
+    let mut matrix = vec![vec![0usize; columns.len()]; labels.len()];
+    for c in &cases {
+        let r = labels.iter().position(|l| l == &c.truth).expect("label");
+        let col = columns
+            .iter()
+            .position(|l| l == &c.verdict)
+            .unwrap_or(columns.len() - 2);
+        matrix[r][col] += 1;
+    }
+    Ok(SelfCheck {
+        model: opts.model.clone(),
+        passed: cases.iter().filter(|c| c.pass).count(),
+        total: cases.len(),
+        cases,
+        labels,
+        matrix,
+        columns,
+        seconds: clock.elapsed().as_secs_f64(),
+    })
+}
+
+/// The confusion matrix as a Markdown table.
+pub fn matrix_markdown(sc: &SelfCheck) -> String {
+    let mut s = format!(
+        "| truth \\ verdict | {} |\n|---|{}\n",
+        sc.columns.join(" | "),
+        "---|".repeat(sc.columns.len())
+    );
+    for (l, row) in sc.labels.iter().zip(&sc.matrix) {
+        s += &format!(
+            "| {l} | {} |\n",
+            row.iter()
+                .map(|v| v.to_string())
+                .collect::<Vec<_>>()
+                .join(" | ")
+        );
+    }
+    s
+}

@@ -1,0 +1,64 @@
+//! The verdict: the leading effect, `unexplained`, or `no_significant_gap`.
+//!
+//! - `effect`: the first-ranked candidate was fitted, its score is significant at the
+//!   family-wise level `alpha` (Bonferroni over the candidates), it lowers the held-out BIC,
+//!   and its closure interval lies above `MIN_CLOSURE`;
+//! - `unexplained`: some candidate is significant or lowers the held-out BIC, but none closes
+//!   a significant part of the gap;
+//! - `no_significant_gap`: no candidate is significant and none lowers the held-out BIC: the
+//!   nominal model explains the data as well as any candidate, to the noise level.
+
+use serde::Serialize;
+
+use super::{Eval, RankEntry};
+
+/// The lower closure bound a winner must clear.
+pub const MIN_CLOSURE: f64 = 0.2;
+
+/// The verdict.
+#[derive(Clone, Debug, Serialize)]
+pub struct Verdict {
+    /// `effect`, `unexplained` or `no_significant_gap`.
+    pub verdict: String,
+    /// The leading effect (for `effect`; for `unexplained`, the best candidate tried).
+    pub effect: Option<String>,
+    pub closure_fraction: Option<f64>,
+    pub ci_low: Option<f64>,
+    pub ci_high: Option<f64>,
+    /// Held-out error of the nominal model in noise variances (1: the noise floor).
+    pub gap: f64,
+    pub reason: String,
+}
+
+/// Decide from the ranking.
+pub fn decide(ranking: &[RankEntry], nominal: &Eval, alpha: f64, candidates: usize) -> Verdict {
+    let level = alpha / candidates.max(1) as f64;
+    let significant: Vec<&RankEntry> = ranking.iter().filter(|r| r.p_value < level).collect();
+    let better: Vec<&RankEntry> = ranking
+        .iter()
+        .filter(|r| r.delta_bic.is_some_and(|d| d < 0.0))
+        .collect();
+    let top = ranking.first();
+    let mk = |v: &str, r: Option<&RankEntry>, reason: String| Verdict {
+        verdict: v.into(),
+        effect: r.map(|r| r.effect.clone()),
+        closure_fraction: r.and_then(|r| r.closure_fraction),
+        ci_low: r.and_then(|r| r.ci_low),
+        ci_high: r.and_then(|r| r.ci_high),
+        gap: nominal.holdout_error,
+        reason,
+    };
+    if let Some(t) = top.filter(|t| {
+        t.fitted
+            && t.p_value < level
+            && t.delta_bic.is_some_and(|d| d < 0.0)
+            && t.ci_low.is_some_and(|c| c > MIN_CLOSURE)
+    }) {
+        return mk("effect", Some(t), format!("`{}`: score p = {:.2e} < {:.1e}, held-out BIC change {:.1}, closure {:.2} [{:.2}, {:.2}]", t.effect, t.p_value, level, t.delta_bic.unwrap_or(f64::NAN), t.closure_fraction.unwrap_or(f64::NAN), t.ci_low.unwrap_or(f64::NAN), t.ci_high.unwrap_or(f64::NAN)));
+    }
+    if significant.is_empty() && better.is_empty() {
+        return mk("no_significant_gap", None, format!("no candidate is significant at {level:.1e} and none lowers the held-out BIC (held-out error {:.3} noise variances)", nominal.holdout_error));
+    }
+    let r = top.filter(|t| t.fitted);
+    mk("unexplained", r, format!("{} candidate(s) significant, {} lower the held-out BIC, but none closes more than {MIN_CLOSURE} of the gap with confidence", significant.len(), better.len()))
+}
