@@ -74,7 +74,7 @@ fn case(model: &str, n: Option<usize>, noise: bool, offsets: bool, stage2: bool)
         },
         offset_x: if offsets { 1.5e-3 } else { 0.0 },
         offset_y: if offsets { -2e-3 } else { 0.0 },
-        seed: 11,
+        seed: std::env::var("SEED").ok().and_then(|v| v.parse().ok()).unwrap_or(11),
         ..Default::default()
     };
     let out = rig::run(&cfg).unwrap();
@@ -84,11 +84,14 @@ fn case(model: &str, n: Option<usize>, noise: bool, offsets: bool, stage2: bool)
         .iter()
         .map(|s| s.split_once('=').unwrap().0.to_string())
         .collect();
-    let opts = FitOptions {
+    let mut opts = FitOptions {
         free: Some(free),
         stage2,
         ..Default::default()
     };
+    if let Some(c) = std::env::var("CUT").ok().and_then(|v| v.parse().ok()) {
+        opts.drift_cut = c;
+    }
     let res = fit::identify(m.as_ref(), &p0, &out.data, &opts).unwrap();
     eprintln!("=== {model} {n:?} noise {noise} offsets {offsets}");
     show(&res);
@@ -109,5 +112,6 @@ fn diag_cv1_noisy() {
 #[test]
 #[ignore]
 fn diag_ns_clean() {
-    case("nsection", Some(2), false, false, false);
+    let noisy = std::env::var("NOISY").is_ok();
+    case("nsection", Some(2), noisy, noisy, true);
 }

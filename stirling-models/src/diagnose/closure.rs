@@ -51,7 +51,7 @@ pub fn cycle_starts(data: &Measured, range: (usize, usize)) -> Vec<usize> {
 fn sample_err(ev: &Eval, prof: &Profile, i: usize) -> f64 {
     ev.channels
         .iter()
-        .zip(&ev.resid)
+        .zip(&ev.hp)
         .map(|(c, r)| {
             (r[i]
                 / prof

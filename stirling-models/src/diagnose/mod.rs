@@ -77,7 +77,7 @@ impl Default for DiagnoseOptions {
             holdout: None,
             fit: FitOptions::default(),
             max_fit: 3,
-            newton_iters: 3,
+            newton_iters: 4,
             bootstrap: 400,
             alpha: 0.01,
             seed: 7,
@@ -180,6 +180,9 @@ pub struct Eval {
     /// evaluated range (`NaN` outside it) and the model prediction in measured space.
     pub channels: Vec<String>,
     pub resid: Vec<Vec<f64>>,
+    /// The residuals with their slow part (a centered moving average over one cycle) removed:
+    /// what the costs and errors use.
+    pub hp: Vec<Vec<f64>>,
     pub pred: Vec<Vec<f64>>,
     /// All model parameters after the re-fit.
     pub p: Vec<f64>,
@@ -197,6 +200,33 @@ pub struct Profile<'a> {
     pub hold_idx: (usize, usize),
     /// Count of two-stage fits run.
     pub count: std::cell::Cell<usize>,
+    /// Half-width (samples) of the moving average removed from the residuals (half a cycle).
+    pub half_period: usize,
+}
+
+/// Remove the centered moving average of half-width `h` (over the finite samples), scaled so
+/// that white noise keeps its variance.
+pub fn high_pass(r: &[f64], h: usize) -> Vec<f64> {
+    let n = r.len();
+    let mut cs = vec![0.0; n + 1];
+    let mut cn = vec![0usize; n + 1];
+    for i in 0..n {
+        let ok = r[i].is_finite();
+        cs[i + 1] = cs[i] + if ok { r[i] } else { 0.0 };
+        cn[i + 1] = cn[i] + ok as usize;
+    }
+    let w = (2 * h + 1) as f64;
+    let gain = 1.0 / (1.0 - 1.0 / w).sqrt();
+    (0..n)
+        .map(|i| {
+            if !r[i].is_finite() || h == 0 {
+                return r[i];
+            }
+            let (a, b) = (i.saturating_sub(h), (i + h + 1).min(n));
+            let m = (cs[b] - cs[a]) / (cn[b] - cn[a]).max(1) as f64;
+            gain * (r[i] - m)
+        })
+        .collect()
 }
 
 impl Profile<'_> {
@@ -255,9 +285,10 @@ impl Profile<'_> {
         let dt = data.dt();
         if tau > 0.0 {
             for ch in [data.p.as_mut(), data.p_hot.as_mut()].into_iter().flatten() {
-                let (val, der) = savitzky_golay(ch, dt, 4, 3);
-                for i in 0..ch.len() {
-                    ch[i] = val[i] + tau * der[i];
+                // invert the lag: u = y + tau y' (the derivative from a local cubic fit)
+                let (_, der) = savitzky_golay(ch, dt, 4, 3);
+                for (v, d) in ch.iter_mut().zip(&der) {
+                    *v += tau * d;
                 }
             }
         }
@@ -306,13 +337,14 @@ impl Profile<'_> {
         if channels.is_empty() {
             return Err("the identification produced no output series".into());
         }
+        let hp: Vec<Vec<f64>> = resid.iter().map(|r| high_pass(r, self.half_period)).collect();
         let (mut s_train, mut n_train) = (0.0, 0);
         let sample_err = |range: (usize, usize), acc: Option<&mut f64>| -> Result<f64, String> {
             let (mut sum, mut cnt) = (0.0, 0usize);
             let mut s_acc = 0.0;
             for i in range.0..range.1 {
                 let mut e = 0.0;
-                for (c, r) in channels.iter().zip(&resid) {
+                for (c, r) in channels.iter().zip(&hp) {
                     let z = r[i] / self.noise_of(c);
                     if !z.is_finite() {
                         return Err(format!("no model output for `{c}` at sample {i}"));
@@ -339,6 +371,7 @@ impl Profile<'_> {
             train_error,
             channels,
             resid,
+            hp,
             pred,
             p: p_fit,
         })
@@ -410,6 +443,8 @@ pub fn diagnose(
             p0[i] = 0.97 * a[(a.len() as f64 * 0.995) as usize];
         }
     }
+    let starts = closure::cycle_starts(data, (train_idx.0, hold_idx.1));
+    let half_period = if starts.len() >= 2 { (starts[starts.len() - 1] - starts[0]) / (starts.len() - 1) / 2 } else { 0 };
     let prof = Profile {
         model,
         data,
@@ -417,14 +452,18 @@ pub fn diagnose(
         fit: fit_opts.clone(),
         train_idx,
         hold_idx,
-        count: std::cell::Cell::new(0),
+        count: std::cell::Cell::new(0), half_period,
     };
     let nominal = prof.eval(None, &[], &p0).map_err(DiagnoseError::Nominal)?;
     let p_nom = nominal.p.clone();
     // later fits start at the calibrated point: fewer iterations suffice
     let mut refit = fit_opts.clone();
-    refit.lm.max_iter = refit.lm.max_iter.min(15);
+    refit.lm.max_iter = refit.lm.max_iter.min(30);
     let prof = Profile { fit: refit, ..prof };
+    // the reference for every comparison: the nominal model re-fitted from its calibrated point
+    // with the same protocol as the candidates (same start, same optimizer settings)
+    let nominal = prof.eval(None, &[], &p_nom).map_err(DiagnoseError::Nominal)?;
+    let p_nom = nominal.p.clone();
 
     let base = model.name().trim_end_matches("_fx").to_string();
     let candidates: Vec<&'static EffectInfo> = match &opts.effects {

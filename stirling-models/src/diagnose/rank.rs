@@ -10,7 +10,7 @@
 //! `N_h ln(err_effect / err_nominal) + k ln N_h` (negative: better than the nominal model).
 
 use super::score::{Quad, Screen};
-use super::{DiagnoseOptions, EffectEstimate, Eval, Profile, RankEntry};
+use super::{chi2_sf, DiagnoseOptions, EffectEstimate, Eval, Profile, RankEntry};
 
 fn nearest<'a>(points: &'a [Eval], center: &[f64], scale: &[f64], m: usize) -> Vec<&'a Eval> {
     let mut v: Vec<&Eval> = points.iter().collect();
@@ -150,10 +150,10 @@ pub fn rank(
 ) -> (Vec<RankEntry>, Vec<Screen>) {
     let mut screens: Vec<Screen> = screens.to_vec();
     let m = screens.len().max(1) as f64;
-    let mut order: Vec<usize> = (0..screens.len())
-        .filter(|&i| screens[i].stat.is_finite())
-        .collect();
-    order.sort_by(|&a, &b| screens[b].stat.total_cmp(&screens[a].stat));
+    // candidates whose screen was inconclusive (profile not convex) are fitted first, then by score
+    let key = |s: &Screen| if s.stat.is_finite() { s.stat } else { f64::INFINITY };
+    let mut order: Vec<usize> = (0..screens.len()).filter(|&i| !screens[i].points.is_empty()).collect();
+    order.sort_by(|&a, &b| key(&screens[b]).total_cmp(&key(&screens[a])));
     let fit_set: Vec<usize> = order
         .iter()
         .copied()
@@ -189,6 +189,14 @@ pub fn rank(
                         n_h * (best.holdout_error / nominal.holdout_error).ln()
                             + sc.dof as f64 * n_h.ln(),
                     );
+                    if !sc.stat.is_finite() {
+                        // the profile is not convex at the null (fit noise at the design step):
+                        // the likelihood-ratio statistic of the fit, asymptotically equivalent
+                        let lr = ((nominal.s_train - best.s_train) / sc.s2).max(0.0);
+                        entry.score = lr;
+                        entry.p_value = chi2_sf(lr, sc.dof);
+                        entry.note = Some("score: profiled cost not convex at the null; likelihood-ratio statistic used".into());
+                    }
                 }
                 Err(e) => entry.note = Some(e),
             }

@@ -20,6 +20,11 @@ use nalgebra::{DMatrix, DVector};
 use super::{chi2_sf, Eval, Profile};
 use crate::effects::{EffectInfo, EffectTarget};
 
+/// Design step of the screen, as a fraction of each parameter's typical value: small, so
+/// that the quadratic model at the null is local (the profile is far from quadratic over
+/// strengths that change the engine's behaviour).
+pub const SCREEN_STEP: f64 = 0.05;
+
 /// A quadratic model `S(center + d) = c + g'd + d'Hd/2`.
 #[derive(Clone, Debug)]
 pub struct Quad {
@@ -142,7 +147,7 @@ pub fn bounded(e: &EffectInfo, name: &str) -> bool {
 pub fn screen(prof: &Profile, e: &'static EffectInfo, nominal: &Eval, n_free: usize) -> Screen {
     let qs = Profile::strengths(e);
     let k = qs.len();
-    let step: Vec<f64> = qs.iter().map(|q| 0.25 * q.typical).collect();
+    let step: Vec<f64> = qs.iter().map(|q| SCREEN_STEP * q.typical).collect();
     let bnd: Vec<bool> = qs.iter().map(|q| bounded(e, q.name)).collect();
     let s2 = nominal.s_train / (nominal.n_train.saturating_sub(n_free)).max(1) as f64;
     let mut null = nominal.clone();
@@ -179,6 +184,11 @@ pub fn screen(prof: &Profile, e: &'static EffectInfo, nominal: &Eval, n_free: us
             }
         }
     }
+    if std::env::var_os("STIRLING_DIAGNOSE_DEBUG").is_some() {
+        for p in &sc.points {
+            eprintln!("screen {} theta {:?}: S {:.3} (n {}), holdout {:.4}", e.name, p.theta, p.s_train, p.n_train, p.holdout_error);
+        }
+    }
     let pts: Vec<&Eval> = sc.points.iter().collect();
     let Some(q) = Quad::fit(&pts, &vec![0.0; k], &step) else {
         sc.note = Some("too few points for the quadratic model".into());
@@ -186,7 +196,7 @@ pub fn screen(prof: &Profile, e: &'static EffectInfo, nominal: &Eval, n_free: us
     };
     let form = q.quad_form(&bnd, true);
     // l = -S/(2 s2): g' I^-1 g = (dS' H_S^-1 dS) / (2 s2)
-    sc.stat = (form / (2.0 * s2)).max(0.0);
+    sc.stat = if form.is_finite() { (form / (2.0 * s2)).max(0.0) } else { f64::NAN };
     if !sc.stat.is_finite() {
         sc.note = Some("the profiled cost is not convex at the null".into());
         sc.stat = f64::NAN;

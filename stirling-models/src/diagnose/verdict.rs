@@ -1,7 +1,7 @@
 //! The verdict: the leading effect, `unexplained`, or `no_significant_gap`.
 //!
 //! - `effect`: the first-ranked candidate was fitted, its score is significant at the
-//!   family-wise level `alpha` (Bonferroni over the candidates), it lowers the held-out BIC,
+//!   family-wise level `alpha` (Bonferroni over the candidates), it lowers the held-out BIC by more than 10,
 //!   and its closure interval lies above `MIN_CLOSURE`;
 //! - `unexplained`: some candidate is significant or lowers the held-out BIC, but none closes
 //!   a significant part of the gap;
@@ -14,6 +14,8 @@ use super::{Eval, RankEntry};
 
 /// The lower closure bound a winner must clear.
 pub const MIN_CLOSURE: f64 = 0.2;
+/// The held-out BIC change that counts as an improvement ("strong evidence", Kass-Raftery).
+pub const STRONG_BIC: f64 = -10.0;
 
 /// The verdict.
 #[derive(Clone, Debug, Serialize)]
@@ -36,7 +38,7 @@ pub fn decide(ranking: &[RankEntry], nominal: &Eval, alpha: f64, candidates: usi
     let significant: Vec<&RankEntry> = ranking.iter().filter(|r| r.p_value < level).collect();
     let better: Vec<&RankEntry> = ranking
         .iter()
-        .filter(|r| r.delta_bic.is_some_and(|d| d < 0.0))
+        .filter(|r| r.delta_bic.is_some_and(|d| d < STRONG_BIC))
         .collect();
     let top = ranking.first();
     let mk = |v: &str, r: Option<&RankEntry>, reason: String| Verdict {
@@ -51,7 +53,7 @@ pub fn decide(ranking: &[RankEntry], nominal: &Eval, alpha: f64, candidates: usi
     if let Some(t) = top.filter(|t| {
         t.fitted
             && t.p_value < level
-            && t.delta_bic.is_some_and(|d| d < 0.0)
+            && t.delta_bic.is_some_and(|d| d < STRONG_BIC)
             && t.ci_low.is_some_and(|c| c > MIN_CLOSURE)
     }) {
         return mk("effect", Some(t), format!("`{}`: score p = {:.2e} < {:.1e}, held-out BIC change {:.1}, closure {:.2} [{:.2}, {:.2}]", t.effect, t.p_value, level, t.delta_bic.unwrap_or(f64::NAN), t.closure_fraction.unwrap_or(f64::NAN), t.ci_low.unwrap_or(f64::NAN), t.ci_high.unwrap_or(f64::NAN)));

@@ -136,6 +136,9 @@ pub struct Stage<'a> {
     /// (carried by the offsets). The projection is exact least squares with `drift` nuisance
     /// coefficients per output, so the statistics lose `drift` degrees of freedom per output.
     pub drift: usize,
+    /// Noise on the prescribed inputs: `(signal, standard deviation of the raw samples,
+    /// Savitzky-Golay half-width the signal was smoothed with)`; see [`Stage::input_noise_cov`].
+    pub input_noise: Vec<(usize, f64, usize)>,
 }
 
 /// Remove the cosines `k = 1..=m` (DCT-II, orthogonal on the uniform grid) from `v`.
@@ -161,12 +164,23 @@ pub fn drift_count(n: usize, dt: f64, f_cut: f64) -> usize {
     ((2.0 * n as f64 * dt * f_cut).floor() as usize).min(n / 4)
 }
 
-/// Cycle frequency (Hz) from the upward crossings of the mean (`None`: fewer than 2 cycles).
+/// Cycle frequency (Hz) from the upward crossings of the mean, with a hysteresis of half the
+/// standard deviation so that noise cannot add crossings (`None`: fewer than 2 cycles).
 pub fn cycle_frequency(y: &[f64], dt: f64) -> Option<f64> {
-    let m = y.iter().sum::<f64>() / y.len().max(1) as f64;
-    let ups: Vec<usize> = (1..y.len())
-        .filter(|&i| y[i - 1] < m && y[i] >= m)
-        .collect();
+    let n = y.len().max(1) as f64;
+    let m = y.iter().sum::<f64>() / n;
+    let sd = (y.iter().map(|v| (v - m) * (v - m)).sum::<f64>() / n).sqrt();
+    let (lo, hi) = (m - 0.5 * sd, m + 0.5 * sd);
+    let mut armed = false;
+    let mut ups = Vec::new();
+    for (i, &v) in y.iter().enumerate() {
+        if v < lo {
+            armed = true;
+        } else if armed && v > hi {
+            armed = false;
+            ups.push(i);
+        }
+    }
     if ups.len() < 3 {
         return None;
     }
@@ -298,6 +312,58 @@ impl Stage<'_> {
             }
         }
         Ok(StageRun { first, yhat, dyhat })
+    }
+
+    /// Covariance of the fit variables `u` caused by the noise on the prescribed inputs
+    /// (errors in variables), by Monte Carlo: `draws` noise records (the estimated standard
+    /// deviation, white, smoothed like the signal) are added to the inputs, each moves the
+    /// weighted residuals by `dr` (the drift band projected out as in the fit), and the
+    /// first-order estimate moves by `-(J^T J)^-1 J^T dr`; returns the sample covariance of
+    /// those moves (`None` without input noise).
+    pub fn input_noise_cov(&self, u: &[f64], first: usize, last: usize, keep: &[usize], j: &DMatrix<f64>, draws: usize, seed: u64) -> Result<Option<DMatrix<f64>>, FitError> {
+        use rand::{rngs::StdRng, Rng, SeedableRng};
+        if self.input_noise.is_empty() || draws == 0 {
+            return Ok(None);
+        }
+        let nv = self.vars.len();
+        let jtj = j.transpose() * j;
+        let Some(inv) = jtj.clone().try_inverse() else { return Ok(None) };
+        let base = self.run(u, first, last, false)?;
+        let mut rng = StdRng::seed_from_u64(seed);
+        let mut gauss = move || {
+            let u1: f64 = 1.0 - rng.gen::<f64>();
+            let u2: f64 = rng.gen::<f64>();
+            (-2.0 * u1.ln()).sqrt() * (2.0 * std::f64::consts::PI * u2).cos()
+        };
+        let mut acc = DMatrix::zeros(nv, nv);
+        let mut noisy = Stage { signals: self.signals.clone(), given: self.given.clone(), vars: self.vars.clone(), outputs: self.outputs.clone(), z0: self.z0.clone(), p: self.p.clone(), base: self.base.clone(), free: self.free.clone(), input_noise: Vec::new(), ..*self };
+        for _ in 0..draws {
+            for &(s, sd, h) in &self.input_noise {
+                let e: Vec<f64> = (0..self.signals[s].val.len()).map(|_| sd * gauss()).collect();
+                let (ev, ed) = savitzky_golay(&e, self.dt, h, 4);
+                let sig = &mut noisy.signals[s];
+                for k in 0..ev.len() {
+                    sig.val[k] = self.signals[s].val[k] + ev[k];
+                    sig.der[k] = self.signals[s].der[k] + ed[k];
+                }
+            }
+            let run = noisy.run(u, first, last, false)?;
+            let mut dr = Vec::with_capacity(keep.len() * self.outputs.len());
+            for (o, out) in self.outputs.iter().enumerate() {
+                let start = dr.len();
+                for &i in keep {
+                    let k = i - first;
+                    dr.push((run.yhat[o][k] - base.yhat[o][k]) / out.sigma);
+                }
+                if self.drift > 0 {
+                    project_drift(&mut dr[start..], self.drift);
+                }
+            }
+            let g = j.transpose() * DVector::from_vec(dr);
+            let du = &inv * g;
+            acc += &du * du.transpose();
+        }
+        Ok(Some(acc / draws as f64))
     }
 
     /// Weighted residuals and Jacobian on the sample indices `keep` (within `first..=last`).

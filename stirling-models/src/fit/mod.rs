@@ -22,7 +22,7 @@ use driven::{
     cold_weight, noise_sigma, pressure_states, savitzky_golay, split_states, static_shift, Output,
     Stage, Var, VarKind,
 };
-use report::{fit_percent, stats, ChannelFit, FitStats};
+use report::{fit_percent, ChannelFit, FitStats};
 use sensitivity::{Given, Signal};
 
 /// Why a fit failed.
@@ -55,6 +55,9 @@ pub struct FitOptions {
     /// Run stage 1 / stage 2.
     pub stage1: bool,
     pub stage2: bool,
+    /// Stage 1: sub-cycle drift band projected out of the residuals, as a fraction of the
+    /// cycle frequency (see [`driven::Stage::drift`]; 0: none).
+    pub drift_cut: f64,
 }
 
 impl Default for FitOptions {
@@ -78,6 +81,7 @@ impl Default for FitOptions {
             },
             stage1: true,
             stage2: true,
+            drift_cut: 0.5,
         }
     }
 }
@@ -251,7 +255,17 @@ fn fit_stage(
         .collect();
     let init: Vec<f64> = stage.vars.iter().map(|v| v.initial).collect();
     let scale: Vec<f64> = stage.vars.iter().map(|v| v.scale).collect();
-    let st = stats(&names, &init, &scale, &res.x, &res.residuals, &res.jacobian);
+    let extra = stage.input_noise_cov(&res.x, train.0, train.1, &keep, &res.jacobian, 40, 0x5eed)?;
+    let st = report::stats_full(
+        &names,
+        &init,
+        &scale,
+        &res.x,
+        &res.residuals,
+        &res.jacobian,
+        stage.drift * stage.outputs.len(),
+        extra.as_ref(),
+    );
     // evaluation over train and holdout (one run from the training start when possible)
     let end = hold.map(|h| h.1.max(train.1)).unwrap_or(train.1);
     let mut fits = Vec::new();
@@ -276,7 +290,21 @@ fn fit_stage(
     for (block, idx, r) in &blocks {
         for (o, out) in stage.outputs.iter().enumerate() {
             let y: Vec<f64> = idx.iter().map(|&i| out.data[i]).collect();
-            let yh: Vec<f64> = idx.iter().map(|&i| r.yhat[o][i - r.first]).collect();
+            let mut yh: Vec<f64> = idx.iter().map(|&i| r.yhat[o][i - r.first]).collect();
+            let raw = fit_percent(&y, &yh);
+            if stage.drift > 0 {
+                // the sub-cycle drift the fit ignores (the wander driven by input noise) is
+                // removed from the model error on this block too, in the same band
+                let m = (stage.drift as f64 * y.len() as f64 / keep.len() as f64).round() as usize;
+                let mut e: Vec<f64> = y.iter().zip(&yh).map(|(a, b)| b - a).collect();
+                if *block != "train" {
+                    // the training block's mean is carried by the fitted offsets
+                    let mean = e.iter().sum::<f64>() / e.len().max(1) as f64;
+                    e.iter_mut().for_each(|v| *v -= mean);
+                }
+                driven::project_drift(&mut e, m);
+                yh = y.iter().zip(&e).map(|(a, b)| a + b).collect();
+            }
             let rms = (y
                 .iter()
                 .zip(&yh)
@@ -288,6 +316,7 @@ fn fit_stage(
                 channel: out.channel.clone(),
                 block: block.to_string(),
                 fit_percent: fit_percent(&y, &yh),
+                fit_percent_raw: raw,
                 rms,
                 samples: y.len(),
             });
@@ -473,7 +502,18 @@ pub fn identify(
                 sigma: noise_sigma(ym).max(1e-9),
             },
         ];
+        let f0 = driven::cycle_frequency(&ym[tr.0..=tr.1], dt)
+            .or_else(|| driven::cycle_frequency(&xm[tr.0..=tr.1], dt))
+            .unwrap_or(0.0);
+        let drift = driven::drift_count(tr.1 - tr.0 + 1, dt, opts.drift_cut * f0);
+        if std::env::var_os("STIRLING_FIT_DEBUG").is_some() {
+            eprintln!("stage 1: cycle frequency {f0:.3} Hz, {drift} drift cosines per output");
+        }
         let stage = Stage {
+            drift,
+            input_noise: std::iter::once((0, noise_sigma(data.p.as_ref().expect("checked")), (h / 2).max(3)))
+                .chain(data.p_hot.as_ref().filter(|_| have_hot).map(|v| (1, noise_sigma(v), (h / 2).max(3))))
+                .collect(),
             name: "stage 1 (mechanics driven by measured pressure)",
             model,
             p: p.clone(),
@@ -634,6 +674,8 @@ pub fn identify(
         let z0: Vec<f64> = gas_states.iter().map(|&i| x_start[i]).collect();
         let burn = ((opts.burn_in / dt).round() as usize).min(tr.1 - tr.0 - 5);
         let stage = Stage {
+            drift: 0,
+            input_noise: vec![(0, noise_sigma(xm), h), (1, noise_sigma(ym), h)],
             name: "stage 2 (gas driven by measured displacements)",
             model,
             p: p.clone(),

@@ -29,7 +29,12 @@ impl Estimate {
 pub struct ChannelFit {
     pub channel: String,
     pub block: String,
+    /// Fit percentage of the model output; in a stage fitted with a drift band projected
+    /// out ([`super::driven::Stage::drift`]), of the output with that band of the error
+    /// removed (the criterion's view).
     pub fit_percent: f64,
+    /// Fit percentage of the raw model output (equal to `fit_percent` without a drift band).
+    pub fit_percent_raw: f64,
     pub rms: f64,
     pub samples: usize,
 }
@@ -83,6 +88,22 @@ pub fn stats_with_nuisance(
     j: &DMatrix<f64>,
     nuisance: usize,
 ) -> FitStats {
+    stats_full(names, initial, scale, u, r, j, nuisance, None)
+}
+
+/// [`stats_with_nuisance`] plus `extra`, a further covariance of `u` (e.g. from the noise on
+/// prescribed inputs, which the residual variance does not see: see
+/// [`super::driven::Stage::input_noise_cov`]), added to `s^2 (J^T J)^-1`.
+pub fn stats_full(
+    names: &[(String, bool)],
+    initial: &[f64],
+    scale: &[f64],
+    u: &[f64],
+    r: &[f64],
+    j: &DMatrix<f64>,
+    nuisance: usize,
+    extra: Option<&DMatrix<f64>>,
+) -> FitStats {
     let (nr, k) = (r.len(), u.len());
     let rss: f64 = r.iter().map(|v| v * v).sum();
     let sigma2 = rss / (nr.saturating_sub(k + nuisance)).max(1) as f64;
@@ -94,7 +115,9 @@ pub fn stats_with_nuisance(
         .clone()
         .try_inverse()
         .unwrap_or_else(|| scaled.clone().pseudo_inverse(1e-14).expect("svd"));
-    let cov = DMatrix::from_fn(k, k, |a, b| sigma2 * inv[(a, b)] / (d[a] * d[b]));
+    let cov = DMatrix::from_fn(k, k, |a, b| {
+        sigma2 * inv[(a, b)] / (d[a] * d[b]) + extra.map_or(0.0, |e| e[(a, b)])
+    });
     let mut estimates = Vec::new();
     for i in 0..k {
         let se = cov[(i, i)].max(0.0).sqrt() * scale[i].abs();
