@@ -66,7 +66,9 @@ impl Default for FitOptions {
             free: None,
             train: None,
             holdout: None,
-            burn_in: 0.03,
+            // the gas's initial temperatures and mass shares are guesses; their transient
+            // lasts several thermal time constants (0.03 s left hh/hk 10 % off on nsection n = 2)
+            burn_in: 0.2,
             smooth: 0.006,
             lm: lm::LmOptions {
                 max_iter: 30,
