@@ -41,7 +41,10 @@ pub fn run(args: &InfoArgs) -> anyhow::Result<()> {
         let dot = stirling_dsl::to_dot(model.topology());
         return match &args.out {
             Some(path) => write_new(path, &dot, args.force),
-            None => Ok(print!("{dot}")),
+            None => {
+                print!("{dot}");
+                Ok(())
+            }
         };
     }
     let style = if args.latex {

@@ -80,8 +80,7 @@ fn dominant_freq(poles: &[Pole]) -> f64 {
         .filter(|p| p.im > 0.0)
         .map(|p| p.im)
         .fold(f64::INFINITY, f64::min)
-        .min(1e6)
-        .max(1e-3)
+        .clamp(1e-3, 1e6)
 }
 
 fn opt(v: Option<f64>, prec: usize) -> String {

@@ -154,10 +154,11 @@ pub struct LinkAst {
     pub fields: Vec<Field>,
 }
 
+#[allow(clippy::large_enum_variant)] // parsed once per item, at compile time
 pub enum Item {
     Name(LitStr),
     Params(Vec<ParamAst>),
-    Let(Ident, Expr),
+    Let(Ident, Box<Expr>),
     Gas(Span, Vec<Field>),
     Body(BodyAst),
     Coupling(CouplingAst),
@@ -207,7 +208,7 @@ fn item(input: ParseStream) -> syn::Result<Item> {
         input.parse::<Token![=]>()?;
         let value = input.parse()?;
         input.parse::<Token![;]>()?;
-        return Ok(Item::Let(name, value));
+        return Ok(Item::Let(name, Box::new(value)));
     }
     let kw: Ident = input.parse()?;
     let item = match kw.to_string().as_str() {

@@ -171,7 +171,7 @@ impl<'t> Assembler<'t> {
     /// `sum coeff * q` and `sum coeff * v` over faces.
     fn face_sums(&mut self, faces: &[super::decl::FaceDecl]) -> (Id, Id) {
         let (mut dv, mut vdot) = (self.t.arena.num(0.0), self.t.arena.num(0.0));
-        for f in faces.to_vec() {
+        for f in faces.iter().cloned() {
             let (q, v) = self.body_syms(f.body);
             let a = &mut self.t.arena;
             let (cq, cv) = (a.mul(f.coeff, q), a.mul(f.coeff, v));

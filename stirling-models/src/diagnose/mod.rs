@@ -58,7 +58,8 @@ pub struct DiagnoseOptions {
     pub holdout: Option<(f64, f64)>,
     /// Options of the underlying two-stage fits.
     pub fit: FitOptions,
-    /// How many of the best-scoring candidates are fitted and ranked (at least the significant ones).
+    /// How many of the best-scoring candidates are fitted and ranked (at least the significant ones;
+    /// default: all, since the profile screen is noisy where the two-stage refit is not idempotent).
     pub max_fit: usize,
     /// Newton iterations on the profiled cost when fitting a candidate.
     pub newton_iters: usize,
@@ -76,7 +77,7 @@ impl Default for DiagnoseOptions {
             train: None,
             holdout: None,
             fit: FitOptions::default(),
-            max_fit: 3,
+            max_fit: 8,
             newton_iters: 4,
             bootstrap: 400,
             alpha: 0.01,
@@ -337,7 +338,10 @@ impl Profile<'_> {
         if channels.is_empty() {
             return Err("the identification produced no output series".into());
         }
-        let hp: Vec<Vec<f64>> = resid.iter().map(|r| high_pass(r, self.half_period)).collect();
+        let hp: Vec<Vec<f64>> = resid
+            .iter()
+            .map(|r| high_pass(r, self.half_period))
+            .collect();
         let (mut s_train, mut n_train) = (0.0, 0);
         let sample_err = |range: (usize, usize), acc: Option<&mut f64>| -> Result<f64, String> {
             let (mut sum, mut cnt) = (0.0, 0usize);
@@ -444,7 +448,11 @@ pub fn diagnose(
         }
     }
     let starts = closure::cycle_starts(data, (train_idx.0, hold_idx.1));
-    let half_period = if starts.len() >= 2 { (starts[starts.len() - 1] - starts[0]) / (starts.len() - 1) / 2 } else { 0 };
+    let half_period = if starts.len() >= 2 {
+        (starts[starts.len() - 1] - starts[0]) / (starts.len() - 1) / 2
+    } else {
+        0
+    };
     let prof = Profile {
         model,
         data,
@@ -452,7 +460,8 @@ pub fn diagnose(
         fit: fit_opts.clone(),
         train_idx,
         hold_idx,
-        count: std::cell::Cell::new(0), half_period,
+        count: std::cell::Cell::new(0),
+        half_period,
     };
     let nominal = prof.eval(None, &[], &p0).map_err(DiagnoseError::Nominal)?;
     let p_nom = nominal.p.clone();
@@ -462,7 +471,9 @@ pub fn diagnose(
     let prof = Profile { fit: refit, ..prof };
     // the reference for every comparison: the nominal model re-fitted from its calibrated point
     // with the same protocol as the candidates (same start, same optimizer settings)
-    let nominal = prof.eval(None, &[], &p_nom).map_err(DiagnoseError::Nominal)?;
+    let nominal = prof
+        .eval(None, &[], &p_nom)
+        .map_err(DiagnoseError::Nominal)?;
     let p_nom = nominal.p.clone();
 
     let base = model.name().trim_end_matches("_fx").to_string();

@@ -151,8 +151,16 @@ pub fn rank(
     let mut screens: Vec<Screen> = screens.to_vec();
     let m = screens.len().max(1) as f64;
     // candidates whose screen was inconclusive (profile not convex) are fitted first, then by score
-    let key = |s: &Screen| if s.stat.is_finite() { s.stat } else { f64::INFINITY };
-    let mut order: Vec<usize> = (0..screens.len()).filter(|&i| !screens[i].points.is_empty()).collect();
+    let key = |s: &Screen| {
+        if s.stat.is_finite() {
+            s.stat
+        } else {
+            f64::INFINITY
+        }
+    };
+    let mut order: Vec<usize> = (0..screens.len())
+        .filter(|&i| !screens[i].points.is_empty())
+        .collect();
     order.sort_by(|&a, &b| key(&screens[b]).total_cmp(&key(&screens[a])));
     let fit_set: Vec<usize> = order
         .iter()

@@ -186,7 +186,10 @@ pub fn screen(prof: &Profile, e: &'static EffectInfo, nominal: &Eval, n_free: us
     }
     if std::env::var_os("STIRLING_DIAGNOSE_DEBUG").is_some() {
         for p in &sc.points {
-            eprintln!("screen {} theta {:?}: S {:.3} (n {}), holdout {:.4}", e.name, p.theta, p.s_train, p.n_train, p.holdout_error);
+            eprintln!(
+                "screen {} theta {:?}: S {:.3} (n {}), holdout {:.4}",
+                e.name, p.theta, p.s_train, p.n_train, p.holdout_error
+            );
         }
     }
     let pts: Vec<&Eval> = sc.points.iter().collect();
@@ -196,7 +199,11 @@ pub fn screen(prof: &Profile, e: &'static EffectInfo, nominal: &Eval, n_free: us
     };
     let form = q.quad_form(&bnd, true);
     // l = -S/(2 s2): g' I^-1 g = (dS' H_S^-1 dS) / (2 s2)
-    sc.stat = if form.is_finite() { (form / (2.0 * s2)).max(0.0) } else { f64::NAN };
+    sc.stat = if form.is_finite() {
+        (form / (2.0 * s2)).max(0.0)
+    } else {
+        f64::NAN
+    };
     if !sc.stat.is_finite() {
         sc.note = Some("the profiled cost is not convex at the null".into());
         sc.stat = f64::NAN;

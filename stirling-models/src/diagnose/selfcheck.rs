@@ -29,6 +29,8 @@ pub struct SelfCheckOptions {
     /// Relative perturbation of the nominal starting parameters (kd, kp, bd, bp, hh, hk).
     pub perturb: f64,
     pub diagnose: DiagnoseOptions,
+    /// Include the clean case (no added effect).
+    pub clean: bool,
 }
 
 impl Default for SelfCheckOptions {
@@ -39,11 +41,12 @@ impl Default for SelfCheckOptions {
             effects: None,
             strengths: vec![0.5, 1.0],
             t_end: 1.0,
-            settle: 0.3,
+            settle: 0.1,
             rate: 1000.0,
             seed: 5,
             perturb: 0.08,
             diagnose: DiagnoseOptions::default(),
+            clean: true,
         }
     }
 }
@@ -129,7 +132,11 @@ pub fn run(
             .map(|e| e.name.to_string())
             .collect(),
     };
-    let mut plan: Vec<(String, f64)> = vec![("none".into(), 0.0)];
+    let mut plan: Vec<(String, f64)> = if opts.clean {
+        vec![("none".into(), 0.0)]
+    } else {
+        vec![]
+    };
     for n in &names {
         for &s in &opts.strengths {
             plan.push((n.clone(), s));
