@@ -41,6 +41,10 @@ pub struct FitArgs {
     /// Write measured-vs-model SVGs into this directory
     #[arg(long)]
     pub plot: Option<PathBuf>,
+    /// Refine by multiple shooting over segments of about this many cycles (on up to 0.5 s
+    /// of the training block) before the free run
+    #[arg(long, value_name = "CYCLES")]
+    pub multiple_shooting: Option<f64>,
 }
 
 pub fn run(a: &FitArgs) -> anyhow::Result<()> {
@@ -50,6 +54,12 @@ pub fn run(a: &FitArgs) -> anyhow::Result<()> {
         .with_context(|| format!("parameters of model `{}`", model.name()))?;
     let mut opts = FitOptions {
         free: a.free.clone(),
+        multiple_shooting: a
+            .multiple_shooting
+            .map(|c| fit::multiple_shooting::MsOptions {
+                cycles: c,
+                ..Default::default()
+            }),
         ..Default::default()
     };
     if let Some(s) = &a.train {
@@ -71,6 +81,11 @@ pub fn run(a: &FitArgs) -> anyhow::Result<()> {
                 )
                 .map_err(anyhow::Error::msg)?;
             }
+        }
+        for s in res.free_run.iter().flat_map(|f| &f.series) {
+            let f = dir.join(format!("free_run_{}.svg", s.channel));
+            plot_series(&f, &format!("free run: {} measured vs model", s.channel), s)
+                .map_err(anyhow::Error::msg)?;
         }
     }
     if a.json {
@@ -137,6 +152,74 @@ pub fn run(a: &FitArgs) -> anyhow::Result<()> {
                 f.channel, f.block, f.fit_percent, f.rms, f.samples
             );
         }
+    }
+    if let Some(ms) = &res.multiple_shooting {
+        println!(
+            "\nmultiple shooting ({} segments, {} iterations, {}, {:.2} s, largest defect {:.2e})",
+            ms.segments.len(),
+            ms.iterations,
+            if ms.converged {
+                "converged"
+            } else {
+                "NOT converged"
+            },
+            ms.seconds,
+            ms.segments.iter().map(|s| s.defect).fold(0.0, f64::max)
+        );
+        for e in ms
+            .stats
+            .estimates
+            .iter()
+            .filter(|e| !e.name.starts_with("seg"))
+        {
+            println!(
+                "  {:<14} {:>14.6e} {:>14.6e} {:>12.3e}   [{:.6e}, {:.6e}]",
+                e.name, e.initial, e.value, e.std_error, e.ci_low, e.ci_high
+            );
+        }
+        for w in &ms.stats.warnings {
+            println!("  WARNING: {w}");
+        }
+        for f in &ms.fits {
+            println!(
+                "  fit {:<6} {:<8} {:>7.2} %",
+                f.channel, f.block, f.fit_percent
+            );
+        }
+    }
+    if let Some(fr) = &res.free_run {
+        println!(
+            "\nfree run from the measured state at {:.3} s (to {:.3} s; short window {:.3} s)",
+            fr.block.0, fr.block.1, fr.short_window
+        );
+        for f in &fr.fits {
+            println!(
+                "  fit {:<6} {:<15} {:>7.2} %  (rms {:.3e})",
+                f.channel, f.block, f.fit_percent, f.rms
+            );
+        }
+        if let (Some(m), Some(s)) = (&fr.measured, &fr.simulated) {
+            println!(
+                "  frequency   measured {:.4} Hz, model {:.4} Hz",
+                m.frequency, s.frequency
+            );
+            for (((c, am), (_, asim)), ((_, pm), (_, psim))) in m
+                .amplitude
+                .iter()
+                .zip(&s.amplitude)
+                .zip(m.phase.iter().zip(&s.phase))
+            {
+                println!(
+                    "  {c:<6} amplitude {am:.4e} / {asim:.4e}, phase vs x {pm:+.4} / {psim:+.4} rad"
+                );
+            }
+        }
+        if let Some(l) = fr.x_phase_lag {
+            println!("  displacer phase drift at the block end {l:+.4} rad");
+        }
+    }
+    for n in &res.notes {
+        println!("NOTE: {n}");
     }
     println!("\ntotal {:.2} s", res.seconds);
     Ok(())

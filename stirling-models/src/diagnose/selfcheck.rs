@@ -208,7 +208,7 @@ pub fn run(
                     .map(|q| {
                         let tv = effect(truth)
                             .and_then(|e| e.params.iter().find(|p| p.name == q.name))
-                            .map(|p| strength * p.typical)
+                            .map(|p| strength * base_strength(truth) * p.typical)
                             .unwrap_or(f64::NAN);
                         (q.name.clone(), tv, q.value, q.ci_low, q.ci_high)
                     })

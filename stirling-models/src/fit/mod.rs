@@ -3,11 +3,14 @@
 //! the measured displacements ([`driven`]), each by Levenberg-Marquardt ([`lm`]) on forward
 //! sensitivities ([`sensitivity`]), with a statistical report ([`report`]).
 //!
-//! Not done yet: the free-run validation from the measured initial state and the
-//! multiple-shooting refinement.
+//! Then, optionally, a multiple-shooting refinement over short free-running segments
+//! ([`multiple_shooting`]) and a free-run validation from the measured initial state
+//! ([`free_run`]), since a self-excited oscillator drifts in phase.
 
 pub mod driven;
+pub mod free_run;
 pub mod lm;
+pub mod multiple_shooting;
 pub mod report;
 pub mod sensitivity;
 
@@ -58,6 +61,11 @@ pub struct FitOptions {
     /// Stage 1: sub-cycle drift band projected out of the residuals, as a fraction of the
     /// cycle frequency (see [`driven::Stage::drift`]; 0: none).
     pub drift_cut: f64,
+    /// Free-run validation after the stages (on the held-out block, else the training block).
+    pub free_run: Option<free_run::FreeRunOptions>,
+    /// Multiple-shooting refinement of the free parameters over the training block (off by
+    /// default: it costs several times the two stages).
+    pub multiple_shooting: Option<multiple_shooting::MsOptions>,
 }
 
 impl Default for FitOptions {
@@ -84,6 +92,8 @@ impl Default for FitOptions {
             stage1: true,
             stage2: true,
             drift_cut: 0.5,
+            free_run: Some(free_run::FreeRunOptions::default()),
+            multiple_shooting: None,
         }
     }
 }
@@ -137,6 +147,13 @@ pub struct Identification {
     pub train: (f64, f64),
     pub holdout: Option<(f64, f64)>,
     pub seconds: f64,
+    /// Sensor offsets after the fit (position offsets as seen by the free model, i.e. with
+    /// the stage-2 pressure-offset correction applied).
+    pub offsets: free_run::SensorOffsets,
+    pub multiple_shooting: Option<multiple_shooting::MultipleShooting>,
+    pub free_run: Option<free_run::FreeRun>,
+    /// Why an optional step (refinement, free run) did not run.
+    pub notes: Vec<String>,
 }
 
 /// Split the free parameters by the rows they enter: body rows -> stage 1, gas rows -> stage 2.
@@ -402,6 +419,7 @@ pub fn identify(
     ];
     let mut stage1 = None;
     let sim = opts.sim;
+
     // pressure-offset guesses: the whole-cycle mean minus the charge pressure (refined in stage 2)
     let p_off0 = data
         .p
@@ -413,6 +431,12 @@ pub fn identify(
         .as_ref()
         .map(|v| cycle_mean(v) - pmean)
         .unwrap_or(0.0);
+    let mut offsets = free_run::SensorOffsets {
+        x: x_off[0],
+        y: x_off[1],
+        p: p_off0,
+        p_hot: have_hot.then_some(ph_off0),
+    };
     let sig_p = data.p.as_ref().map(|v| signal(t0, dt, v, (h / 2).max(3)));
     let sig_ph = data
         .p_hot
@@ -693,12 +717,50 @@ pub fn identify(
             sim,
         };
         let (fit, values) = fit_stage(&stage, tr, ho, burn, &opts.lm)?;
+        let (mut p_off, mut ph_off) = (p_off0, ph_off0);
         for (v, val) in stage.vars.iter().zip(&values) {
-            if let VarKind::Param(j) = v.kind {
-                p[j] = *val;
+            match v.kind {
+                VarKind::Param(j) => p[j] = *val,
+                VarKind::Offset { out: 0, .. } => p_off = *val,
+                VarKind::Offset { out: 1, .. } => ph_off = *val,
+                _ => {}
             }
         }
+        // the positions stage 2 prescribed: measured - x_off + used - shift (offsets)
+        for k in 0..2 {
+            x_off[k] += shift[0][k] * p_off + shift[1][k] * ph_off - used[k];
+        }
+        offsets.p = p_off;
+        if have_hot {
+            offsets.p_hot = Some(ph_off);
+        }
         stage2 = Some(fit);
+    }
+    offsets.x = x_off[0];
+    offsets.y = x_off[1];
+    let mut notes = Vec::new();
+    let mut ms = None;
+    if let Some(mo) = &opts.multiple_shooting {
+        let mut idx_free: Vec<usize> = mech.clone();
+        idx_free.extend(gas.iter().filter(|j| !mech.contains(j)));
+        match multiple_shooting::multiple_shooting(model, &p, &idx_free, data, &offsets, train, mo) {
+            Ok(r) => {
+                for (k, (_, v)) in r.params.iter().enumerate() {
+                    p[k] = *v;
+                }
+                offsets = r.offsets.clone();
+                ms = Some(r);
+            }
+            Err(e) => notes.push(format!("multiple shooting: {e}")),
+        }
+    }
+    let mut fr = None;
+    if let Some(fo) = &opts.free_run {
+        let block = holdout.unwrap_or(train);
+        match free_run::free_run(model, &p, data, &offsets, block, fo) {
+            Ok(r) => fr = Some(r),
+            Err(e) => notes.push(format!("free run: {e}")),
+        }
     }
     Ok(Identification {
         model: model.name().into(),
@@ -714,5 +776,9 @@ pub fn identify(
         train,
         holdout,
         seconds: clock.elapsed().as_secs_f64(),
+        offsets,
+        multiple_shooting: ms,
+        free_run: fr,
+        notes,
     })
 }

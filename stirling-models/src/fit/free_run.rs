@@ -1,0 +1,446 @@
+//! Free-run validation: the identified model simulated on its own (nothing prescribed) from the
+//! measured state at the start of a block, compared with the record.
+//!
+//! The initial state:
+//! - positions: the smoothed measured displacements minus the position offsets;
+//! - velocities: the derivative of the same Savitzky-Golay smoother the driven stages use;
+//! - pressures: the smoothed measured `p` (and `p_hot` when present) minus the pressure
+//!   offsets; control volumes between the hot and cold ends get the mix of
+//!   [`driven::cold_weight`], as in stage 2;
+//! - masses (models with mass states): the model's gas inventory (the charge of
+//!   `equilibrium_guess`) shared in proportion to `P V / T_rest`, i.e. `m = P V / (R T_rest)`
+//!   rescaled so that the total is the charge. Why: the inventory is a parameter of the
+//!   identified model (the pressure offsets were estimated against it), so conserving it keeps
+//!   the free run's mean pressure consistent with the fit; scaling each mass by its own
+//!   `P/P0` instead would add the pressure noise at the start sample to the inventory.
+//!
+//! Pointwise fit degrades as the self-excited oscillation drifts in phase, so the report also
+//! gives the fit over the first cycles only and limit-cycle features (frequency, amplitudes,
+//! phases of the fundamental relative to the displacer) of the simulated vs the measured motion.
+
+use std::time::Instant;
+
+use serde::Serialize;
+use stirling_dsl::{Model, StateKind};
+
+use super::driven::{self, cold_weight, pressure_states, savitzky_golay};
+use super::report::{fit_percent, ChannelFit};
+use super::{FitError, Series};
+use crate::data::Measured;
+use crate::sim::{simulate, SimOptions};
+
+/// Additive sensor offsets: measured = model + offset.
+#[derive(Clone, Debug, Default, Serialize, PartialEq)]
+pub struct SensorOffsets {
+    pub x: f64,
+    pub y: f64,
+    pub p: f64,
+    /// `None` when the record has no `p_hot` or the model a single control volume.
+    pub p_hot: Option<f64>,
+}
+
+impl SensorOffsets {
+    /// The offset of a channel.
+    pub fn get(&self, channel: &str) -> f64 {
+        match channel {
+            "x" => self.x,
+            "y" => self.y,
+            "p" => self.p,
+            "p_hot" => self.p_hot.unwrap_or(0.0),
+            _ => 0.0,
+        }
+    }
+}
+
+/// A measured channel and the model state it observes.
+#[derive(Clone, Debug)]
+pub struct Channel {
+    pub name: String,
+    pub state: usize,
+    pub data: Vec<f64>,
+}
+
+/// The observed channels: `x`, `y` (body positions), `p` (cold pressure), `p_hot` (hot
+/// pressure, when measured and the model has more than one control volume).
+pub fn channels(model: &dyn Model, data: &Measured) -> Result<Vec<Channel>, FitError> {
+    let pos: Vec<usize> = model
+        .states()
+        .iter()
+        .enumerate()
+        .filter(|(_, s)| matches!(s.kind, StateKind::Position(_)))
+        .map(|(i, _)| i)
+        .collect();
+    let ps = pressure_states(model);
+    let (Some(x), Some(y), Some(p)) = (&data.x, &data.y, &data.p) else {
+        return Err(FitError::Bad(format!(
+            "{}: the free run needs the columns p, x and y",
+            data.source
+        )));
+    };
+    if pos.len() != 2 || ps.is_empty() {
+        return Err(FitError::Bad(format!(
+            "the free run expects two bodies and a gas model; `{}` has {} bodies",
+            model.name(),
+            pos.len()
+        )));
+    }
+    let mut out = vec![
+        Channel {
+            name: "x".into(),
+            state: pos[0],
+            data: x.clone(),
+        },
+        Channel {
+            name: "y".into(),
+            state: pos[1],
+            data: y.clone(),
+        },
+        Channel {
+            name: "p".into(),
+            state: *ps.last().expect("CVs"),
+            data: p.clone(),
+        },
+    ];
+    if let (Some(ph), true) = (&data.p_hot, ps.len() > 1) {
+        out.push(Channel {
+            name: "p_hot".into(),
+            state: ps[0],
+            data: ph.clone(),
+        });
+    }
+    Ok(out)
+}
+
+/// The model state at sample `k` from the measurements (see the module doc); `h` is the
+/// half-width of the smoothing window in samples.
+pub fn measured_state(
+    model: &dyn Model,
+    p: &[f64],
+    data: &Measured,
+    off: &SensorOffsets,
+    k: usize,
+    h: usize,
+) -> Result<Vec<f64>, FitError> {
+    let ch = channels(model, data)?;
+    let dt = data.dt();
+    let n = model.n_states();
+    let mut x = vec![0.0; n];
+    model.equilibrium_guess(p, &mut x);
+    let eq = x.clone();
+    let states = model.states();
+    // smooth locally: a window around k is enough
+    let lo = k.saturating_sub(4 * h + 2);
+    let hi = (k + 4 * h + 2).min(data.t.len() - 1);
+    let smooth = |v: &[f64], hh: usize| {
+        let (a, b) = savitzky_golay(&v[lo..=hi], dt, hh, 4);
+        (a[k - lo], b[k - lo])
+    };
+    for c in &ch[..2] {
+        let (v, d) = smooth(&c.data, h);
+        x[c.state] = v - off.get(&c.name);
+        // the velocity state follows its position state
+        let vel = states
+            .iter()
+            .position(|s| {
+                matches!((s.kind, states[c.state].kind),
+                    (StateKind::Velocity(a), StateKind::Position(b)) if a == b)
+            })
+            .ok_or_else(|| FitError::Bad("a body without a velocity state".into()))?;
+        x[vel] = d;
+    }
+    let ps = pressure_states(model);
+    let have_hot = ch.len() > 3;
+    let pc = smooth(&ch[2].data, (h / 2).max(3)).0 - off.p;
+    let ph = if have_hot {
+        smooth(&ch[3].data, (h / 2).max(3)).0 - off.get("p_hot")
+    } else {
+        0.0
+    };
+    for (i, &s) in ps.iter().enumerate() {
+        let wc = cold_weight(i, ps.len(), have_hot);
+        x[s] = wc * pc + (1.0 - wc) * ph;
+    }
+    let masses: Vec<usize> = (0..n)
+        .filter(|&i| matches!(states[i].kind, StateKind::Mass(_)))
+        .collect();
+    if !masses.is_empty() {
+        let nv = model.vessel_names().len();
+        let (mut pr, mut vol) = (vec![0.0; nv], vec![0.0; nv]);
+        model.pv(p, &x, &mut pr, &mut vol);
+        let mut t_rest = vec![0.0; ps.len()];
+        model.temperatures(p, &eq, &mut t_rest);
+        let total: f64 = masses.iter().map(|&i| eq[i]).sum();
+        let share: Vec<f64> = (0..ps.len())
+            .map(|i| x[ps[i]] * vol[i] / t_rest[i])
+            .collect();
+        let ssum: f64 = share.iter().sum();
+        for (j, &mi) in masses.iter().enumerate() {
+            x[mi] = total * share[j] / ssum;
+        }
+    }
+    Ok(x)
+}
+
+/// Fundamental-harmonic features of a periodic motion.
+#[derive(Clone, Debug, Serialize)]
+pub struct CycleFeatures {
+    /// Cycle frequency from the mean crossings of `x` (Hz).
+    pub frequency: f64,
+    /// `(channel, amplitude of the fundamental)`.
+    pub amplitude: Vec<(String, f64)>,
+    /// `(channel, phase of the fundamental relative to x)` (rad, in `(-pi, pi]`; positive: leads).
+    pub phase: Vec<(String, f64)>,
+}
+
+/// Least-squares `c + a cos(wt) + b sin(wt)`: returns `(amplitude, phase)`.
+fn fundamental(y: &[f64], dt: f64, f: f64) -> (f64, f64) {
+    let w = 2.0 * std::f64::consts::PI * f;
+    let mut a = nalgebra::Matrix3::<f64>::zeros();
+    let mut g = nalgebra::Vector3::<f64>::zeros();
+    for (i, &v) in y.iter().enumerate() {
+        let t = i as f64 * dt;
+        let r = nalgebra::Vector3::new(1.0, (w * t).cos(), (w * t).sin());
+        a += r * r.transpose();
+        g += r * v;
+    }
+    let c = a.lu().solve(&g).unwrap_or_else(nalgebra::Vector3::zeros);
+    // a cos + b sin = A cos(wt - phi): phase = -phi
+    ((c[1] * c[1] + c[2] * c[2]).sqrt(), -(c[2].atan2(c[1])))
+}
+
+fn wrap(a: f64) -> f64 {
+    let tau = 2.0 * std::f64::consts::PI;
+    let mut v = a % tau;
+    if v <= -std::f64::consts::PI {
+        v += tau;
+    } else if v > std::f64::consts::PI {
+        v -= tau;
+    }
+    v
+}
+
+/// Cycle frequency from the upward mean crossings, located by linear interpolation between
+/// samples (with the hysteresis of [`driven::cycle_frequency`]); `None`: fewer than 2 cycles.
+pub fn crossing_frequency(y: &[f64], dt: f64) -> Option<f64> {
+    driven::cycle_frequency(y, dt)?;
+    let n = y.len() as f64;
+    let m = y.iter().sum::<f64>() / n;
+    let sd = (y.iter().map(|v| (v - m) * (v - m)).sum::<f64>() / n).sqrt();
+    let (lo, hi) = (m - 0.5 * sd, m + 0.5 * sd);
+    let mut armed = false;
+    let mut last_below = 0;
+    let mut ups: Vec<f64> = Vec::new();
+    for (i, &v) in y.iter().enumerate() {
+        if v < m {
+            last_below = i;
+        }
+        if v < lo {
+            armed = true;
+        } else if armed && v > hi {
+            armed = false;
+            // the mean crossing between last_below and last_below + 1
+            let (a, b) = (y[last_below], y[last_below + 1]);
+            ups.push(last_below as f64 + (m - a) / (b - a));
+        }
+    }
+    if ups.len() < 3 {
+        return None;
+    }
+    Some((ups.len() - 1) as f64 / ((ups[ups.len() - 1] - ups[0]) * dt))
+}
+
+/// Features of channels `(name, samples)` (the first must be `x`); `None` when `x` holds
+/// fewer than two cycles.
+pub fn cycle_features(series: &[(String, Vec<f64>)], dt: f64) -> Option<CycleFeatures> {
+    let f = crossing_frequency(&series[0].1, dt)?;
+    let fx: Vec<(f64, f64)> = series.iter().map(|(_, y)| fundamental(y, dt, f)).collect();
+    Some(CycleFeatures {
+        frequency: f,
+        amplitude: series
+            .iter()
+            .zip(&fx)
+            .map(|((n, _), a)| (n.clone(), a.0))
+            .collect(),
+        phase: series
+            .iter()
+            .zip(&fx)
+            .map(|((n, _), a)| (n.clone(), wrap(a.1 - fx[0].1)))
+            .collect(),
+    })
+}
+
+/// Options of the free run.
+#[derive(Clone, Copy, Debug)]
+pub struct FreeRunOptions {
+    /// Cycles of the short window (fit from the measured state before the phase drifts).
+    pub cycles: f64,
+    /// Half-width of the smoothing window for the initial state (s).
+    pub smooth: f64,
+    pub sim: SimOptions,
+}
+
+impl Default for FreeRunOptions {
+    fn default() -> Self {
+        Self {
+            cycles: 2.0,
+            smooth: 0.006,
+            sim: SimOptions {
+                rtol: 1e-8,
+                atol: 1e-8,
+                ..Default::default()
+            },
+        }
+    }
+}
+
+/// The free-run validation of a block.
+#[derive(Clone, Debug, Serialize)]
+pub struct FreeRun {
+    /// The block `[a, b]` (s).
+    pub block: (f64, f64),
+    /// Length of the short window from the block start (s).
+    pub short_window: f64,
+    /// The initial state from the measurements.
+    pub initial_state: Vec<(String, f64)>,
+    /// Fit per channel: block `free_run` (the whole block) and `free_run_short` (the first
+    /// cycles).
+    pub fits: Vec<ChannelFit>,
+    pub measured: Option<CycleFeatures>,
+    pub simulated: Option<CycleFeatures>,
+    /// `simulated - measured` frequency, relative.
+    pub frequency_error: Option<f64>,
+    /// Phase of the simulated displacer relative to the measured one over the last cycles of
+    /// the block (rad; the accumulated phase drift of the free run).
+    pub x_phase_lag: Option<f64>,
+    pub seconds: f64,
+    #[serde(skip)]
+    pub series: Vec<Series>,
+}
+
+impl FreeRun {
+    /// Fit percentage of a channel on `free_run` or `free_run_short`.
+    pub fn fit_percent(&self, channel: &str, block: &str) -> Option<f64> {
+        self.fits
+            .iter()
+            .find(|f| f.channel == channel && f.block == block)
+            .map(|f| f.fit_percent)
+    }
+}
+
+/// Simulate `model` at `p` from the measured state at the start of `block` and compare.
+pub fn free_run(
+    model: &dyn Model,
+    p: &[f64],
+    data: &Measured,
+    off: &SensorOffsets,
+    block: (f64, f64),
+    opts: &FreeRunOptions,
+) -> Result<FreeRun, FitError> {
+    let clock = Instant::now();
+    let name = "free run";
+    let ch = channels(model, data)?;
+    let (t0, dt) = (data.t[0], data.dt());
+    let nt = data.t.len();
+    let idx = |t: f64| (((t - t0) / dt).round().max(0.0) as usize).min(nt - 1);
+    let (a, b) = (idx(block.0), idx(block.1));
+    if b < a + 10 {
+        return Err(FitError::Bad(format!(
+            "{name}: the block {}:{} is too short",
+            block.0, block.1
+        )));
+    }
+    let h = ((opts.smooth / dt).round() as usize).max(3);
+    let x0 = measured_state(model, p, data, off, a, h)?;
+    let samples: Vec<f64> = (0..=b - a).map(|k| k as f64 * dt).collect();
+    let traj = simulate(
+        model,
+        p,
+        &x0,
+        samples[samples.len() - 1],
+        &samples,
+        &opts.sim,
+    )
+    .map_err(|e| FitError::Sim(name.into(), e.to_string()))?;
+    let meas: Vec<(String, Vec<f64>)> = ch
+        .iter()
+        .map(|c| (c.name.clone(), c.data[a..=b].to_vec()))
+        .collect();
+    let sim: Vec<(String, Vec<f64>)> = ch
+        .iter()
+        .map(|c| {
+            (
+                c.name.clone(),
+                traj.x
+                    .iter()
+                    .map(|r| r[c.state] + off.get(&c.name))
+                    .collect(),
+            )
+        })
+        .collect();
+    let measured = cycle_features(&meas, dt);
+    let simulated = cycle_features(&sim, dt);
+    let f_meas = measured
+        .as_ref()
+        .map(|m| m.frequency)
+        .or_else(|| driven::cycle_frequency(&data.x.as_ref().expect("checked")[..], dt));
+    let short = f_meas
+        .map(|f| opts.cycles / f)
+        .unwrap_or(block.1 - block.0)
+        .min(block.1 - block.0);
+    let ns = ((short / dt).round() as usize).clamp(10, b - a + 1);
+    let mut fits = Vec::new();
+    for (label, len) in [("free_run", b - a + 1), ("free_run_short", ns)] {
+        for ((n, y), (_, yh)) in meas.iter().zip(&sim) {
+            let (y, yh) = (&y[..len], &yh[..len]);
+            let fp = fit_percent(y, yh);
+            let rms = (y
+                .iter()
+                .zip(yh)
+                .map(|(u, v)| (u - v) * (u - v))
+                .sum::<f64>()
+                / len as f64)
+                .sqrt();
+            fits.push(ChannelFit {
+                channel: n.clone(),
+                block: label.into(),
+                fit_percent: fp,
+                fit_percent_raw: fp,
+                rms,
+                samples: len,
+            });
+        }
+    }
+    let series = meas
+        .iter()
+        .zip(&sim)
+        .map(|((n, y), (_, yh))| Series {
+            channel: n.clone(),
+            t: (a..=b).map(|i| data.t[i]).collect(),
+            measured: y.clone(),
+            model: yh.clone(),
+        })
+        .collect();
+    let frequency_error = match (&measured, &simulated) {
+        (Some(m), Some(s)) => Some(s.frequency / m.frequency - 1.0),
+        _ => None,
+    };
+    let x_phase_lag = f_meas.map(|f| {
+        let m = ((opts.cycles / f / dt).round() as usize).clamp(10, b - a + 1);
+        let k = b - a + 1 - m;
+        let (_, pm) = fundamental(&meas[0].1[k..], dt, f);
+        let (_, ps) = fundamental(&sim[0].1[k..], dt, f);
+        wrap(ps - pm)
+    });
+    Ok(FreeRun {
+        x_phase_lag,
+        block,
+        short_window: ns as f64 * dt,
+        initial_state: model.state_names().into_iter().zip(x0).collect(),
+        fits,
+        measured,
+        simulated,
+        frequency_error,
+        seconds: clock.elapsed().as_secs_f64(),
+        series,
+    })
+}
