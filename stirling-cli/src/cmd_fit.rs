@@ -177,8 +177,17 @@ pub fn run(a: &FitArgs) -> anyhow::Result<()> {
                 e.name, e.initial, e.value, e.std_error, e.ci_low, e.ci_high
             );
         }
-        for w in &ms.stats.warnings {
+        // collinear segment initial states (fast gas modes) are expected: count them only
+        let (seg, other): (Vec<&String>, Vec<&String>) =
+            ms.stats.warnings.iter().partition(|w| w.contains("`seg"));
+        for w in other {
             println!("  WARNING: {w}");
+        }
+        if !seg.is_empty() {
+            println!(
+                "  note: {} nearly collinear pairs involve segment initial states (see --json)",
+                seg.len()
+            );
         }
         for f in &ms.fits {
             println!(
