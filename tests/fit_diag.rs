@@ -74,7 +74,10 @@ fn case(model: &str, n: Option<usize>, noise: bool, offsets: bool, stage2: bool)
         },
         offset_x: if offsets { 1.5e-3 } else { 0.0 },
         offset_y: if offsets { -2e-3 } else { 0.0 },
-        seed: std::env::var("SEED").ok().and_then(|v| v.parse().ok()).unwrap_or(11),
+        seed: std::env::var("SEED")
+            .ok()
+            .and_then(|v| v.parse().ok())
+            .unwrap_or(11),
         ..Default::default()
     };
     let out = rig::run(&cfg).unwrap();
@@ -124,12 +127,44 @@ fn diag_ns_clean() {
 #[test]
 #[ignore]
 fn timing_nsection2_3s() {
-    let cfg = RigConfig { model: "nsection".into(), n: Some(2), set: ["kd=680", "kp=58", "bd=0.55", "bp=8.4", "hh=560", "hk=450", "Rf=1.3e5"].iter().map(|s| s.to_string()).collect(), t_end: 3.0, settle: 0.4, rate: 2000.0, offset_p: 300.0, seed: 11, ..Default::default() };
+    let cfg = RigConfig {
+        model: "nsection".into(),
+        n: Some(2),
+        set: [
+            "kd=680", "kp=58", "bd=0.55", "bp=8.4", "hh=560", "hk=450", "Rf=1.3e5",
+        ]
+        .iter()
+        .map(|s| s.to_string())
+        .collect(),
+        t_end: 3.0,
+        settle: 0.4,
+        rate: 2000.0,
+        offset_p: 300.0,
+        seed: 11,
+        ..Default::default()
+    };
     let out = rig::run(&cfg).unwrap();
     let m = stirling::models::build("nsection", Some(2), Closure::Full).unwrap();
     let p0 = m.default_params();
     let clock = std::time::Instant::now();
-    let res = fit::identify(m.as_ref(), &p0, &out.data, &FitOptions { free: Some(["kd", "kp", "bd", "bp", "hh", "hk", "Rf"].iter().map(|s| s.to_string()).collect()), ..Default::default() }).unwrap();
-    eprintln!("two-stage fit of nsection n = 2, 3 s at 2 kHz: {:.2} s", clock.elapsed().as_secs_f64());
+    let res = fit::identify(
+        m.as_ref(),
+        &p0,
+        &out.data,
+        &FitOptions {
+            free: Some(
+                ["kd", "kp", "bd", "bp", "hh", "hk", "Rf"]
+                    .iter()
+                    .map(|s| s.to_string())
+                    .collect(),
+            ),
+            ..Default::default()
+        },
+    )
+    .unwrap();
+    eprintln!(
+        "two-stage fit of nsection n = 2, 3 s at 2 kHz: {:.2} s",
+        clock.elapsed().as_secs_f64()
+    );
     show(&res);
 }

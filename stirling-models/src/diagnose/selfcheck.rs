@@ -159,7 +159,10 @@ pub fn run(
             p0[i] *= 1.0 + sign * opts.perturb * (1.0 - 0.1 * k as f64);
         }
     }
-    let dir = std::env::temp_dir().join(format!("stirling-selfcheck-{}", std::process::id()));
+    // one folder per run: self-checks may run concurrently in one process (tests)
+    static RUNS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+    let run = RUNS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+    let dir = std::env::temp_dir().join(format!("stirling-selfcheck-{}-{run}", std::process::id()));
     std::fs::create_dir_all(&dir)
         .map_err(|e| DiagnoseError::Bad(format!("cannot create {}: {e}", dir.display())))?;
     let mut cases = Vec::new();

@@ -320,14 +320,25 @@ impl Stage<'_> {
     /// weighted residuals by `dr` (the drift band projected out as in the fit), and the
     /// first-order estimate moves by `-(J^T J)^-1 J^T dr`; returns the sample covariance of
     /// those moves (`None` without input noise).
-    pub fn input_noise_cov(&self, u: &[f64], first: usize, last: usize, keep: &[usize], j: &DMatrix<f64>, draws: usize, seed: u64) -> Result<Option<DMatrix<f64>>, FitError> {
+    pub fn input_noise_cov(
+        &self,
+        u: &[f64],
+        first: usize,
+        last: usize,
+        keep: &[usize],
+        j: &DMatrix<f64>,
+        draws: usize,
+        seed: u64,
+    ) -> Result<Option<DMatrix<f64>>, FitError> {
         use rand::{rngs::StdRng, Rng, SeedableRng};
         if self.input_noise.is_empty() || draws == 0 {
             return Ok(None);
         }
         let nv = self.vars.len();
         let jtj = j.transpose() * j;
-        let Some(inv) = jtj.clone().try_inverse() else { return Ok(None) };
+        let Some(inv) = jtj.clone().try_inverse() else {
+            return Ok(None);
+        };
         let base = self.run(u, first, last, false)?;
         let mut rng = StdRng::seed_from_u64(seed);
         let mut gauss = move || {
@@ -336,10 +347,23 @@ impl Stage<'_> {
             (-2.0 * u1.ln()).sqrt() * (2.0 * std::f64::consts::PI * u2).cos()
         };
         let mut acc = DMatrix::zeros(nv, nv);
-        let mut noisy = Stage { signals: self.signals.clone(), given: self.given.clone(), vars: self.vars.clone(), outputs: self.outputs.clone(), z0: self.z0.clone(), p: self.p.clone(), base: self.base.clone(), free: self.free.clone(), input_noise: Vec::new(), ..*self };
+        let mut noisy = Stage {
+            signals: self.signals.clone(),
+            given: self.given.clone(),
+            vars: self.vars.clone(),
+            outputs: self.outputs.clone(),
+            z0: self.z0.clone(),
+            p: self.p.clone(),
+            base: self.base.clone(),
+            free: self.free.clone(),
+            input_noise: Vec::new(),
+            ..*self
+        };
         for _ in 0..draws {
             for &(s, sd, h) in &self.input_noise {
-                let e: Vec<f64> = (0..self.signals[s].val.len()).map(|_| sd * gauss()).collect();
+                let e: Vec<f64> = (0..self.signals[s].val.len())
+                    .map(|_| sd * gauss())
+                    .collect();
                 let (ev, ed) = savitzky_golay(&e, self.dt, h, 4);
                 let sig = &mut noisy.signals[s];
                 for k in 0..ev.len() {

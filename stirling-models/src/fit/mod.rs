@@ -274,7 +274,8 @@ fn fit_stage(
         .collect();
     let init: Vec<f64> = stage.vars.iter().map(|v| v.initial).collect();
     let scale: Vec<f64> = stage.vars.iter().map(|v| v.scale).collect();
-    let extra = stage.input_noise_cov(&res.x, train.0, train.1, &keep, &res.jacobian, 40, 0x5eed)?;
+    let extra =
+        stage.input_noise_cov(&res.x, train.0, train.1, &keep, &res.jacobian, 40, 0x5eed)?;
     let st = report::stats_full(
         &names,
         &init,
@@ -537,9 +538,18 @@ pub fn identify(
         }
         let stage = Stage {
             drift,
-            input_noise: std::iter::once((0, noise_sigma(data.p.as_ref().expect("checked")), (h / 2).max(3)))
-                .chain(data.p_hot.as_ref().filter(|_| have_hot).map(|v| (1, noise_sigma(v), (h / 2).max(3))))
-                .collect(),
+            input_noise: std::iter::once((
+                0,
+                noise_sigma(data.p.as_ref().expect("checked")),
+                (h / 2).max(3),
+            ))
+            .chain(
+                data.p_hot
+                    .as_ref()
+                    .filter(|_| have_hot)
+                    .map(|v| (1, noise_sigma(v), (h / 2).max(3))),
+            )
+            .collect(),
             name: "stage 1 (mechanics driven by measured pressure)",
             model,
             p: p.clone(),
@@ -743,7 +753,8 @@ pub fn identify(
     if let Some(mo) = &opts.multiple_shooting {
         let mut idx_free: Vec<usize> = mech.clone();
         idx_free.extend(gas.iter().filter(|j| !mech.contains(j)));
-        match multiple_shooting::multiple_shooting(model, &p, &idx_free, data, &offsets, train, mo) {
+        match multiple_shooting::multiple_shooting(model, &p, &idx_free, data, &offsets, train, mo)
+        {
             Ok(r) => {
                 for (k, (_, v)) in r.params.iter().enumerate() {
                     p[k] = *v;
