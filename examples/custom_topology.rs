@@ -304,15 +304,7 @@ fn figures(
         find(StateKind::Position(1)),
         &pressures,
     )?;
-    let nv = model.vessel_names().len();
-    let mut loops = vec![Vec::new(); nv];
-    let (mut pr, mut v) = (vec![0.0; nv], vec![0.0; nv]);
-    for x in &lc.orbit {
-        model.pv(p, x, &mut pr, &mut v);
-        for i in 0..nv {
-            loops[i].push((v[i], pr[i]));
-        }
-    }
+    let loops = stirling::models::sim::work::pv_loops(model, p, &lc.orbit);
     plot::pv::pv_svg(
         &files[3],
         &title,

@@ -210,14 +210,7 @@ fn pv_loops(
 ) -> (Vec<String>, Vec<Vec<(f64, f64)>>, Vec<f64>) {
     let names = model.vessel_names();
     let k = names.len();
-    let mut loops = vec![Vec::new(); k];
-    let (mut pr, mut vo) = (vec![0.0; k], vec![0.0; k]);
-    for x in &lc.orbit {
-        model.pv(p, x, &mut pr, &mut vo);
-        for i in 0..k {
-            loops[i].push((vo[i], pr[i]));
-        }
-    }
+    let loops = sim::work::pv_loops(model, p, &lc.orbit);
     // a loop needs both the volume and the pressure to change (not a section, not the fixed bounce space)
     let span = |l: &Vec<(f64, f64)>, f: fn(&(f64, f64)) -> f64| {
         let (lo, hi) = l

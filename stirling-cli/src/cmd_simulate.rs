@@ -200,15 +200,7 @@ fn plots(
     )
     .map_err(anyhow::Error::msg)?;
     if let Some(lc) = lc {
-        let nv = model.vessel_names().len();
-        let mut loops = vec![Vec::new(); nv];
-        for x in &lc.orbit {
-            let (mut pr, mut v) = (vec![0.0; nv], vec![0.0; nv]);
-            model.pv(p, x, &mut pr, &mut v);
-            for i in 0..nv {
-                loops[i].push((v[i], pr[i]));
-            }
-        }
+        let loops = sim::work::pv_loops(model, p, &lc.orbit);
         stirling_models::plot::pv::pv_svg(
             &dir.join("pv.svg"),
             &title,

@@ -50,3 +50,17 @@ pub fn cycle_work(model: &dyn Model, p: &[f64], period: f64, states: &[Vec<f64>]
 pub fn indicated_power(w: f64, frequency_hz: f64) -> f64 {
     w * frequency_hz
 }
+
+/// One `(V, P)` loop per vessel (in [`Model::vessel_names`] order) along sampled states.
+pub fn pv_loops(model: &dyn Model, p: &[f64], states: &[Vec<f64>]) -> Vec<Vec<(f64, f64)>> {
+    let nv = model.vessel_names().len();
+    let mut loops = vec![Vec::with_capacity(states.len()); nv];
+    let (mut pr, mut v) = (vec![0.0; nv], vec![0.0; nv]);
+    for x in states {
+        model.pv(p, x, &mut pr, &mut v);
+        for i in 0..nv {
+            loops[i].push((v[i], pr[i]));
+        }
+    }
+    loops
+}
