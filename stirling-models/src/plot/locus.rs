@@ -5,7 +5,7 @@ use std::path::Path;
 
 use plotters::prelude::*;
 
-use super::poles::{frame, DrawError};
+use super::poles::{frame, splane_chart, DrawError};
 use crate::linear::Locus;
 
 /// Draw the root locus to an SVG file.
@@ -25,33 +25,7 @@ pub fn root_locus(path: &Path, locus: &Locus) -> Result<(), DrawError> {
     if out > 0 {
         title.push_str(&format!(", {out} stiff poles off frame"));
     }
-    let mut chart = ChartBuilder::on(&root)
-        .caption(title, ("sans-serif", 18))
-        .margin(15)
-        .x_label_area_size(45)
-        .y_label_area_size(60)
-        .build_cartesian_2d(x0..x1, -y1..y1)
-        .map_err(|e| err(e.to_string()))?;
-    chart
-        .configure_mesh()
-        .x_desc("Real axis (1/s)")
-        .y_desc("Imaginary axis (rad/s)")
-        .draw()
-        .map_err(|e| err(e.to_string()))?;
-    let shade = RGBColor(255, 210, 210).filled();
-    chart
-        .draw_series(std::iter::once(Rectangle::new(
-            [(0.0, -y1), (x1, y1)],
-            shade,
-        )))
-        .map_err(|e| err(e.to_string()))?;
-    let axis = BLACK.mix(0.5);
-    chart
-        .draw_series(LineSeries::new([(x0, 0.0), (x1, 0.0)], axis))
-        .map_err(|e| err(e.to_string()))?;
-    chart
-        .draw_series(LineSeries::new([(0.0, -y1), (0.0, y1)], axis))
-        .map_err(|e| err(e.to_string()))?;
+    let mut chart = splane_chart(&root, title, 18, (x0, x1, y1), &err)?;
     let k = locus.points.len().max(2) - 1;
     for (i, pt) in locus.points.iter().enumerate() {
         let t = i as f64 / k as f64;

@@ -59,33 +59,7 @@ pub fn pole_map(path: &Path, title: &str, closed: &[Pole], open: &[Pole]) -> Res
     } else {
         title.to_string()
     };
-    let mut chart = ChartBuilder::on(&root)
-        .caption(caption, ("sans-serif", 20))
-        .margin(15)
-        .x_label_area_size(45)
-        .y_label_area_size(60)
-        .build_cartesian_2d(x0..x1, -y1..y1)
-        .map_err(|e| err(e.to_string()))?;
-    chart
-        .configure_mesh()
-        .x_desc("Real axis (1/s)")
-        .y_desc("Imaginary axis (rad/s)")
-        .draw()
-        .map_err(|e| err(e.to_string()))?;
-    let shade = RGBColor(255, 210, 210).filled();
-    chart
-        .draw_series(std::iter::once(Rectangle::new(
-            [(0.0, -y1), (x1, y1)],
-            shade,
-        )))
-        .map_err(|e| err(e.to_string()))?;
-    let axis = BLACK.mix(0.5);
-    chart
-        .draw_series(LineSeries::new([(x0, 0.0), (x1, 0.0)], axis))
-        .map_err(|e| err(e.to_string()))?;
-    chart
-        .draw_series(LineSeries::new([(0.0, -y1), (0.0, y1)], axis))
-        .map_err(|e| err(e.to_string()))?;
+    let mut chart = splane_chart(&root, caption, 20, (x0, x1, y1), &err)?;
     let visible = |p: &&Pole| p.re >= x0 && p.im.abs() <= y1;
     chart
         .draw_series(
@@ -114,4 +88,50 @@ pub fn pole_map(path: &Path, title: &str, closed: &[Pole], open: &[Pole]) -> Res
         .draw()
         .map_err(|e| err(e.to_string()))?;
     root.present().map_err(|e| err(e.to_string()))
+}
+
+/// The s-plane chart shared by the pole map and the root locus: mesh, labels, the
+/// shaded right half plane and the two axes.
+pub(crate) fn splane_chart<'a, 'b>(
+    root: &'a DrawingArea<SVGBackend<'b>, plotters::coord::Shift>,
+    caption: String,
+    font: u32,
+    (x0, x1, y1): (f64, f64, f64),
+    err: &dyn Fn(String) -> DrawError,
+) -> Result<
+    ChartContext<
+        'a,
+        SVGBackend<'b>,
+        Cartesian2d<plotters::coord::types::RangedCoordf64, plotters::coord::types::RangedCoordf64>,
+    >,
+    DrawError,
+> {
+    let mut chart = ChartBuilder::on(root)
+        .caption(caption, ("sans-serif", font))
+        .margin(15)
+        .x_label_area_size(45)
+        .y_label_area_size(60)
+        .build_cartesian_2d(x0..x1, -y1..y1)
+        .map_err(|e| err(e.to_string()))?;
+    chart
+        .configure_mesh()
+        .x_desc("Real axis (1/s)")
+        .y_desc("Imaginary axis (rad/s)")
+        .draw()
+        .map_err(|e| err(e.to_string()))?;
+    let shade = RGBColor(255, 210, 210).filled();
+    chart
+        .draw_series(std::iter::once(Rectangle::new(
+            [(0.0, -y1), (x1, y1)],
+            shade,
+        )))
+        .map_err(|e| err(e.to_string()))?;
+    let axis = BLACK.mix(0.5);
+    chart
+        .draw_series(LineSeries::new([(x0, 0.0), (x1, 0.0)], axis))
+        .map_err(|e| err(e.to_string()))?;
+    chart
+        .draw_series(LineSeries::new([(0.0, -y1), (0.0, y1)], axis))
+        .map_err(|e| err(e.to_string()))?;
+    Ok(chart)
 }
