@@ -289,7 +289,7 @@ pub fn localize(
                 })
                 .collect();
             hnoise = 2.0 * s / (seg.len() as f64).sqrt();
-            let mut acc = vec![(0.0, 0usize); PHASE_BINS];
+            let mut acc = [(0.0, 0usize); PHASE_BINS];
             for w in starts.windows(2) {
                 for i in w[0]..w[1] {
                     let ph = (i - w[0]) as f64 / (w[1] - w[0]) as f64;
