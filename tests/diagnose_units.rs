@@ -1,7 +1,8 @@
 //! Gap diagnosis: the statistics it is built on (cheap, no simulation).
 
-use stirling::models::diagnose::score::Quad;
-use stirling::models::diagnose::{chi2_sf, erfc, high_pass, Eval};
+use nalgebra::{DMatrix, DVector};
+use stirling::models::diagnose::score::{bandwidth, long_run_cov, robust_score};
+use stirling::models::diagnose::{chi2_sf, erfc, high_pass};
 
 #[test]
 fn chi_square_tails() {
@@ -45,54 +46,81 @@ fn high_pass_removes_slow_parts_and_keeps_white_noise() {
     );
 }
 
-fn point(theta: Vec<f64>, s: f64) -> Eval {
-    Eval {
-        theta,
-        s_train: s,
-        n_train: 100,
-        holdout_error: 1.0,
-        train_error: 1.0,
-        channels: vec![],
-        resid: vec![],
-        hp: vec![],
-        pred: vec![],
-        p: vec![],
-    }
+/// A small deterministic generator (LCG) of standard normal draws (Box-Muller).
+fn normals(seed: u64) -> impl FnMut() -> f64 {
+    let mut s = seed;
+    let mut u = move || {
+        s = s
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        ((s >> 11) as f64 + 0.5) / (1u64 << 53) as f64
+    };
+    move || (-2.0 * u().ln()).sqrt() * (2.0 * std::f64::consts::PI * u()).cos()
+}
+
+/// A regression `y = a cos + b sin + noise` with AR(1) noise (correlation `rho`), fitted
+/// without the column `t sin` (the omitted effect, true coefficient `c`): residuals and the
+/// Jacobian `[cos, sin, t sin]` at the restricted least-squares optimum.
+fn restricted(c: f64, rho: f64, seed: u64) -> (Vec<f64>, DMatrix<f64>) {
+    let n = 600;
+    let mut z = normals(seed);
+    let mut e = 0.0;
+    let cols = DMatrix::from_fn(n, 3, |i, k| {
+        let w = 0.21 * i as f64;
+        match k {
+            0 => w.cos(),
+            1 => w.sin(),
+            _ => i as f64 / n as f64 * w.sin(),
+        }
+    });
+    let y: Vec<f64> = (0..n)
+        .map(|i| {
+            e = rho * e + (1.0 - rho * rho).sqrt() * z();
+            2.0 * cols[(i, 0)] - cols[(i, 1)] + c * cols[(i, 2)] + e
+        })
+        .collect();
+    let x = cols.columns(0, 2).into_owned();
+    let yv = DVector::from_vec(y);
+    let beta = (x.transpose() * &x).cholesky().unwrap().solve(&(x.transpose() * &yv));
+    // residuals as model minus data, like the fit's
+    let r = (&x * beta - yv).iter().copied().collect();
+    (r, cols)
 }
 
 #[test]
-fn quadratic_profile_model_and_one_sided_score() {
-    // S(a, b) = 10 + 2a - 4b + 3a^2 + ab + 2b^2, exact through six points
-    let s = |a: f64, b: f64| 10.0 + 2.0 * a - 4.0 * b + 3.0 * a * a + a * b + 2.0 * b * b;
-    let pts: Vec<Eval> = [
-        (0.0, 0.0),
-        (0.1, 0.0),
-        (0.2, 0.0),
-        (0.0, 0.1),
-        (0.0, 0.2),
-        (0.1, 0.1),
-    ]
-    .iter()
-    .map(|&(a, b)| point(vec![a, b], s(a, b)))
-    .collect();
-    let refs: Vec<&Eval> = pts.iter().collect();
-    let q = Quad::fit(&refs, &[0.0, 0.0], &[0.1, 0.1]).unwrap();
-    assert!(
-        (q.g[0] - 2.0).abs() < 1e-8 && (q.g[1] + 4.0).abs() < 1e-8,
-        "{:?}",
-        q.g
-    );
-    assert!(
-        (q.h[0][0] - 6.0).abs() < 1e-6
-            && (q.h[0][1] - 1.0).abs() < 1e-6
-            && (q.h[1][1] - 4.0).abs() < 1e-6,
-        "{:?}",
-        q.h
-    );
-    // unconstrained g' H^-1 g
-    let det = 6.0 * 4.0 - 1.0;
-    let full = (2.0 * 2.0 * 4.0 - 2.0 * 2.0 * (-4.0) * 1.0 + 16.0 * 6.0) / det;
-    assert!((q.quad_form(&[false, false], true) - full).abs() < 1e-6);
-    // one-sided: `a` would have to go negative to lower the cost, so only `b` counts
-    assert!((q.quad_form(&[true, true], true) - 16.0 / 4.0).abs() < 1e-6);
+fn robust_score_has_its_size_under_correlated_noise_and_power_against_the_effect() {
+    let blocks = [(0, 600)];
+    let lag = bandwidth(600, 30);
+    let mut rejections = 0;
+    let reps = 300;
+    for s in 0..reps {
+        let (r, j) = restricted(0.0, 0.6, 1000 + s);
+        let sc = robust_score(&r, &j, &[2], &[], &[false], &blocks, lag);
+        assert_eq!(sc.dof, 1);
+        if sc.p_value < 0.05 {
+            rejections += 1;
+        }
+    }
+    // nominal size 5 %: AR(1) noise with rho = 0.6 would triple a naive test's rate
+    let rate = rejections as f64 / reps as f64;
+    assert!((0.01..=0.11).contains(&rate), "size {rate}");
+    // the omitted column at a strength of a few noise levels is found, with the right sign
+    let (r, j) = restricted(1.0, 0.6, 7);
+    let sc = robust_score(&r, &j, &[2], &[], &[true], &blocks, lag);
+    assert!(sc.p_value < 1e-3 && sc.step[0] > 0.0, "{sc:?}");
+    // one-sided: a negative effect of a strength bounded at zero is not evidence
+    let (r, j) = restricted(-1.0, 0.6, 7);
+    let sc = robust_score(&r, &j, &[2], &[], &[true], &blocks, lag);
+    assert_eq!((sc.dof, sc.p_value), (0, 1.0));
+}
+
+#[test]
+fn long_run_covariance_of_white_rows_is_their_sum_of_squares() {
+    let mut z = normals(3);
+    let c = DMatrix::from_fn(5000, 1, |_, _| z());
+    let v = long_run_cov(&c, &[(0, 5000)], 0);
+    assert!((v[(0, 0)] / 5000.0 - 1.0).abs() < 0.05, "{}", v[(0, 0)]);
+    // with a bandwidth, white rows stay close (the cross terms average out)
+    let v10 = long_run_cov(&c, &[(0, 5000)], 10);
+    assert!((v10[(0, 0)] / v[(0, 0)] - 1.0).abs() < 0.15);
 }

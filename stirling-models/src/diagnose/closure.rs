@@ -7,7 +7,7 @@
 use rand::{rngs::StdRng, Rng, SeedableRng};
 use serde::Serialize;
 
-use super::{Eval, Profile};
+use super::{Eval, Context};
 use crate::data::{cycle_mean, Measured};
 
 /// The closure fraction with its interval.
@@ -48,7 +48,7 @@ pub fn cycle_starts(data: &Measured, range: (usize, usize)) -> Vec<usize> {
 }
 
 /// Per-sample channel-averaged normalized squared residual.
-fn sample_err(ev: &Eval, prof: &Profile, i: usize) -> f64 {
+fn sample_err(ev: &Eval, prof: &Context, i: usize) -> f64 {
     ev.channels
         .iter()
         .zip(&ev.hp)
@@ -72,7 +72,7 @@ pub fn closure(
     before: &Eval,
     after: &Eval,
     range: (usize, usize),
-    prof: &Profile,
+    prof: &Context,
     resamples: usize,
     seed: u64,
 ) -> Closure {

@@ -10,7 +10,7 @@ use serde::Serialize;
 use stirling_dsl::{Model, StateKind};
 
 use super::closure::cycle_starts;
-use super::{Eval, Profile};
+use super::{Eval, Context};
 use crate::data::{cycle_mean, Measured};
 use crate::fit::driven::savitzky_golay;
 use crate::sim::{simulate, SimOptions};
@@ -230,7 +230,7 @@ pub fn localize(
     p: &[f64],
     data: &Measured,
     nominal: &Eval,
-    prof: &Profile,
+    prof: &Context,
 ) -> Localization {
     let dt = data.dt();
     let first = prof.train_idx.0;

@@ -21,6 +21,7 @@
 //! Gauss-Newton information, i.e. `[I^-1]_theta,theta ^-1`.
 
 pub mod closure;
+pub mod joint;
 pub mod localize;
 pub mod rank;
 pub mod report;
@@ -34,9 +35,10 @@ use serde::Serialize;
 use stirling_dsl::{Closure, Model};
 
 use crate::data::{cycle_mean, Measured};
-use crate::effects::{self, EffectInfo, EffectTarget};
-use crate::fit::driven::{noise_sigma, savitzky_golay};
-use crate::fit::{self, FitOptions, Identification};
+use crate::effects::{self, EffectInfo};
+use crate::fit::driven::noise_sigma;
+use crate::fit::{self, FitOptions, FittedStage};
+use joint::Joint;
 
 /// Why a diagnosis failed.
 #[derive(Clone, Debug, thiserror::Error)]
@@ -167,9 +169,10 @@ pub struct Diagnosis {
     pub after: Option<Eval>,
 }
 
-/// One evaluation of the profiled cost at an effect setting.
+/// The residuals of one model (nominal or with an effect) on the record.
 #[derive(Clone, Debug)]
 pub struct Eval {
+    /// Effect values (empty for the nominal model).
     pub theta: Vec<f64>,
     /// Training cost: sum over channels and samples of (residual / noise)^2.
     pub s_train: f64,
@@ -185,24 +188,56 @@ pub struct Eval {
     /// what the costs and errors use.
     pub hp: Vec<Vec<f64>>,
     pub pred: Vec<Vec<f64>>,
-    /// All model parameters after the re-fit.
+    /// All model parameters (effect values applied).
     pub p: Vec<f64>,
 }
 
-/// The profiled cost of a model on a record.
-pub struct Profile<'a> {
+/// A model prediction of one channel in measured space, from sample `first` on.
+#[derive(Clone, Debug)]
+pub struct Prediction {
+    pub channel: String,
+    pub first: usize,
+    pub values: Vec<f64>,
+}
+
+/// The prediction of a fitted stage at variables `u`, from its training start to `last`.
+pub fn predict(st: &FittedStage, u: &[f64], last: usize) -> Result<Vec<Prediction>, String> {
+    let run = st
+        .stage
+        .run(u, st.first, last, false)
+        .map_err(|e| e.to_string())?;
+    Ok(st
+        .stage
+        .outputs
+        .iter()
+        .zip(run.yhat)
+        .map(|(o, values)| Prediction {
+            channel: o.channel.clone(),
+            first: run.first,
+            values,
+        })
+        .collect())
+}
+
+/// What every evaluation of a diagnosis shares.
+pub struct Context<'a> {
     pub model: &'a dyn Model,
     pub data: &'a Measured,
     /// Per-channel noise from the original record.
     pub noise: Vec<(String, f64)>,
-    pub fit: FitOptions,
     /// Training sample range (after the burn-in) and held-out range, inclusive-exclusive.
     pub train_idx: (usize, usize),
     pub hold_idx: (usize, usize),
-    /// Count of two-stage fits run.
-    pub count: std::cell::Cell<usize>,
     /// Half-width (samples) of the moving average removed from the residuals (half a cycle).
     pub half_period: usize,
+    /// Bartlett bandwidth of the robust score test (samples).
+    pub lag: usize,
+    /// The calibrated nominal parameters.
+    pub p_nom: Vec<f64>,
+    /// The nominal stages' predictions (per stage), reused for stages an effect leaves alone.
+    pub nominal_preds: Vec<Vec<Prediction>>,
+    /// Joint fits run.
+    pub fits: std::cell::Cell<usize>,
 }
 
 /// Remove the centered moving average of half-width `h` (over the finite samples), scaled so
@@ -230,12 +265,7 @@ pub fn high_pass(r: &[f64], h: usize) -> Vec<f64> {
         .collect()
 }
 
-impl Profile<'_> {
-    /// Strength parameters of an effect (those with a null value).
-    pub fn strengths(e: &EffectInfo) -> Vec<&'static effects::EffectParam> {
-        e.params.iter().filter(|q| q.null.is_some()).collect()
-    }
-
+impl Context<'_> {
     fn noise_of(&self, ch: &str) -> f64 {
         self.noise
             .iter()
@@ -244,161 +274,145 @@ impl Profile<'_> {
             .unwrap_or(1.0)
     }
 
-    /// Re-fit the nominal parameters from `start` with the effect `e` at `theta`, and return
-    /// the residuals in measured space.
-    pub fn eval(
-        &self,
-        e: Option<&EffectInfo>,
-        theta: &[f64],
-        start: &[f64],
-    ) -> Result<Eval, String> {
-        self.count.set(self.count.get() + 1);
-        let mut p = start.to_vec();
-        let mut data = self.data.clone();
-        let (mut gain_x, mut gain_y, mut tau) = (0.0, 0.0, 0.0);
-        if let Some(e) = e {
-            for (q, &v) in Self::strengths(e).iter().zip(theta) {
-                match (e.target, q.name) {
-                    (EffectTarget::Model, name) => {
-                        let i = self.model.param_index(name).ok_or_else(|| {
-                            format!("model `{}` has no parameter `{name}`", self.model.name())
-                        })?;
-                        p[i] = v;
-                    }
-                    (EffectTarget::Sensor, "gain_x") => gain_x = v,
-                    (EffectTarget::Sensor, "gain_y") => gain_y = v,
-                    (EffectTarget::Sensor, "tau_p") => tau = v,
-                    (EffectTarget::Sensor, other) => {
-                        return Err(format!(
-                            "sensor parameter `{other}` is not handled by the diagnosis"
-                        ))
-                    }
-                }
-            }
-        }
-        // sensor effects: undo them on the data for the fit, apply them to the prediction
-        if let Some(x) = data.x.as_mut() {
-            x.iter_mut().for_each(|v| *v /= 1.0 + gain_x);
-        }
-        if let Some(y) = data.y.as_mut() {
-            y.iter_mut().for_each(|v| *v /= 1.0 + gain_y);
-        }
-        let dt = data.dt();
-        if tau > 0.0 {
-            for ch in [data.p.as_mut(), data.p_hot.as_mut()].into_iter().flatten() {
-                // invert the lag: u = y + tau y' (the derivative from a local cubic fit)
-                let (_, der) = savitzky_golay(ch, dt, 4, 3);
-                for (v, d) in ch.iter_mut().zip(&der) {
-                    *v += tau * d;
-                }
-            }
-        }
-        let id: Identification =
-            fit::identify(self.model, &p, &data, &self.fit).map_err(|e| e.to_string())?;
-        let mut p_fit = p.clone();
-        for (name, v) in &id.params {
-            if let Some(i) = self.model.param_index(name) {
-                p_fit[i] = *v;
-            }
-        }
+    /// The recorded excursion of a position channel about its mean (99.5th percentile).
+    pub fn excursion(&self, ch: &str) -> Option<f64> {
+        let v = self.data.channel(ch)?;
+        let m = cycle_mean(v);
+        let mut a: Vec<f64> = v.iter().map(|s| (s - m).abs()).collect();
+        a.sort_by(f64::total_cmp);
+        a.get((a.len() as f64 * 0.995) as usize).copied()
+    }
+
+    /// Residual samples (all channels) on the held-out block.
+    pub fn holdout_points(&self, ev: &Eval) -> usize {
+        (self.hold_idx.1 - self.hold_idx.0) * ev.channels.len()
+    }
+
+    /// The evaluation of a set of predictions (effect values `theta`, parameters `p`).
+    pub fn eval(&self, preds: &[Prediction], theta: Vec<f64>, p: Vec<f64>) -> Result<Eval, String> {
         let nt = self.data.t.len();
-        let t0 = self.data.t[0];
-        let mut channels = Vec::new();
-        let mut resid = Vec::new();
-        let mut pred = Vec::new();
-        for st in [id.stage1.as_ref(), id.stage2.as_ref()]
-            .into_iter()
-            .flatten()
-        {
-            for s in &st.series {
-                let meas = self
-                    .data
-                    .channel(&s.channel)
-                    .ok_or_else(|| format!("channel `{}` missing", s.channel))?;
-                let model_out: Vec<f64> = match s.channel.as_str() {
-                    "x" => s.model.iter().map(|v| v * (1.0 + gain_x)).collect(),
-                    "y" => s.model.iter().map(|v| v * (1.0 + gain_y)).collect(),
-                    "p" | "p_hot" if tau > 0.0 => crate::rig::first_order_lag(&s.model, dt, tau),
-                    _ => s.model.clone(),
-                };
-                let mut r = vec![f64::NAN; nt];
-                let mut pr = vec![f64::NAN; nt];
-                for (k, &t) in s.t.iter().enumerate() {
-                    let i = ((t - t0) / dt).round() as usize;
-                    if i < nt {
-                        r[i] = meas[i] - model_out[k];
-                        pr[i] = model_out[k];
-                    }
+        let (mut channels, mut resid, mut pred) = (Vec::new(), Vec::new(), Vec::new());
+        for pr in preds {
+            let meas = self
+                .data
+                .channel(&pr.channel)
+                .ok_or_else(|| format!("channel `{}` missing", pr.channel))?;
+            let mut r = vec![f64::NAN; nt];
+            let mut pv = vec![f64::NAN; nt];
+            for (k, v) in pr.values.iter().enumerate() {
+                let i = pr.first + k;
+                if i < nt {
+                    r[i] = meas[i] - v;
+                    pv[i] = *v;
                 }
-                channels.push(s.channel.clone());
-                resid.push(r);
-                pred.push(pr);
             }
+            channels.push(pr.channel.clone());
+            resid.push(r);
+            pred.push(pv);
         }
         if channels.is_empty() {
-            return Err("the identification produced no output series".into());
+            return Err("the calibration produced no output series".into());
         }
         let hp: Vec<Vec<f64>> = resid
             .iter()
             .map(|r| high_pass(r, self.half_period))
             .collect();
-        let (mut s_train, mut n_train) = (0.0, 0);
-        let sample_err = |range: (usize, usize), acc: Option<&mut f64>| -> Result<f64, String> {
-            let (mut sum, mut cnt) = (0.0, 0usize);
-            let mut s_acc = 0.0;
+        let sample_err = |range: (usize, usize)| -> Result<(f64, f64), String> {
+            let mut total = 0.0;
             for i in range.0..range.1 {
-                let mut e = 0.0;
                 for (c, r) in channels.iter().zip(&hp) {
                     let z = r[i] / self.noise_of(c);
                     if !z.is_finite() {
                         return Err(format!("no model output for `{c}` at sample {i}"));
                     }
-                    e += z * z;
+                    total += z * z;
                 }
-                s_acc += e;
-                sum += e / channels.len() as f64;
-                cnt += 1;
             }
-            if let Some(a) = acc {
-                *a = s_acc;
-            }
-            Ok(sum / cnt.max(1) as f64)
+            let n = ((range.1 - range.0) * channels.len()).max(1) as f64;
+            Ok((total, total / n))
         };
-        let train_error = sample_err(self.train_idx, Some(&mut s_train))?;
-        n_train += (self.train_idx.1 - self.train_idx.0) * channels.len();
-        let holdout_error = sample_err(self.hold_idx, None)?;
+        let (s_train, train_error) = sample_err(self.train_idx)?;
+        let (_, holdout_error) = sample_err(self.hold_idx)?;
         Ok(Eval {
-            theta: theta.to_vec(),
+            theta,
             s_train,
-            n_train,
+            n_train: (self.train_idx.1 - self.train_idx.0) * channels.len(),
             holdout_error,
             train_error,
             channels,
             resid,
             hp,
             pred,
-            p: p_fit,
+            p,
         })
+    }
+
+    /// The evaluation of a fitted joint problem: its stages at `u`, the others nominal.
+    pub fn eval_joint(
+        &self,
+        joint: &Joint,
+        u: &[f64],
+        theta: Vec<f64>,
+    ) -> Result<Eval, String> {
+        let last = self.hold_idx.1 - 1;
+        let mut preds = Vec::new();
+        for (si, nom) in self.nominal_preds.iter().enumerate() {
+            match joint.stages.iter().position(|(s, _)| *s == si) {
+                Some(k) => preds.extend(predict(&joint.stages[k].1, &joint.stage_u(k, u), last)?),
+                None => preds.extend(nom.iter().cloned()),
+            }
+        }
+        let mut p = self.p_nom.clone();
+        for (v, val) in joint.effect.iter().zip(&theta) {
+            if let Some(i) = self.model.param_index(&v.name) {
+                p[i] = *val;
+            }
+        }
+        self.eval(&preds, theta, p)
     }
 }
 
-/// Error for parameters that the two-stage fit did not free (used for the BIC count).
-fn free_count(model: &dyn Model, p: &[f64], fit: &FitOptions) -> usize {
-    fit.free
-        .clone()
-        .unwrap_or_else(|| fit::default_free(model, p))
-        .len()
+/// The candidate effects of a diagnosis.
+fn candidates(
+    model: &dyn Model,
+    names: &Option<Vec<String>>,
+) -> Result<Vec<&'static EffectInfo>, DiagnoseError> {
+    let base = model.name().trim_end_matches("_fx").to_string();
+    let Some(names) = names else {
+        return Ok(effects::effects_for(&base));
+    };
+    let mut v = Vec::new();
+    for n in names {
+        let e = effects::effect(n).ok_or_else(|| {
+            DiagnoseError::Bad(format!(
+                "unknown effect `{n}`: expected one of {}",
+                effects::EFFECTS
+                    .iter()
+                    .map(|e| e.name)
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            ))
+        })?;
+        if !e.applies_to.contains(&base.as_str()) {
+            return Err(DiagnoseError::Bad(format!(
+                "effect `{n}` does not apply to `{base}` (it applies to {})",
+                e.applies_to.join(", ")
+            )));
+        }
+        v.push(e);
+    }
+    Ok(v)
 }
 
-/// Diagnose `model` (a base model with an augmented member: `cv1`, `nsection`) from starting
-/// parameters `p0` (of the augmented model, effects at their nulls) on a measured record.
-pub fn diagnose(
-    model: &dyn Model,
-    p0: &[f64],
-    data: &Measured,
-    opts: &DiagnoseOptions,
-) -> Result<Diagnosis, DiagnoseError> {
-    let clock = Instant::now();
+/// Training and held-out blocks (times and sample ranges) of a record.
+struct Blocks {
+    train: (f64, f64),
+    holdout: (f64, f64),
+    train_idx: (usize, usize),
+    hold_idx: (usize, usize),
+}
+
+fn blocks(data: &Measured, opts: &DiagnoseOptions) -> Result<Blocks, DiagnoseError> {
     if data.t.len() < 100 {
         return Err(DiagnoseError::Bad(format!(
             "{}: {} samples are too few to diagnose",
@@ -423,9 +437,29 @@ pub fn diagnose(
     let hold_idx = (idx(holdout.0).max(train_idx.1), idx(holdout.1) + 1);
     if train_idx.1 < train_idx.0 + 50 || hold_idx.1 < hold_idx.0 + 50 {
         return Err(DiagnoseError::Bad(
-            "the training and held-out blocks need at least 50 samples each".into(),
+            "the training and held-out blocks need at least 50 samples each (after the burn-in)"
+                .into(),
         ));
     }
+    Ok(Blocks {
+        train,
+        holdout,
+        train_idx,
+        hold_idx,
+    })
+}
+
+/// Diagnose `model` (a base model with an augmented member: `cv1`, `nsection`) from starting
+/// parameters `p0` (of the augmented model, effects at their nulls) on a measured record.
+pub fn diagnose(
+    model: &dyn Model,
+    p0: &[f64],
+    data: &Measured,
+    opts: &DiagnoseOptions,
+) -> Result<Diagnosis, DiagnoseError> {
+    let clock = Instant::now();
+    let b = blocks(data, opts)?;
+    let cands = candidates(model, &opts.effects)?;
     let noise: Vec<(String, f64)> = data
         .channels()
         .iter()
@@ -435,120 +469,112 @@ pub fn diagnose(
         })
         .collect();
     let mut fit_opts = opts.fit.clone();
-    fit_opts.train = Some(train);
-    fit_opts.holdout = Some(holdout);
-    // the end stops' travel is a shape parameter: taken from the data (the largest excursion)
-    let mut p0 = p0.to_vec();
-    for (ch, name) in [("x", "xmax"), ("y", "ymax")] {
-        if let (Some(v), Some(i)) = (data.channel(ch), model.param_index(name)) {
-            let m = cycle_mean(v);
-            let mut a: Vec<f64> = v.iter().map(|s| (s - m).abs()).collect();
-            a.sort_by(f64::total_cmp);
-            p0[i] = 0.97 * a[(a.len() as f64 * 0.995) as usize];
+    fit_opts.train = Some(b.train);
+    fit_opts.holdout = Some(b.holdout);
+    // the diagnosis needs the stages, not the validation extras
+    fit_opts.free_run = None;
+    fit_opts.multiple_shooting = None;
+    fit_opts.input_noise_draws = 0;
+    let (id, stages) = fit::identify_stages(model, p0, data, &fit_opts)
+        .map_err(|e| DiagnoseError::Nominal(e.to_string()))?;
+    let mut p_nom = p0.to_vec();
+    for (name, v) in &id.params {
+        if let Some(i) = model.param_index(name) {
+            p_nom[i] = *v;
         }
     }
-    let starts = closure::cycle_starts(data, (train_idx.0, hold_idx.1));
-    let half_period = if starts.len() >= 2 {
-        (starts[starts.len() - 1] - starts[0]) / (starts.len() - 1) / 2
+    let starts = closure::cycle_starts(data, (b.train_idx.0, b.hold_idx.1));
+    let period = if starts.len() >= 2 {
+        (starts[starts.len() - 1] - starts[0]) / (starts.len() - 1)
     } else {
         0
     };
-    let prof = Profile {
+    let last = b.hold_idx.1 - 1;
+    let nominal_preds = stages
+        .iter()
+        .map(|st| predict(st, &st.u, last))
+        .collect::<Result<Vec<_>, String>>()
+        .map_err(DiagnoseError::Nominal)?;
+    let ctx = Context {
         model,
         data,
-        noise: noise.clone(),
-        fit: fit_opts.clone(),
-        train_idx,
-        hold_idx,
-        count: std::cell::Cell::new(0),
-        half_period,
+        noise,
+        train_idx: b.train_idx,
+        hold_idx: b.hold_idx,
+        half_period: period / 2,
+        lag: score::bandwidth(b.train_idx.1 - b.train_idx.0, period),
+        p_nom: p_nom.clone(),
+        nominal_preds,
+        fits: std::cell::Cell::new(1),
     };
-    let nominal = prof.eval(None, &[], &p0).map_err(DiagnoseError::Nominal)?;
-    let p_nom = nominal.p.clone();
-    // later fits start at the calibrated point: fewer iterations suffice
-    let mut refit = fit_opts.clone();
-    refit.lm.max_iter = refit.lm.max_iter.min(30);
-    let prof = Profile { fit: refit, ..prof };
-    // the reference for every comparison: the nominal model re-fitted from its calibrated point
-    // with the same protocol as the candidates (same start, same optimizer settings)
-    let nominal = prof
-        .eval(None, &[], &p_nom)
+    let all: Vec<Prediction> = ctx.nominal_preds.iter().flatten().cloned().collect();
+    let nominal = ctx
+        .eval(&all, vec![], p_nom.clone())
         .map_err(DiagnoseError::Nominal)?;
-    let p_nom = nominal.p.clone();
-
-    let base = model.name().trim_end_matches("_fx").to_string();
-    let candidates: Vec<&'static EffectInfo> = match &opts.effects {
-        None => effects::effects_for(&base),
-        Some(names) => {
-            let mut v = Vec::new();
-            for n in names {
-                let e = effects::effect(n).ok_or_else(|| {
-                    DiagnoseError::Bad(format!(
-                        "unknown effect `{n}`: expected one of {}",
-                        effects::EFFECTS
-                            .iter()
-                            .map(|e| e.name)
-                            .collect::<Vec<_>>()
-                            .join(", ")
-                    ))
-                })?;
-                if !e.applies_to.contains(&base.as_str()) {
-                    return Err(DiagnoseError::Bad(format!(
-                        "effect `{n}` does not apply to `{base}` (it applies to {})",
-                        e.applies_to.join(", ")
-                    )));
-                }
-                v.push(e);
-            }
-            v
-        }
-    };
-    let n_free = free_count(model, &p_nom, &prof.fit);
-    let localization = localize::localize(model, &p_nom, data, &nominal, &prof);
-    let screens: Vec<score::Screen> = candidates
+    let s2 = stages
         .iter()
-        .map(|e| score::screen(&prof, e, &nominal, n_free))
+        .map(joint::variance_factor)
+        .collect::<Result<Vec<f64>, _>>()
+        .map_err(|e| DiagnoseError::Nominal(e.to_string()))?;
+    let localization = localize::localize(model, &p_nom, data, &nominal, &ctx);
+    let mut lm = opts.fit.lm;
+    lm.max_iter = opts.newton_iters;
+    let mut assessed: Vec<rank::Assessed> = cands
+        .iter()
+        .map(|e| rank::assess(&ctx, &stages, &s2, &nominal, e, &lm))
         .collect();
-    let (mut ranking, screens) = rank::rank(&prof, &screens, &nominal, n_free, opts);
-    let mut after = None;
-    if let Some(best) = ranking.first().filter(|r| r.fitted) {
-        if let Some(ev) = screens
-            .iter()
-            .find(|s| s.effect.name == best.effect)
-            .and_then(|s| s.best_fit.clone())
-        {
-            after = Some(ev);
-        }
-    }
-    for r in ranking.iter_mut().filter(|r| r.fitted) {
-        if let Some(ev) = screens
-            .iter()
-            .find(|s| s.effect.name == r.effect)
-            .and_then(|s| s.best_fit.as_ref())
-        {
+    rank::sort(&mut assessed);
+    for a in assessed.iter_mut() {
+        if let Some(ev) = &a.eval {
             let c = closure::closure(
                 data,
                 &nominal,
                 ev,
-                prof.hold_idx,
-                &prof,
+                ctx.hold_idx,
+                &ctx,
                 opts.bootstrap,
                 opts.seed,
             );
-            r.closure_fraction = Some(c.fraction);
-            r.ci_low = Some(c.ci_low);
-            r.ci_high = Some(c.ci_high);
+            a.entry.closure_fraction = Some(c.fraction);
+            a.entry.ci_low = Some(c.ci_low);
+            a.entry.ci_high = Some(c.ci_high);
         }
     }
-    let verdict = verdict::decide(&ranking, &nominal, opts.alpha, screens.len());
+    let after = assessed.first().and_then(|a| a.eval.clone());
+    let ranking: Vec<RankEntry> = assessed.into_iter().map(|a| a.entry).collect();
+    let verdict = verdict::decide(&ranking, &nominal, opts.alpha, cands.len());
+    let gap_before = gap_before(&ctx, &nominal, &stages, &localization);
+    Ok(Diagnosis {
+        model: model.name().into(),
+        n: model.n(),
+        train: b.train,
+        holdout: b.holdout,
+        gap_before,
+        localization,
+        ranking,
+        verdict,
+        fits: ctx.fits.get(),
+        seconds: clock.elapsed().as_secs_f64(),
+        before: Some(nominal),
+        after,
+    })
+}
+
+/// The nominal model's held-out gap per channel, with features and calibrated parameters.
+fn gap_before(
+    ctx: &Context,
+    nominal: &Eval,
+    stages: &[FittedStage],
+    loc: &localize::Localization,
+) -> GapBefore {
+    let (a, b) = ctx.hold_idx;
     let channels = nominal
         .channels
         .iter()
         .zip(&nominal.resid)
         .map(|(c, r)| {
-            let h: Vec<f64> = r[hold_idx.0..hold_idx.1].to_vec();
-            let rms = (h.iter().map(|v| v * v).sum::<f64>() / h.len() as f64).sqrt();
-            let s = prof.noise_of(c);
+            let rms = (r[a..b].iter().map(|v| v * v).sum::<f64>() / (b - a) as f64).sqrt();
+            let s = ctx.noise_of(c);
             ChannelError {
                 channel: c.clone(),
                 rms,
@@ -557,36 +583,21 @@ pub fn diagnose(
             }
         })
         .collect();
-    let free = prof
-        .fit
-        .free
-        .clone()
-        .unwrap_or_else(|| fit::default_free(model, &p_nom));
-    let params = free
+    let params = stages
         .iter()
-        .filter_map(|n| model.param_index(n).map(|i| (n.clone(), p_nom[i])))
+        .flat_map(|st| st.stage.vars.iter())
+        .filter_map(|v| match v.kind {
+            fit::driven::VarKind::Param(i) => Some((v.name.clone(), ctx.p_nom[i])),
+            _ => None,
+        })
         .collect();
-    let features = localization.features.clone();
-    Ok(Diagnosis {
-        model: model.name().into(),
-        n: model.n(),
-        train,
-        holdout,
-        gap_before: GapBefore {
-            channels,
-            holdout_error: nominal.holdout_error,
-            train_error: nominal.train_error,
-            features,
-            params,
-        },
-        localization,
-        ranking,
-        verdict,
-        fits: prof.count.get(),
-        seconds: clock.elapsed().as_secs_f64(),
-        before: Some(nominal),
-        after,
-    })
+    GapBefore {
+        channels,
+        holdout_error: nominal.holdout_error,
+        train_error: nominal.train_error,
+        features: loc.features.clone(),
+        params,
+    }
 }
 
 /// The augmented model of a base model name, with its nominal parameters.

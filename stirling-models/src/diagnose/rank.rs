@@ -1,221 +1,233 @@
-//! Fit the promising effects jointly with the nominal parameters on the training block and
-//! rank them by held-out error with a BIC penalty for the added parameters.
+//! Screen, fit and rank the candidates: for every effect, the score test at its null on the
+//! joint problem ([`super::joint`], [`super::score`]); then the joint Levenberg-Marquardt fit
+//! of its strengths (and shapes) with every nominal variable of the stages it touches, from
+//! the nominal optimum; then the held-out error of the fitted model and the held-out BIC
+//! change `N_h ln(err_effect / err_nominal) + k ln N_h` (negative: better than nominal).
 //!
-//! A candidate's strength `theta` is fitted by Newton steps on the profiled cost `S(theta)`
-//! (the nominal parameters re-fitted by the two-stage identification at every evaluation):
-//! a least-squares quadratic through the evaluated points nearest the current best, a step to
-//! its minimizer (kept non-negative for bounded strengths and inside a trust region), repeated
-//! `newton_iters` times. Intervals come from the curvature, `cov = 2 s^2 H^-1`.
-//! The ranking criterion is the held-out BIC change
-//! `N_h ln(err_effect / err_nominal) + k ln N_h` (negative: better than the nominal model).
+//! Shape parameters (the end stops' travel) are inert at a zero strength, so the score test
+//! cannot see them (Davies' problem): it is taken at a grid of travels (fractions of the
+//! recorded excursion), the largest statistic kept with a Bonferroni factor, and the joint
+//! fit starts from that travel with the travel free.
 
-use super::score::{Quad, Screen};
-use super::{chi2_sf, DiagnoseOptions, EffectEstimate, Eval, Profile, RankEntry};
+use nalgebra::DVector;
 
-fn nearest<'a>(points: &'a [Eval], center: &[f64], scale: &[f64], m: usize) -> Vec<&'a Eval> {
-    let mut v: Vec<&Eval> = points.iter().collect();
-    let d = |e: &Eval| {
-        e.theta
-            .iter()
-            .zip(center)
-            .zip(scale)
-            .map(|((a, b), s)| ((a - b) / s).powi(2))
-            .sum::<f64>()
-    };
-    v.sort_by(|a, b| d(a).total_cmp(&d(b)));
-    v.truncate(m);
-    v
+use super::joint::{EffectVar, Joint};
+use super::score::{robust_score, Score};
+use super::{Context, EffectEstimate, Eval, RankEntry};
+use crate::effects::EffectInfo;
+use crate::fit::lm::{self, LmOptions};
+use crate::fit::FittedStage;
+
+/// Travel grid of the end stops, as fractions of the recorded excursion.
+const TRAVEL_GRID: [f64; 4] = [0.6, 0.75, 0.9, 1.0];
+
+/// A candidate's screen and fit.
+pub struct Assessed {
+    pub entry: RankEntry,
+    /// The fitted model's evaluation on the record.
+    pub eval: Option<Eval>,
 }
 
-/// Fit one screened effect; sets `sc.best_fit` and returns the estimates.
-pub fn fit_effect(
-    prof: &Profile,
-    sc: &mut Screen,
-    iters: usize,
-    n_free: usize,
-) -> Result<Vec<EffectEstimate>, String> {
-    let k = sc.step.len();
-    let nc = 1 + k + k * (k + 1) / 2;
-    for _ in 0..iters {
-        let best = sc
-            .points
-            .iter()
-            .min_by(|a, b| a.s_train.total_cmp(&b.s_train))
-            .expect("null point")
-            .clone();
-        let scale: Vec<f64> = sc
-            .step
-            .iter()
-            .zip(&best.theta)
-            .map(|(h, t)| h.max(0.5 * t.abs()))
-            .collect();
-        let pts = nearest(&sc.points, &best.theta, &scale, nc + 1);
-        let Some(q) = Quad::fit(&pts, &best.theta, &scale) else {
-            break;
-        };
-        let step: Vec<f64> = match q.newton() {
-            Some(s) => s.iter().map(|v| -v).collect(),
-            // not convex here: a gradient step of one design scale
-            None => {
-                let gn =
-                    q.g.iter()
-                        .zip(&scale)
-                        .map(|(g, s)| (g * s).powi(2))
-                        .sum::<f64>()
-                        .sqrt()
-                        .max(1e-300);
-                q.g.iter()
-                    .zip(&scale)
-                    .map(|(g, s)| -g * s * s / gn)
-                    .collect()
-            }
-        };
-        let mut th: Vec<f64> = best
-            .theta
-            .iter()
-            .zip(&step)
-            .zip(&scale)
-            .map(|((t, d), s)| t + d.clamp(-4.0 * s, 4.0 * s))
-            .collect();
-        for (i, b) in sc.bounded.iter().enumerate() {
-            if *b {
-                th[i] = th[i].max(0.0);
-            }
-        }
-        if th
-            .iter()
-            .zip(&best.theta)
-            .zip(&scale)
-            .all(|((a, b), s)| (a - b).abs() < 0.02 * s)
-        {
-            break;
-        }
-        match prof.eval(Some(sc.effect), &th, &best.p) {
-            Ok(ev) => sc.points.push(ev),
-            Err(_) => break,
-        }
-    }
-    let best = sc
-        .points
-        .iter()
-        .min_by(|a, b| a.s_train.total_cmp(&b.s_train))
-        .expect("null point")
-        .clone();
-    let scale: Vec<f64> = sc
-        .step
-        .iter()
-        .zip(&best.theta)
-        .map(|(h, t)| h.max(0.5 * t.abs()))
+/// Shape settings to screen: one empty setting, or the travel grid.
+fn shape_grid(ctx: &Context, e: &EffectInfo) -> Vec<Vec<(&'static str, f64)>> {
+    let travel: Vec<(&'static str, f64)> = [("xmax", "x"), ("ymax", "y")]
+        .into_iter()
+        .filter(|(q, _)| e.params.iter().any(|p| p.name == *q))
+        .filter_map(|(q, ch)| ctx.excursion(ch).map(|a| (q, a)))
         .collect();
-    let pts = nearest(&sc.points, &best.theta, &scale, nc + 1);
-    let s2 = best.s_train / (best.n_train.saturating_sub(n_free + k)).max(1) as f64;
-    let cov = Quad::fit(&pts, &best.theta, &scale).and_then(|q| {
-        let h = nalgebra::DMatrix::from_fn(k, k, |a, b| q.h[a][b]);
-        h.try_inverse().map(|inv| inv * (2.0 * s2))
-    });
-    let qs = Profile::strengths(sc.effect);
-    let est = qs
+    if travel.is_empty() {
+        return vec![vec![]];
+    }
+    TRAVEL_GRID
         .iter()
-        .enumerate()
-        .map(|(i, q)| {
-            let se = cov
-                .as_ref()
-                .map(|c| c[(i, i)])
-                .filter(|v| *v > 0.0)
-                .map(f64::sqrt)
-                .unwrap_or(f64::NAN);
-            let v = best.theta[i];
+        .map(|f| travel.iter().map(|(q, a)| (*q, f * a)).collect())
+        .collect()
+}
+
+/// The score test of `joint` at its start.
+fn screen(ctx: &Context, joint: &Joint, u0: &[f64]) -> Result<Score, String> {
+    let (r, j, blocks) = joint.residuals(u0).map_err(|e| e.to_string())?;
+    let strengths: Vec<&EffectVar> = joint.effect.iter().filter(|v| !v.shape).collect();
+    let test: Vec<usize> = strengths.iter().map(|v| v.index).collect();
+    let skip: Vec<usize> = joint
+        .effect
+        .iter()
+        .filter(|v| v.shape)
+        .map(|v| v.index)
+        .collect();
+    let bounded: Vec<bool> = strengths.iter().map(|v| v.bounded).collect();
+    Ok(robust_score(&r, &j, &test, &skip, &bounded, &blocks, ctx.lag))
+}
+
+/// Levenberg-Marquardt on the joint problem from `u0`, with the variables `fixed` held.
+fn solve(joint: &Joint, u0: &[f64], fixed: &[usize], opts: &LmOptions) -> Option<lm::LmResult> {
+    let mut eval = |u: &[f64]| {
+        let mut u = u.to_vec();
+        fixed.iter().for_each(|&i| u[i] = u0[i]);
+        let (r, mut j, _) = joint.residuals(&u).ok()?;
+        for &i in fixed {
+            j.column_mut(i).fill(0.0);
+        }
+        Some((r, j))
+    };
+    let mut res = lm::minimize(&mut eval, u0, opts)?;
+    fixed.iter().for_each(|&i| res.x[i] = u0[i]);
+    Some(res)
+}
+
+/// Fit the effect jointly: strengths start at the one-step estimate (kept on their side of
+/// the bound); a bounded strength that ends below its null is held there and the fit redone.
+fn fit(
+    joint: &Joint,
+    start: &[f64],
+    score: &Score,
+    opts: &LmOptions,
+) -> Result<(lm::LmResult, Vec<usize>), String> {
+    let mut u0 = start.to_vec();
+    let strengths: Vec<&EffectVar> = joint.effect.iter().filter(|v| !v.shape).collect();
+    for (v, &s) in strengths.iter().zip(&score.step) {
+        // a strength the screen dropped still gets a small push to explore its side
+        u0[v.index] = if v.bounded { s.max(0.05) } else { s };
+    }
+    let mut fixed: Vec<usize> = Vec::new();
+    for _ in 0..=strengths.len() {
+        let res = solve(joint, &u0, &fixed, opts)
+            .ok_or_else(|| "the joint fit could not evaluate its start".to_string())?;
+        let below: Vec<usize> = strengths
+            .iter()
+            .filter(|v| v.bounded && !fixed.contains(&v.index) && res.x[v.index] < 0.0)
+            .map(|v| v.index)
+            .collect();
+        if below.is_empty() {
+            return Ok((res, fixed));
+        }
+        for i in below {
+            u0[i] = 0.0;
+            fixed.push(i);
+        }
+        u0.iter_mut()
+            .zip(&res.x)
+            .enumerate()
+            .filter(|(i, _)| !fixed.contains(i))
+            .for_each(|(_, (a, b))| *a = *b);
+    }
+    Err("the joint fit did not settle its bounds".into())
+}
+
+/// Estimates with 95 % intervals from the Gauss-Newton covariance at the optimum.
+fn estimates(joint: &Joint, res: &lm::LmResult, fixed: &[usize]) -> Vec<EffectEstimate> {
+    let j = &res.jacobian;
+    let free: Vec<usize> = (0..j.ncols()).filter(|c| !fixed.contains(c)).collect();
+    let jf = j.select_columns(&free);
+    let dof = res.residuals.len().saturating_sub(free.len()).max(1);
+    let s2 = DVector::from_column_slice(&res.residuals).norm_squared() / dof as f64;
+    let cov = (jf.transpose() * &jf).try_inverse().map(|c| c * s2);
+    let values = joint.effect_values(&res.x);
+    joint
+        .effect
+        .iter()
+        .zip(values)
+        .map(|(v, value)| {
+            let se = free
+                .iter()
+                .position(|&c| c == v.index)
+                .and_then(|k| cov.as_ref().map(|c| c[(k, k)]))
+                .filter(|c| *c > 0.0)
+                .map(|c| v.scale * c.sqrt())
+                .unwrap_or(if fixed.contains(&v.index) { 0.0 } else { f64::NAN });
             EffectEstimate {
-                name: q.name.into(),
-                value: v,
+                name: v.name.clone(),
+                value,
                 std_error: se,
-                ci_low: v - 1.96 * se,
-                ci_high: v + 1.96 * se,
-                unit: q.unit.into(),
+                ci_low: value - 1.96 * se,
+                ci_high: value + 1.96 * se,
+                unit: v.unit.clone(),
             }
         })
-        .collect();
-    sc.best_fit = Some(best);
-    Ok(est)
+        .collect()
 }
 
-/// Fit the promising candidates and rank every candidate (fitted ones first, by held-out BIC
-/// change; then the rest by p-value).
-pub fn rank(
-    prof: &Profile,
-    screens: &[Screen],
-    nominal: &Eval,
-    n_free: usize,
-    opts: &DiagnoseOptions,
-) -> (Vec<RankEntry>, Vec<Screen>) {
-    let mut screens: Vec<Screen> = screens.to_vec();
-    let m = screens.len().max(1) as f64;
-    // candidates whose screen was inconclusive (profile not convex) are fitted first, then by score
-    let key = |s: &Screen| {
-        if s.stat.is_finite() {
-            s.stat
-        } else {
-            f64::INFINITY
-        }
+/// Screen and fit one candidate.
+pub fn assess(
+    ctx: &Context,
+    nominal: &[FittedStage],
+    s2: &[f64],
+    nominal_eval: &Eval,
+    e: &'static EffectInfo,
+    opts: &LmOptions,
+) -> Assessed {
+    let mut entry = RankEntry {
+        effect: e.name.into(),
+        score: f64::NAN,
+        dof: 0,
+        p_value: f64::NAN,
+        fitted: false,
+        delta_bic: None,
+        holdout_error: None,
+        closure_fraction: None,
+        ci_low: None,
+        ci_high: None,
+        params: Vec::new(),
+        note: None,
     };
-    let mut order: Vec<usize> = (0..screens.len())
-        .filter(|&i| !screens[i].points.is_empty())
-        .collect();
-    order.sort_by(|&a, &b| key(&screens[b]).total_cmp(&key(&screens[a])));
-    let fit_set: Vec<usize> = order
-        .iter()
-        .copied()
-        .enumerate()
-        .filter(|(r, i)| *r < opts.max_fit || screens[*i].p_value < opts.alpha / m)
-        .map(|(_, i)| i)
-        .collect();
-    let n_h = ((prof.hold_idx.1 - prof.hold_idx.0) * nominal.channels.len()) as f64;
-    let mut out = Vec::new();
-    for (i, sc) in screens.iter_mut().enumerate() {
-        let mut entry = RankEntry {
-            effect: sc.effect.name.into(),
-            score: sc.stat,
-            dof: sc.dof,
-            p_value: sc.p_value,
-            fitted: false,
-            delta_bic: None,
-            holdout_error: None,
-            closure_fraction: None,
-            ci_low: None,
-            ci_high: None,
-            params: Vec::new(),
-            note: sc.note.clone(),
-        };
-        if fit_set.contains(&i) {
-            match fit_effect(prof, sc, opts.newton_iters, n_free) {
-                Ok(est) => {
-                    let best = sc.best_fit.as_ref().expect("set by fit_effect");
-                    entry.fitted = true;
-                    entry.params = est;
-                    entry.holdout_error = Some(best.holdout_error);
-                    entry.delta_bic = Some(
-                        n_h * (best.holdout_error / nominal.holdout_error).ln()
-                            + sc.dof as f64 * n_h.ln(),
-                    );
-                    if !sc.stat.is_finite() {
-                        // the profile is not convex at the null (fit noise at the design step):
-                        // the likelihood-ratio statistic of the fit, asymptotically equivalent
-                        let lr = ((nominal.s_train - best.s_train) / sc.s2).max(0.0);
-                        entry.score = lr;
-                        entry.p_value = chi2_sf(lr, sc.dof);
-                        entry.note = Some("score: profiled cost not convex at the null; likelihood-ratio statistic used".into());
-                    }
-                }
-                Err(e) => entry.note = Some(e),
-            }
+    match assess_inner(ctx, nominal, s2, nominal_eval, e, opts, &mut entry) {
+        Ok(eval) => Assessed { entry, eval },
+        Err(msg) => {
+            entry.note = Some(msg);
+            Assessed { entry, eval: None }
         }
-        out.push(entry);
     }
-    out.sort_by(|a, b| match (a.delta_bic, b.delta_bic) {
+}
+
+fn assess_inner(
+    ctx: &Context,
+    nominal: &[FittedStage],
+    s2: &[f64],
+    nominal_eval: &Eval,
+    e: &'static EffectInfo,
+    opts: &LmOptions,
+    entry: &mut RankEntry,
+) -> Result<Option<Eval>, String> {
+    let grid = shape_grid(ctx, e);
+    let mut best: Option<(Score, Vec<(&'static str, f64)>)> = None;
+    for shapes in &grid {
+        let joint = Joint::new(ctx.model, nominal, s2, e, shapes, false)?;
+        let sc = screen(ctx, &joint, &joint.start(nominal))?;
+        if best.as_ref().is_none_or(|(b, _)| sc.stat > b.stat) {
+            best = Some((sc, shapes.clone()));
+        }
+    }
+    let (score, shapes) = best.expect("the grid is not empty");
+    entry.score = score.stat;
+    entry.dof = score.dof;
+    entry.p_value = (score.p_value * grid.len() as f64).min(1.0);
+    if grid.len() > 1 {
+        entry.note = Some(format!(
+            "score: largest over {} end-stop travels (Bonferroni factor {})",
+            grid.len(),
+            grid.len()
+        ));
+    }
+    let joint = Joint::new(ctx.model, nominal, s2, e, &shapes, !shapes.is_empty())?;
+    let (res, fixed) = fit(&joint, &joint.start(nominal), &score, opts)?;
+    ctx.fits.set(ctx.fits.get() + 1);
+    entry.params = estimates(&joint, &res, &fixed);
+    let ev = ctx.eval_joint(&joint, &res.x, joint.effect_values(&res.x))?;
+    let k = joint.effect.len() - fixed.len();
+    let n_h = ctx.holdout_points(nominal_eval) as f64;
+    entry.fitted = true;
+    entry.holdout_error = Some(ev.holdout_error);
+    entry.delta_bic =
+        Some(n_h * (ev.holdout_error / nominal_eval.holdout_error).ln() + k as f64 * n_h.ln());
+    Ok(Some(ev))
+}
+
+/// Order: fitted candidates by held-out BIC change, then the rest by p-value.
+pub fn sort(entries: &mut [Assessed]) {
+    entries.sort_by(|a, b| match (a.entry.delta_bic, b.entry.delta_bic) {
         (Some(x), Some(y)) => x.total_cmp(&y),
         (Some(_), None) => std::cmp::Ordering::Less,
         (None, Some(_)) => std::cmp::Ordering::Greater,
-        (None, None) => a.p_value.total_cmp(&b.p_value),
+        (None, None) => a.entry.p_value.total_cmp(&b.entry.p_value),
     });
-    (out, screens)
 }

@@ -1,214 +1,149 @@
-//! **Which**: the score (Lagrange-multiplier) test of each omitted effect at its null value.
+//! **Which**: the score (Lagrange-multiplier) test of an omitted effect at its null.
 //!
-//! For an effect with strength parameters `theta` (null 0) the log-likelihood of the driven
-//! subsystems is `l = -S / (2 s^2)`, with `S` the noise-normalized sum of squared residuals
-//! and `s^2 = S_0 / (N - p)` the residual variance factor of the calibrated nominal model.
-//! The statistic is `g' I^-1 g` with `g = dl/dtheta` and the Gauss-Newton information
-//! `I = J'J / s^2`, both with the nominal parameters profiled out: `S` is evaluated by
-//! re-fitting the nominal parameters at a few small settings of `theta` around the null
-//! (`0, h, 2h` per parameter, plus `(h, h)` for two-parameter effects), and its gradient and
-//! curvature at the null come from the exact quadratic through those points. By the envelope
-//! theorem this gradient is the partial gradient at the constrained optimum and the curvature
-//! is the Schur complement of the information, so the statistic equals `g_e' [I^-1]_ee g_e`.
-//! It is chi-square with `dof = len(theta)` under the null. The profile route (rather than
-//! the stage Jacobians directly) also covers the sensor effects, which are not model
-//! parameters. Effects whose strength cannot be negative are tested one-sided (a gradient
-//! pointing to negative strength gives 0).
+//! At the restricted optimum (the nominal calibration, effect strengths at their nulls) the
+//! stacked weighted residuals `r` and Jacobian `J = [N, E]` (nuisance: every nominal
+//! variable; tested: the effect strengths) give the effective score
+//! `g = E_perp' r`, `E_perp = E - N (N'N)^-1 N'E` (the strength columns with what the nominal
+//! parameters can absorb projected out). Its variance is estimated robustly: the per-sample
+//! contributions `c_i = E_perp,i r_i` are correlated in time (smoothed inputs, periodic model
+//! error), so `V` is the Newey-West (Bartlett) long-run covariance of `c` within every output
+//! series, centered. The statistic `g' V^-1 g` is chi-square with one degree of freedom per
+//! strength under the null.
+//!
+//! Strengths that cannot be negative make the test one-sided: a strength whose one-step
+//! estimate `-(E_perp'E_perp)^-1 g` is negative is dropped (held at its null) and the test is
+//! repeated on the rest; a single bounded strength gets the chi-bar-square tail `P/2`.
 
 use nalgebra::{DMatrix, DVector};
+use serde::Serialize;
 
-use super::{chi2_sf, Eval, Profile};
-use crate::effects::{EffectInfo, EffectTarget};
+use super::chi2_sf;
 
-/// Design step of the screen, as a fraction of each parameter's typical value: small, so
-/// that the quadratic model at the null is local (the profile is far from quadratic over
-/// strengths that change the engine's behaviour).
-pub const SCREEN_STEP: f64 = 0.05;
-
-/// A quadratic model `S(center + d) = c + g'd + d'Hd/2`.
-#[derive(Clone, Debug)]
-pub struct Quad {
-    pub center: Vec<f64>,
-    pub c: f64,
-    pub g: Vec<f64>,
-    pub h: Vec<Vec<f64>>,
-}
-
-impl Quad {
-    /// Least-squares quadratic through evaluated points (needs at least 1 + k + k(k+1)/2).
-    pub fn fit(points: &[&Eval], center: &[f64], scale: &[f64]) -> Option<Quad> {
-        let k = center.len();
-        let nc = 1 + k + k * (k + 1) / 2;
-        if points.len() < nc {
-            return None;
-        }
-        let row = |th: &[f64]| -> Vec<f64> {
-            let d: Vec<f64> = (0..k).map(|i| (th[i] - center[i]) / scale[i]).collect();
-            let mut r = vec![1.0];
-            r.extend(d.iter().copied());
-            for a in 0..k {
-                for b in a..k {
-                    r.push(if a == b {
-                        0.5 * d[a] * d[a]
-                    } else {
-                        d[a] * d[b]
-                    });
-                }
-            }
-            r
-        };
-        let a = DMatrix::from_fn(points.len(), nc, |i, j| row(&points[i].theta)[j]);
-        let y = DVector::from_fn(points.len(), |i, _| points[i].s_train);
-        let sol = a.clone().svd(true, true).solve(&y, 1e-12).ok()?;
-        let mut h = vec![vec![0.0; k]; k];
-        let mut m = 1 + k;
-        for a in 0..k {
-            for b in a..k {
-                h[a][b] = sol[m] / (scale[a] * scale[b]);
-                h[b][a] = h[a][b];
-                m += 1;
-            }
-        }
-        Some(Quad {
-            center: center.to_vec(),
-            c: sol[0],
-            g: (0..k).map(|i| sol[1 + i] / scale[i]).collect(),
-            h,
-        })
-    }
-
-    /// `H^-1 g` (None unless H is positive definite).
-    pub fn newton(&self) -> Option<Vec<f64>> {
-        let k = self.g.len();
-        let h = DMatrix::from_fn(k, k, |a, b| self.h[a][b]);
-        let ch = h.cholesky()?;
-        let s = ch.solve(&DVector::from_column_slice(&self.g));
-        Some(s.iter().copied().collect())
-    }
-
-    /// `g' H^-1 g` on the admissible subset (bounded parameters whose Newton step would go
-    /// negative from the null are dropped).
-    pub fn quad_form(&self, bounded: &[bool], at_null: bool) -> f64 {
-        let k = self.g.len();
-        let mut keep: Vec<usize> = (0..k).collect();
-        for _ in 0..k {
-            let h = DMatrix::from_fn(keep.len(), keep.len(), |a, b| self.h[keep[a]][keep[b]]);
-            let g = DVector::from_fn(keep.len(), |a, _| self.g[keep[a]]);
-            let Some(ch) = h.cholesky() else {
-                return f64::NAN;
-            };
-            let step = ch.solve(&g);
-            // the minimizer moves by -step: a bounded parameter at its null must move up
-            let bad: Vec<usize> = (0..keep.len())
-                .filter(|&a| at_null && bounded[keep[a]] && -step[a] < 0.0)
-                .collect();
-            if bad.is_empty() {
-                return g.dot(&step);
-            }
-            keep = keep
-                .iter()
-                .enumerate()
-                .filter(|(a, _)| !bad.contains(a))
-                .map(|(_, &i)| i)
-                .collect();
-            if keep.is_empty() {
-                return 0.0;
-            }
-        }
-        0.0
-    }
-}
-
-/// The screen of one effect.
-#[derive(Clone, Debug)]
-pub struct Screen {
-    pub effect: &'static EffectInfo,
+/// The result of a score test.
+#[derive(Clone, Debug, Serialize)]
+pub struct Score {
     pub stat: f64,
+    /// Strengths tested (after dropping those pointing below their bound).
     pub dof: usize,
     pub p_value: f64,
-    /// Evaluated settings (the null first).
-    pub points: Vec<Eval>,
-    /// Design step per strength parameter.
+    /// One-step estimate of every tested column (in the columns' units; 0 for dropped ones).
     pub step: Vec<f64>,
-    pub bounded: Vec<bool>,
-    /// Residual variance factor of the nominal model.
-    pub s2: f64,
-    /// Set by the ranking: the best fit of this effect.
-    pub best_fit: Option<Eval>,
-    pub note: Option<String>,
 }
 
-/// Whether a strength parameter must stay on the positive side of its null.
-pub fn bounded(e: &EffectInfo, name: &str) -> bool {
-    !(e.target == EffectTarget::Sensor && name.starts_with("gain"))
+/// The Bartlett bandwidth for `n` samples per series and a cycle of `period` samples: the
+/// Newey-West rule, at least a quarter cycle.
+pub fn bandwidth(n: usize, period: usize) -> usize {
+    let nw = (4.0 * (n as f64 / 100.0).powf(2.0 / 9.0)).ceil() as usize;
+    nw.max(period / 4).min(n / 4).max(1)
 }
 
-/// Screen an effect: the score statistic at the null.
-pub fn screen(prof: &Profile, e: &'static EffectInfo, nominal: &Eval, n_free: usize) -> Screen {
-    let qs = Profile::strengths(e);
-    let k = qs.len();
-    let step: Vec<f64> = qs.iter().map(|q| SCREEN_STEP * q.typical).collect();
-    let bnd: Vec<bool> = qs.iter().map(|q| bounded(e, q.name)).collect();
-    let s2 = nominal.s_train / (nominal.n_train.saturating_sub(n_free)).max(1) as f64;
-    let mut null = nominal.clone();
-    null.theta = vec![0.0; k];
-    let mut sc = Screen {
-        effect: e,
-        stat: f64::NAN,
-        dof: k,
-        p_value: f64::NAN,
-        points: vec![null],
-        step: step.clone(),
-        bounded: bnd.clone(),
-        s2,
-        best_fit: None,
-        note: None,
-    };
-    let mut design: Vec<Vec<f64>> = Vec::new();
-    for i in 0..k {
-        for m in [1.0, 2.0] {
-            let mut th = vec![0.0; k];
-            th[i] = m * step[i];
-            design.push(th);
+/// Columns `test` of `j` with the span of the other columns projected out.
+fn effective(j: &DMatrix<f64>, test: &[usize], skip: &[usize]) -> Option<DMatrix<f64>> {
+    let nuis: Vec<usize> = (0..j.ncols())
+        .filter(|c| !test.contains(c) && !skip.contains(c))
+        .collect();
+    let e = j.select_columns(test);
+    if nuis.is_empty() {
+        return Some(e);
+    }
+    let n = j.select_columns(&nuis);
+    let mut ntn = n.transpose() * &n;
+    let ridge = 1e-12 * (0..ntn.nrows()).map(|i| ntn[(i, i)]).fold(0.0, f64::max);
+    for i in 0..ntn.nrows() {
+        ntn[(i, i)] += ridge;
+    }
+    let b = ntn.cholesky()?.solve(&(n.transpose() * &e));
+    Some(e - n * b)
+}
+
+/// Newey-West covariance of the rows of `c` (centered within every block of rows).
+pub fn long_run_cov(c: &DMatrix<f64>, blocks: &[(usize, usize)], lag: usize) -> DMatrix<f64> {
+    let k = c.ncols();
+    let mut v = DMatrix::zeros(k, k);
+    for &(a, b) in blocks {
+        if b <= a {
+            continue;
         }
-    }
-    if k == 2 {
-        design.push(step.clone());
-    }
-    for th in design {
-        match prof.eval(Some(e), &th, &nominal.p) {
-            Ok(ev) => sc.points.push(ev),
-            Err(err) => {
-                sc.note = Some(format!("screen at {th:?} failed: {err}"));
-                return sc;
+        let mean: Vec<f64> = (0..k)
+            .map(|q| (a..b).map(|i| c[(i, q)]).sum::<f64>() / (b - a) as f64)
+            .collect();
+        let x = DMatrix::from_fn(b - a, k, |i, q| c[(a + i, q)] - mean[q]);
+        for l in 0..=lag.min(b - a - 1) {
+            let w = if l == 0 {
+                1.0
+            } else {
+                1.0 - l as f64 / (lag + 1) as f64
+            };
+            let m = b - a - l;
+            let g = x.rows(l, m).transpose() * x.rows(0, m);
+            if l == 0 {
+                v += g * w;
+            } else {
+                v += (&g + g.transpose()) * w;
             }
         }
     }
-    if std::env::var_os("STIRLING_DIAGNOSE_DEBUG").is_some() {
-        for p in &sc.points {
-            eprintln!(
-                "screen {} theta {:?}: S {:.3} (n {}), holdout {:.4}",
-                e.name, p.theta, p.s_train, p.n_train, p.holdout_error
-            );
+    v
+}
+
+/// The robust one-sided score test of columns `test` of `j` at residuals `r`; `skip`: columns
+/// that are neither tested nor nuisance (shape parameters, inert at the null); `bounded`: per
+/// tested column; `blocks`: the rows of every time series; `lag`: the Bartlett bandwidth.
+pub fn robust_score(
+    r: &[f64],
+    j: &DMatrix<f64>,
+    test: &[usize],
+    skip: &[usize],
+    bounded: &[bool],
+    blocks: &[(usize, usize)],
+    lag: usize,
+) -> Score {
+    let mut active: Vec<usize> = (0..test.len()).collect();
+    let rv = DVector::from_column_slice(r);
+    let none = |dof| Score {
+        stat: 0.0,
+        dof,
+        p_value: 1.0,
+        step: vec![0.0; test.len()],
+    };
+    loop {
+        if active.is_empty() {
+            return none(0);
         }
+        let cols: Vec<usize> = active.iter().map(|&a| test[a]).collect();
+        let mut skipped: Vec<usize> = skip.to_vec();
+        skipped.extend(test.iter().filter(|c| !cols.contains(c)));
+        let Some(e) = effective(j, &cols, &skipped) else {
+            return none(active.len());
+        };
+        let g = e.transpose() * &rv;
+        let Some(step) = (e.transpose() * &e).cholesky().map(|c| -c.solve(&g)) else {
+            return none(active.len());
+        };
+        if let Some(drop) = (0..active.len()).find(|&q| bounded[active[q]] && step[q] < 0.0) {
+            active.remove(drop);
+            continue;
+        }
+        let c = DMatrix::from_fn(e.nrows(), e.ncols(), |i, q| e[(i, q)] * r[i]);
+        let v = long_run_cov(&c, blocks, lag);
+        let stat = match v.cholesky() {
+            Some(ch) => g.dot(&ch.solve(&g)).max(0.0),
+            None => return none(active.len()),
+        };
+        let dof = active.len();
+        let mut p = chi2_sf(stat, dof);
+        if dof == 1 && bounded[active[0]] {
+            p *= 0.5;
+        }
+        let mut full = vec![0.0; test.len()];
+        for (q, &a) in active.iter().enumerate() {
+            full[a] = step[q];
+        }
+        return Score {
+            stat,
+            dof,
+            p_value: p,
+            step: full,
+        };
     }
-    let pts: Vec<&Eval> = sc.points.iter().collect();
-    let Some(q) = Quad::fit(&pts, &vec![0.0; k], &step) else {
-        sc.note = Some("too few points for the quadratic model".into());
-        return sc;
-    };
-    let form = q.quad_form(&bnd, true);
-    // l = -S/(2 s2): g' I^-1 g = (dS' H_S^-1 dS) / (2 s2)
-    sc.stat = if form.is_finite() {
-        (form / (2.0 * s2)).max(0.0)
-    } else {
-        f64::NAN
-    };
-    if !sc.stat.is_finite() {
-        sc.note = Some("the profiled cost is not convex at the null".into());
-        sc.stat = f64::NAN;
-        return sc;
-    }
-    sc.p_value = chi2_sf(sc.stat, k);
-    sc
 }

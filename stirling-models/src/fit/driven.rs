@@ -97,6 +97,33 @@ pub enum VarKind {
     /// An additive offset of output `out`; `du` (per [`Given`], may be empty) is how the
     /// prescribed inputs move per unit of the offset.
     Offset { out: usize, du: Vec<f64> },
+    /// A sensor distortion (see [`Sensor`]); its column is a central difference of two runs.
+    Sensor(Sensor),
+}
+
+/// A sensor distortion fitted as a variable: the data the stage reads through the sensor as
+/// inputs are un-distorted, the model's predictions of what the sensor reads are distorted.
+#[derive(Clone, Debug)]
+pub enum Sensor {
+    /// `measured = (1 + g) true`: the prescribed states `given` (indices into
+    /// [`Stage::given`]) are divided by `1 + g`, the outputs `outputs` multiplied by it.
+    Gain {
+        given: Vec<usize>,
+        outputs: Vec<usize>,
+    },
+    /// `measured = lag(true, tau)` (first order): the input signals `signals` get
+    /// `+ tau d/dt` (the inverse lag to first order), the outputs `outputs` are lagged.
+    Lag {
+        signals: Vec<usize>,
+        outputs: Vec<usize>,
+    },
+}
+
+impl Sensor {
+    /// Whether the variable's value cannot be negative (a lag).
+    pub fn bounded(&self) -> bool {
+        matches!(self, Sensor::Lag { .. })
+    }
 }
 
 /// A measured output: free state number `pos` plus its offsets.
@@ -109,6 +136,7 @@ pub struct Output {
 }
 
 /// A driven-subsystem fitting problem on a uniform record.
+#[derive(Clone)]
 pub struct Stage<'a> {
     pub name: &'static str,
     pub model: &'a dyn Model,
@@ -250,13 +278,14 @@ impl Stage<'_> {
                         });
                     }
                 }
+                VarKind::Sensor(_) => {}
             }
         }
         if !sens {
             columns.clear();
         }
         let t_start = self.t0 + first as f64 * self.dt;
-        let signals: Vec<Signal> = self
+        let mut signals: Vec<Signal> = self
             .signals
             .iter()
             .map(|s| Signal {
@@ -264,6 +293,7 @@ impl Stage<'_> {
                 ..s.clone()
             })
             .collect();
+        let (gain, lag) = self.apply_sensors(&th, &mut given, &mut signals);
         let zscale: Vec<f64> = {
             let s = state_scale(self.model, &p);
             self.free.iter().map(|&i| s[i]).collect()
@@ -288,7 +318,7 @@ impl Stage<'_> {
         let mut dyhat = vec![Vec::new(); self.outputs.len()];
         for row in &traj.x {
             for (o, out) in self.outputs.iter().enumerate() {
-                let mut y = row[out.pos];
+                let mut y = gain[o] * row[out.pos];
                 let mut d = vec![0.0; if sens { self.vars.len() } else { 0 }];
                 for (k, v) in self.vars.iter().enumerate() {
                     if let VarKind::Offset { out: oo, .. } = v.kind {
@@ -301,7 +331,7 @@ impl Stage<'_> {
                     }
                     if sens {
                         if let Some(c) = col_of[k] {
-                            d[k] += row[nz + c * nz + out.pos];
+                            d[k] += gain[o] * row[nz + c * nz + out.pos];
                         }
                     }
                 }
@@ -311,7 +341,90 @@ impl Stage<'_> {
                 }
             }
         }
+        for (o, &tau) in lag.iter().enumerate() {
+            if tau > 0.0 {
+                yhat[o] = crate::rig::first_order_lag(&yhat[o], self.dt, tau);
+                lag_columns(&mut dyhat[o], self.dt, tau);
+            }
+        }
+        if sens {
+            self.sensor_columns(u, first, last, &mut dyhat)?;
+        }
         Ok(StageRun { first, yhat, dyhat })
+    }
+
+    /// Apply the sensor variables at values `th`: scale the prescribed states read through a
+    /// gain, un-lag the input signals read through a lag; returns each output's gain factor
+    /// and lag time constant.
+    fn apply_sensors(
+        &self,
+        th: &[f64],
+        given: &mut [Given],
+        signals: &mut [Signal],
+    ) -> (Vec<f64>, Vec<f64>) {
+        let mut gain = vec![1.0; self.outputs.len()];
+        let mut lag = vec![0.0; self.outputs.len()];
+        for (v, &val) in self.vars.iter().zip(th) {
+            match &v.kind {
+                VarKind::Sensor(Sensor::Gain { given: gs, outputs }) => {
+                    for &g in gs {
+                        let gv = &mut given[g];
+                        gv.constant /= 1.0 + val;
+                        gv.terms.iter_mut().for_each(|t| t.1 /= 1.0 + val);
+                    }
+                    outputs.iter().for_each(|&o| gain[o] *= 1.0 + val);
+                }
+                VarKind::Sensor(Sensor::Lag { signals: ss, outputs }) => {
+                    for &s in ss {
+                        let sig = &mut signals[s];
+                        let d2 = derivative(&sig.der, sig.dt);
+                        for k in 0..sig.val.len() {
+                            sig.val[k] += val * sig.der[k];
+                            sig.der[k] += val * d2[k];
+                        }
+                    }
+                    outputs.iter().for_each(|&o| lag[o] += val);
+                }
+                _ => {}
+            }
+        }
+        (gain, lag)
+    }
+
+    /// Columns of the sensor variables by differences of two runs (central; forward where
+    /// a lag would go negative).
+    fn sensor_columns(
+        &self,
+        u: &[f64],
+        first: usize,
+        last: usize,
+        dyhat: &mut [Vec<Vec<f64>>],
+    ) -> Result<(), FitError> {
+        const DU: f64 = 0.02;
+        for (k, v) in self.vars.iter().enumerate() {
+            let VarKind::Sensor(s) = &v.kind else {
+                continue;
+            };
+            let val = v.initial + v.scale * u[k];
+            let lo = if s.bounded() && val - DU * v.scale < 0.0 {
+                u[k]
+            } else {
+                u[k] - DU
+            };
+            let (mut ua, mut ub) = (u.to_vec(), u.to_vec());
+            ua[k] = lo;
+            ub[k] = u[k] + DU;
+            let (ra, rb) = (
+                self.run(&ua, first, last, false)?,
+                self.run(&ub, first, last, false)?,
+            );
+            for (o, rows) in dyhat.iter_mut().enumerate() {
+                for (i, row) in rows.iter_mut().enumerate() {
+                    row[k] = (rb.yhat[o][i] - ra.yhat[o][i]) / (ub[k] - ua[k]);
+                }
+            }
+        }
+        Ok(())
     }
 
     /// Covariance of the fit variables `u` caused by the noise on the prescribed inputs
@@ -426,6 +539,31 @@ impl Stage<'_> {
             }
         }
         Ok((r, j))
+    }
+}
+
+/// Central-difference derivative of uniform samples (one-sided at the ends).
+fn derivative(y: &[f64], dt: f64) -> Vec<f64> {
+    let n = y.len();
+    (0..n)
+        .map(|i| {
+            let (a, b) = (i.saturating_sub(1), (i + 1).min(n - 1));
+            if b > a {
+                (y[b] - y[a]) / ((b - a) as f64 * dt)
+            } else {
+                0.0
+            }
+        })
+        .collect()
+}
+
+/// Lag every sensitivity column (`rows[sample][var]`) by the first-order filter.
+fn lag_columns(rows: &mut [Vec<f64>], dt: f64, tau: f64) {
+    let nv = rows.first().map_or(0, |r| r.len());
+    for v in 0..nv {
+        let col: Vec<f64> = rows.iter().map(|r| r[v]).collect();
+        let f = crate::rig::first_order_lag(&col, dt, tau);
+        rows.iter_mut().zip(f).for_each(|(r, c)| r[v] = c);
     }
 }
 

@@ -61,6 +61,9 @@ pub struct FitOptions {
     /// Stage 1: sub-cycle drift band projected out of the residuals, as a fraction of the
     /// cycle frequency (see [`driven::Stage::drift`]; 0: none).
     pub drift_cut: f64,
+    /// Monte Carlo draws for the input-noise (errors-in-variables) part of the parameter
+    /// covariance (0: skip it; the intervals then miss that part).
+    pub input_noise_draws: usize,
     /// Free-run validation after the stages (on the held-out block, else the training block).
     pub free_run: Option<free_run::FreeRunOptions>,
     /// Multiple-shooting refinement of the free parameters over the training block (off by
@@ -92,6 +95,7 @@ impl Default for FitOptions {
             stage1: true,
             stage2: true,
             drift_cut: 0.5,
+            input_noise_draws: 40,
             free_run: Some(free_run::FreeRunOptions::default()),
             multiple_shooting: None,
         }
@@ -243,14 +247,27 @@ fn signal(t0: f64, dt: f64, y: &[f64], h: usize) -> Signal {
     Signal { t0, dt, val, der }
 }
 
+/// A fitted stage with its optimum, for analyses that extend it (the gap diagnosis).
+#[derive(Clone)]
+pub struct FittedStage<'a> {
+    pub stage: Stage<'a>,
+    /// The optimum in the stage's scaled variables.
+    pub u: Vec<f64>,
+    /// Training window (inclusive sample indices) and the samples the cost uses.
+    pub first: usize,
+    pub last: usize,
+    pub keep: Vec<usize>,
+}
+
 /// Fit a stage on the training indices, then report train and holdout fits.
 fn fit_stage(
     stage: &Stage,
     train: (usize, usize),
     hold: Option<(usize, usize)>,
     burn: usize,
-    lm_opts: &lm::LmOptions,
-) -> Result<(StageFit, Vec<f64>), FitError> {
+    opts: &FitOptions,
+) -> Result<(StageFit, Vec<f64>, Vec<f64>), FitError> {
+    let lm_opts = &opts.lm;
     let clock = Instant::now();
     let keep: Vec<usize> = ((train.0 + burn).min(train.1)..=train.1).collect();
     let mut last_err = None;
@@ -274,8 +291,15 @@ fn fit_stage(
         .collect();
     let init: Vec<f64> = stage.vars.iter().map(|v| v.initial).collect();
     let scale: Vec<f64> = stage.vars.iter().map(|v| v.scale).collect();
-    let extra =
-        stage.input_noise_cov(&res.x, train.0, train.1, &keep, &res.jacobian, 40, 0x5eed)?;
+    let extra = stage.input_noise_cov(
+        &res.x,
+        train.0,
+        train.1,
+        &keep,
+        &res.jacobian,
+        opts.input_noise_draws,
+        0x5eed,
+    )?;
     let st = report::stats_full(
         &names,
         &init,
@@ -369,6 +393,7 @@ fn fit_stage(
             series,
         },
         values,
+        res.x,
     ))
 }
 
@@ -379,6 +404,17 @@ pub fn identify(
     data: &Measured,
     opts: &FitOptions,
 ) -> Result<Identification, FitError> {
+    identify_stages(model, p0, data, opts).map(|(id, _)| id)
+}
+
+/// [`identify`], also returning the fitted stages (stage 1, then stage 2, those that ran).
+pub fn identify_stages<'a>(
+    model: &'a dyn Model,
+    p0: &[f64],
+    data: &Measured,
+    opts: &FitOptions,
+) -> Result<(Identification, Vec<FittedStage<'a>>), FitError> {
+    let mut fitted = Vec::new();
     let clock = Instant::now();
     let (t0, dt) = uniform(data)?;
     let nt = data.t.len();
@@ -564,7 +600,7 @@ pub fn identify(
             dt,
             sim,
         };
-        let (fit, values) = fit_stage(&stage, tr, ho, 0, &opts.lm)?;
+        let (fit, values, u) = fit_stage(&stage, tr, ho, 0, opts)?;
         for (v, val) in stage.vars.iter().zip(&values) {
             match v.kind {
                 VarKind::Param(j) => p[j] = *val,
@@ -573,6 +609,13 @@ pub fn identify(
             }
         }
         stage1 = Some(fit);
+        fitted.push(FittedStage {
+            stage,
+            u,
+            first: tr.0,
+            last: tr.1,
+            keep: (tr.0..=tr.1).collect(),
+        });
     }
 
     let mut stage2 = None;
@@ -726,7 +769,7 @@ pub fn identify(
             dt,
             sim,
         };
-        let (fit, values) = fit_stage(&stage, tr, ho, burn, &opts.lm)?;
+        let (fit, values, u) = fit_stage(&stage, tr, ho, burn, opts)?;
         let (mut p_off, mut ph_off) = (p_off0, ph_off0);
         for (v, val) in stage.vars.iter().zip(&values) {
             match v.kind {
@@ -745,6 +788,13 @@ pub fn identify(
             offsets.p_hot = Some(ph_off);
         }
         stage2 = Some(fit);
+        fitted.push(FittedStage {
+            stage,
+            u,
+            first: tr.0,
+            last: tr.1,
+            keep: ((tr.0 + burn).min(tr.1)..=tr.1).collect(),
+        });
     }
     offsets.x = x_off[0];
     offsets.y = x_off[1];
@@ -773,7 +823,7 @@ pub fn identify(
             Err(e) => notes.push(format!("free run: {e}")),
         }
     }
-    Ok(Identification {
+    let id = Identification {
         model: model.name().into(),
         n: model.n(),
         params: model
@@ -791,5 +841,6 @@ pub fn identify(
         multiple_shooting: ms,
         free_run: fr,
         notes,
-    })
+    };
+    Ok((id, fitted))
 }

@@ -1,0 +1,305 @@
+//! The joint problem of one candidate effect: the calibrated driven subsystems (the two
+//! stages of [`crate::fit`]) that the effect touches, each extended by the effect's variables,
+//! stacked into one least-squares problem whose variables are every stage's own variables
+//! plus the shared effect strengths.
+//!
+//! - Model effects (leak, Coulomb friction, end stops, quadratic regenerator friction) are
+//!   parameters of the augmented model: a variable of the stage whose rows they enter, with
+//!   forward sensitivities like any parameter.
+//! - Sensor effects act on both stages: a pressure-transducer lag un-lags stage 1's pressure
+//!   input and lags stage 2's pressure output; a position gain rescales stage 1's position
+//!   outputs and stage 2's prescribed positions ([`crate::fit::driven::Sensor`]).
+//!
+//! At the null of the strengths the problem is the nominal calibration, so its Jacobian there
+//! gives the score test ([`super::score`]) and Levenberg-Marquardt from there the joint fit.
+
+use nalgebra::DMatrix;
+use stirling_dsl::Model;
+
+use crate::effects::{EffectInfo, EffectTarget};
+use crate::fit::driven::{Sensor, Var, VarKind};
+use crate::fit::{classify, FitError, FittedStage};
+
+/// One effect variable of the joint problem.
+#[derive(Clone, Debug)]
+pub struct EffectVar {
+    pub name: String,
+    /// Index among the joint variables.
+    pub index: usize,
+    /// Value at the null, and the unit of the scaled variable.
+    pub null: f64,
+    pub scale: f64,
+    /// Must stay on the positive side of its null.
+    pub bounded: bool,
+    /// A shape parameter (end-stop travel): not a strength; not tested, only fitted.
+    pub shape: bool,
+    pub unit: String,
+}
+
+/// The stacked problem.
+#[derive(Clone)]
+pub struct Joint<'a> {
+    /// The stages the effect touches (index into the nominal stages, extended stage).
+    pub stages: Vec<(usize, FittedStage<'a>)>,
+    /// Per stage: the joint index of each of its variables.
+    pub map: Vec<Vec<usize>>,
+    /// Per stage: the residual weight `1 / s` (`s^2`: the nominal fit's variance factor).
+    pub weight: Vec<f64>,
+    pub n_vars: usize,
+    pub effect: Vec<EffectVar>,
+}
+
+/// Whether a stage is the mechanics stage (positions out, pressures in).
+fn is_mechanics(st: &FittedStage) -> bool {
+    st.stage.outputs.iter().any(|o| o.channel == "x")
+}
+
+/// The nominal variance factor of a stage: `|r|^2 / (N - k)` at its optimum.
+pub fn variance_factor(st: &FittedStage) -> Result<f64, FitError> {
+    let (r, _) = st.stage.residuals(&st.u, st.first, st.last, &st.keep)?;
+    let dof = r
+        .len()
+        .saturating_sub(st.stage.vars.len() + st.stage.drift * st.stage.outputs.len())
+        .max(1);
+    Ok(r.iter().map(|v| v * v).sum::<f64>() / dof as f64)
+}
+
+impl<'a> Joint<'a> {
+    /// Extend the nominal stages by the variables of `e` (`shapes`: values of the effect's
+    /// shape parameters; `free_shapes`: fit them too). `s2`: the nominal variance factors.
+    pub fn new(
+        model: &dyn Model,
+        nominal: &[FittedStage<'a>],
+        s2: &[f64],
+        e: &EffectInfo,
+        shapes: &[(&str, f64)],
+        free_shapes: bool,
+    ) -> Result<Self, String> {
+        let mut stages: Vec<(usize, FittedStage<'a>)> = Vec::new();
+        let mut effect: Vec<EffectVar> = Vec::new();
+        let n_nom: usize = nominal.iter().map(|s| s.stage.vars.len()).sum();
+        // which stages each effect variable goes to, with its variable kind there
+        let mut adds: Vec<(usize, Var)> = Vec::new();
+        for q in e.params {
+            let shape_value = shapes.iter().find(|(n, _)| *n == q.name).map(|s| s.1);
+            if q.null.is_none() && !(free_shapes && shape_value.is_some()) {
+                continue;
+            }
+            let (initial, scale) = match (q.null, shape_value) {
+                (Some(null), _) => (null, q.typical),
+                (None, Some(v)) => (v, 0.1 * v.abs().max(1e-9)),
+                (None, None) => unreachable!("filtered above"),
+            };
+            let index = n_nom + effect.len();
+            let bounded = q.null.is_some() && !q.name.starts_with("gain");
+            effect.push(EffectVar {
+                name: q.name.into(),
+                index,
+                null: initial,
+                scale,
+                bounded,
+                shape: q.null.is_none(),
+                unit: q.unit.into(),
+            });
+            for (si, st) in nominal.iter().enumerate() {
+                if let Some(kind) = kind_in(model, st, e, q.name)? {
+                    adds.push((
+                        si,
+                        Var {
+                            name: q.name.into(),
+                            initial,
+                            scale,
+                            kind,
+                        },
+                    ));
+                }
+            }
+            if !adds.iter().any(|(_, v)| v.name == q.name) {
+                return Err(format!(
+                    "`{}` enters neither driven subsystem of `{}`",
+                    q.name,
+                    model.name()
+                ));
+            }
+        }
+        let mut map = Vec::new();
+        let mut weight = Vec::new();
+        for (si, st) in nominal.iter().enumerate() {
+            let extra: Vec<&(usize, Var)> = adds.iter().filter(|(s, _)| *s == si).collect();
+            if extra.is_empty() {
+                continue;
+            }
+            let mut ext = st.clone();
+            for (name, v) in shapes {
+                if let Some(j) = model.param_index(name) {
+                    ext.stage.p[j] = *v;
+                }
+            }
+            let offset: usize = nominal[..si].iter().map(|s| s.stage.vars.len()).sum();
+            let mut m: Vec<usize> = (offset..offset + st.stage.vars.len()).collect();
+            for (_, v) in extra {
+                let k = effect
+                    .iter()
+                    .find(|ev| ev.name == v.name)
+                    .expect("pushed above")
+                    .index;
+                m.push(k);
+                ext.stage.vars.push(v.clone());
+                ext.u.push(0.0);
+            }
+            map.push(m);
+            weight.push(1.0 / s2[si].max(1e-12).sqrt());
+            stages.push((si, ext));
+        }
+        Ok(Joint {
+            stages,
+            map,
+            weight,
+            n_vars: n_nom + effect.len(),
+            effect,
+        })
+    }
+
+    /// The joint variables at the nominal optimum with the effect at its null.
+    pub fn start(&self, nominal: &[FittedStage]) -> Vec<f64> {
+        let mut u: Vec<f64> = nominal.iter().flat_map(|s| s.u.iter().copied()).collect();
+        u.resize(self.n_vars, 0.0);
+        u
+    }
+
+    /// A stage's variables from the joint ones.
+    pub fn stage_u(&self, k: usize, u: &[f64]) -> Vec<f64> {
+        self.map[k].iter().map(|&i| u[i]).collect()
+    }
+
+    /// Weighted stacked residuals and Jacobian, with the row ranges of every output block
+    /// (residuals of one output of one stage, in time order).
+    pub fn residuals(
+        &self,
+        u: &[f64],
+    ) -> Result<(Vec<f64>, DMatrix<f64>, Vec<(usize, usize)>), FitError> {
+        let mut parts = Vec::new();
+        for (k, (_, st)) in self.stages.iter().enumerate() {
+            let (r, j) = st
+                .stage
+                .residuals(&self.stage_u(k, u), st.first, st.last, &st.keep)?;
+            parts.push((r, j));
+        }
+        let rows: usize = parts.iter().map(|(r, _)| r.len()).sum();
+        let mut r = Vec::with_capacity(rows);
+        let mut jm = DMatrix::zeros(rows, self.n_vars);
+        let mut blocks = Vec::new();
+        for (k, (rk, jk)) in parts.iter().enumerate() {
+            let w = self.weight[k];
+            let row0 = r.len();
+            r.extend(rk.iter().map(|v| v * w));
+            for (c, &jc) in self.map[k].iter().enumerate() {
+                for i in 0..rk.len() {
+                    jm[(row0 + i, jc)] += w * jk[(i, c)];
+                }
+            }
+            let per = self.stages[k].1.keep.len();
+            for o in 0..self.stages[k].1.stage.outputs.len() {
+                blocks.push((row0 + o * per, row0 + (o + 1) * per));
+            }
+        }
+        Ok((r, jm, blocks))
+    }
+
+    /// Effect values from the joint variables.
+    pub fn effect_values(&self, u: &[f64]) -> Vec<f64> {
+        self.effect
+            .iter()
+            .map(|e| e.null + e.scale * u[e.index])
+            .collect()
+    }
+}
+
+/// The kind of an effect variable in a stage, if it enters it.
+fn kind_in(
+    model: &dyn Model,
+    st: &FittedStage,
+    e: &EffectInfo,
+    name: &str,
+) -> Result<Option<VarKind>, String> {
+    let mech = is_mechanics(st);
+    let outputs = |pred: &dyn Fn(&str) -> bool| -> Vec<usize> {
+        st.stage
+            .outputs
+            .iter()
+            .enumerate()
+            .filter(|(_, o)| pred(&o.channel))
+            .map(|(i, _)| i)
+            .collect()
+    };
+    Ok(match (e.target, name) {
+        (EffectTarget::Model, _) => {
+            let j = model
+                .param_index(name)
+                .ok_or_else(|| format!("model `{}` has no parameter `{name}`", model.name()))?;
+            // which rows the effect enters, with its strengths on and its shapes (travel,
+            // smoothing) small, so that it acts at the probe state `classify` uses
+            let mut p = st.stage.p.clone();
+            for q in e.params {
+                if let Some(i) = model.param_index(q.name) {
+                    p[i] = if q.null.is_some() { q.typical } else { 1e-4 * q.typical };
+                }
+            }
+            let shape = e.params.iter().any(|q| q.name == name && q.null.is_none());
+            let probe: Vec<String> = if shape {
+                e.params
+                    .iter()
+                    .filter(|q| q.null.is_some())
+                    .map(|q| q.name.to_string())
+                    .collect()
+            } else {
+                vec![name.to_string()]
+            };
+            let enters = probe.iter().any(|q| {
+                classify(model, &p, std::slice::from_ref(q))
+                    .is_ok_and(|(m, g)| if mech { !m.is_empty() } else { !g.is_empty() })
+            });
+            enters.then_some(VarKind::Param(j))
+        }
+        (EffectTarget::Sensor, "tau_p") => Some(if mech {
+            VarKind::Sensor(Sensor::Lag {
+                signals: (0..st.stage.signals.len()).collect(),
+                outputs: vec![],
+            })
+        } else {
+            VarKind::Sensor(Sensor::Lag {
+                signals: vec![],
+                outputs: outputs(&|c| c.starts_with('p')),
+            })
+        }),
+        (EffectTarget::Sensor, "gain_x" | "gain_y") => {
+            let ch = &name[5..];
+            Some(if mech {
+                VarKind::Sensor(Sensor::Gain {
+                    given: vec![],
+                    outputs: outputs(&|c| c == ch),
+                })
+            } else {
+                // stage 2 reads the positions as signals 0 (x) and 1 (y)
+                let sig = usize::from(ch == "y");
+                let given = st
+                    .stage
+                    .given
+                    .iter()
+                    .enumerate()
+                    .filter(|(_, g)| g.terms.iter().any(|t| t.0 == sig))
+                    .map(|(i, _)| i)
+                    .collect();
+                VarKind::Sensor(Sensor::Gain {
+                    given,
+                    outputs: vec![],
+                })
+            })
+        }
+        (EffectTarget::Sensor, other) => {
+            return Err(format!(
+                "sensor parameter `{other}` is not handled by the diagnosis"
+            ))
+        }
+    })
+}
