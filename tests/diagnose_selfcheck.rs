@@ -18,8 +18,6 @@ fn reduced(effects: &[&str], clean: bool) -> SelfCheckOptions {
         clean,
         diagnose: DiagnoseOptions {
             effects: Some(cands),
-            max_fit: 2,
-            newton_iters: 4,
             bootstrap: 200,
             ..Default::default()
         },

@@ -60,11 +60,8 @@ pub struct DiagnoseOptions {
     pub holdout: Option<(f64, f64)>,
     /// Options of the underlying two-stage fits.
     pub fit: FitOptions,
-    /// How many of the best-scoring candidates are fitted and ranked (at least the significant ones;
-    /// default: all, since the profile screen is noisy where the two-stage refit is not idempotent).
-    pub max_fit: usize,
-    /// Newton iterations on the profiled cost when fitting a candidate.
-    pub newton_iters: usize,
+    /// Levenberg-Marquardt iterations of each candidate's joint fit.
+    pub joint_iters: usize,
     /// Bootstrap resamples for the closure interval.
     pub bootstrap: usize,
     /// Family-wise significance level of the score screen (Bonferroni over the candidates).
@@ -79,8 +76,7 @@ impl Default for DiagnoseOptions {
             train: None,
             holdout: None,
             fit: FitOptions::default(),
-            max_fit: 8,
-            newton_iters: 4,
+            joint_iters: 12,
             bootstrap: 400,
             alpha: 0.01,
             seed: 7,
@@ -518,7 +514,10 @@ pub fn diagnose(
         .map_err(|e| DiagnoseError::Nominal(e.to_string()))?;
     let localization = localize::localize(model, &p_nom, data, &nominal, &ctx);
     let mut lm = opts.fit.lm;
-    lm.max_iter = opts.newton_iters;
+    lm.max_iter = opts.joint_iters;
+    // trial steps of at most one typical strength: far trials (an engine stopped by friction)
+    // are slow to integrate and rejected anyway
+    lm.max_step = 1.0;
     let mut assessed: Vec<rank::Assessed> = cands
         .iter()
         .map(|e| rank::assess(&ctx, &stages, &s2, &nominal, e, &lm))

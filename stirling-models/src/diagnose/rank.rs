@@ -87,7 +87,7 @@ fn fit(
     let strengths: Vec<&EffectVar> = joint.effect.iter().filter(|v| !v.shape).collect();
     for (v, &s) in strengths.iter().zip(&score.step) {
         // a strength the screen dropped still gets a small push to explore its side
-        u0[v.index] = if v.bounded { s.max(0.05) } else { s };
+        u0[v.index] = if v.bounded { s.clamp(0.05, 2.0) } else { s.clamp(-2.0, 2.0) };
     }
     let mut fixed: Vec<usize> = Vec::new();
     for _ in 0..=strengths.len() {
@@ -170,7 +170,22 @@ pub fn assess(
         params: Vec::new(),
         note: None,
     };
-    match assess_inner(ctx, nominal, s2, nominal_eval, e, opts, &mut entry) {
+    let clock = std::time::Instant::now();
+    let out = assess_inner(ctx, nominal, s2, nominal_eval, e, opts, &mut entry);
+    if std::env::var_os("STIRLING_DIAGNOSE_DEBUG").is_some() {
+        eprintln!(
+            "{}: score {:.2} (dof {}, p {:.2e}), params {:?}, held-out {:?} ({:.1} s) {:?}",
+            e.name,
+            entry.score,
+            entry.dof,
+            entry.p_value,
+            entry.params.iter().map(|q| (q.name.clone(), q.value, q.std_error)).collect::<Vec<_>>(),
+            entry.holdout_error,
+            clock.elapsed().as_secs_f64(),
+            entry.note
+        );
+    }
+    match out {
         Ok(eval) => Assessed { entry, eval },
         Err(msg) => {
             entry.note = Some(msg);

@@ -20,6 +20,8 @@ pub struct LmOptions {
     /// Stop when the step is below this (in the variables' units).
     pub xtol: f64,
     pub lambda0: f64,
+    /// Largest step (max norm, in the variables' units); longer steps are shortened.
+    pub max_step: f64,
 }
 
 impl Default for LmOptions {
@@ -29,6 +31,7 @@ impl Default for LmOptions {
             ftol: 1e-10,
             xtol: 1e-9,
             lambda0: 1e-3,
+            max_step: f64::INFINITY,
         }
     }
 }
@@ -72,7 +75,11 @@ pub fn minimize(eval: &mut Eval, x0: &[f64], opts: &LmOptions) -> Option<LmResul
                 nu *= 2.0;
                 continue;
             };
-            let step = ch.solve(&(-&g));
+            let mut step = ch.solve(&(-&g));
+            let long = step.amax();
+            if long > opts.max_step {
+                step *= opts.max_step / long;
+            }
             let xn: Vec<f64> = x.iter().zip(step.iter()).map(|(a, b)| a + b).collect();
             let pred = -(step.dot(&g) + 0.5 * (step.transpose() * &jtj * &step)[(0, 0)]);
             evals += 1;

@@ -86,6 +86,7 @@ impl Default for FitOptions {
                 ftol: 1e-8,
                 xtol: 1e-7,
                 lambda0: 1e-3,
+                max_step: f64::INFINITY,
             },
             sim: SimOptions {
                 rtol: 1e-7,
