@@ -95,7 +95,7 @@ fn robust_score_has_its_size_under_correlated_noise_and_power_against_the_effect
     let reps = 300;
     for s in 0..reps {
         let (r, j) = restricted(0.0, 0.6, 1000 + s);
-        let sc = robust_score(&r, &j, &[2], &[], &[false], &blocks, lag);
+        let sc = robust_score(&r, &j, &[2], &[], &[false], &blocks, lag, &[]);
         assert_eq!(sc.dof, 1);
         if sc.p_value < 0.05 {
             rejections += 1;
@@ -106,11 +106,11 @@ fn robust_score_has_its_size_under_correlated_noise_and_power_against_the_effect
     assert!((0.01..=0.11).contains(&rate), "size {rate}");
     // the omitted column at a strength of a few noise levels is found, with the right sign
     let (r, j) = restricted(1.0, 0.6, 7);
-    let sc = robust_score(&r, &j, &[2], &[], &[true], &blocks, lag);
+    let sc = robust_score(&r, &j, &[2], &[], &[true], &blocks, lag, &[]);
     assert!(sc.p_value < 1e-3 && sc.step[0] > 0.0, "{sc:?}");
     // one-sided: a negative effect of a strength bounded at zero is not evidence
     let (r, j) = restricted(-1.0, 0.6, 7);
-    let sc = robust_score(&r, &j, &[2], &[], &[true], &blocks, lag);
+    let sc = robust_score(&r, &j, &[2], &[], &[true], &blocks, lag, &[]);
     assert_eq!((sc.dof, sc.p_value), (0, 1.0));
 }
 

@@ -206,6 +206,26 @@ impl<'a> Joint<'a> {
         Ok((r, jm, blocks))
     }
 
+    /// Stacked, weighted input-noise draws of the joint stages (`per_stage[s][k]`: draw `k`
+    /// of nominal stage `s`; see [`crate::fit::driven::Stage::input_noise_draws`]).
+    pub fn noise_draws(&self, per_stage: &[Vec<Vec<f64>>]) -> Vec<Vec<f64>> {
+        let k = self
+            .stages
+            .iter()
+            .map(|(s, _)| per_stage.get(*s).map_or(0, |d| d.len()))
+            .min()
+            .unwrap_or(0);
+        (0..k)
+            .map(|d| {
+                self.stages
+                    .iter()
+                    .zip(&self.weight)
+                    .flat_map(|((s, _), w)| per_stage[*s][d].iter().map(move |v| v * w))
+                    .collect()
+            })
+            .collect()
+    }
+
     /// Effect values from the joint variables.
     pub fn effect_values(&self, u: &[f64]) -> Vec<f64> {
         self.effect

@@ -244,7 +244,7 @@ pub fn localize(
     let mut channels = Vec::new();
     let (mut mech, mut nm, mut gas, mut ng) = (0.0, 0, 0.0, 0);
     let mut dominant_harmonic = Vec::new();
-    for (c, r) in nominal.channels.iter().zip(&nominal.resid) {
+    for (c, r) in nominal.channels.iter().zip(&nominal.hp) {
         let s = prof
             .noise
             .iter()

@@ -36,7 +36,7 @@ use stirling_dsl::{Closure, Model};
 
 use crate::data::{cycle_mean, Measured};
 use crate::effects::{self, EffectInfo};
-use crate::fit::driven::noise_sigma;
+use crate::fit::driven::{noise_sigma, project_drift};
 use crate::fit::{self, FitOptions, FittedStage};
 use joint::Joint;
 
@@ -64,6 +64,8 @@ pub struct DiagnoseOptions {
     pub joint_iters: usize,
     /// Bootstrap resamples for the closure interval.
     pub bootstrap: usize,
+    /// Monte Carlo draws of the input noise for the score's variance (0: output noise only).
+    pub noise_draws: usize,
     /// Family-wise significance level of the score screen (Bonferroni over the candidates).
     pub alpha: f64,
     pub seed: u64,
@@ -77,6 +79,7 @@ impl Default for DiagnoseOptions {
             holdout: None,
             fit: FitOptions::default(),
             joint_iters: 12,
+            noise_draws: 40,
             bootstrap: 400,
             alpha: 0.01,
             seed: 7,
@@ -88,7 +91,7 @@ impl Default for DiagnoseOptions {
 #[derive(Clone, Debug, Serialize)]
 pub struct ChannelError {
     pub channel: String,
-    /// RMS of measured minus model (channel units).
+    /// RMS of measured minus model (channel units), slow part removed as in every error.
     pub rms: f64,
     /// Noise level estimated from the data (third differences).
     pub noise: f64,
@@ -194,6 +197,9 @@ pub struct Prediction {
     pub channel: String,
     pub first: usize,
     pub values: Vec<f64>,
+    /// Drift cosines per sample that the stage's fit ignores ([`crate::fit::driven::Stage::drift`]):
+    /// the same band is projected out of this channel's residuals on every block.
+    pub drift_rate: f64,
 }
 
 /// The prediction of a fitted stage at variables `u`, from its training start to `last`.
@@ -211,6 +217,7 @@ pub fn predict(st: &FittedStage, u: &[f64], last: usize) -> Result<Vec<Predictio
             channel: o.channel.clone(),
             first: run.first,
             values,
+            drift_rate: st.stage.drift as f64 / st.keep.len().max(1) as f64,
         })
         .collect())
 }
@@ -232,6 +239,8 @@ pub struct Context<'a> {
     pub p_nom: Vec<f64>,
     /// The nominal stages' predictions (per stage), reused for stages an effect leaves alone.
     pub nominal_preds: Vec<Vec<Prediction>>,
+    /// Per nominal stage: Monte Carlo draws of how input noise moves its weighted residuals.
+    pub input_noise: Vec<Vec<Vec<f64>>>,
     /// Joint fits run.
     pub fits: std::cell::Cell<usize>,
 }
@@ -311,7 +320,17 @@ impl Context<'_> {
         }
         let hp: Vec<Vec<f64>> = resid
             .iter()
-            .map(|r| high_pass(r, self.half_period))
+            .zip(preds)
+            .map(|(r, pr)| {
+                let mut h = high_pass(r, self.half_period);
+                for (a, b) in [self.train_idx, self.hold_idx] {
+                    let m = (pr.drift_rate * (b - a) as f64).round() as usize;
+                    if m > 0 && h[a..b].iter().all(|v| v.is_finite()) {
+                        project_drift(&mut h[a..b], m);
+                    }
+                }
+                h
+            })
             .collect();
         let sample_err = |range: (usize, usize)| -> Result<(f64, f64), String> {
             let mut total = 0.0;
@@ -501,6 +520,14 @@ pub fn diagnose(
         lag: score::bandwidth(b.train_idx.1 - b.train_idx.0, period),
         p_nom: p_nom.clone(),
         nominal_preds,
+        input_noise: stages
+            .iter()
+            .map(|st| {
+                st.stage
+                    .input_noise_draws(&st.u, st.first, st.last, &st.keep, opts.noise_draws, opts.seed)
+            })
+            .collect::<Result<Vec<_>, _>>()
+            .map_err(|e| DiagnoseError::Nominal(e.to_string()))?,
         fits: std::cell::Cell::new(1),
     };
     let all: Vec<Prediction> = ctx.nominal_preds.iter().flatten().cloned().collect();
@@ -513,6 +540,14 @@ pub fn diagnose(
         .collect::<Result<Vec<f64>, _>>()
         .map_err(|e| DiagnoseError::Nominal(e.to_string()))?;
     let localization = localize::localize(model, &p_nom, data, &nominal, &ctx);
+    if std::env::var_os("STIRLING_DIAGNOSE_DEBUG").is_some() {
+        for c in &localization.channels {
+            eprintln!(
+                "nominal {}: train {:.3}, held-out {:.3} x noise; s2 {s2:?}",
+                c.channel, c.train_ratio, c.holdout_ratio
+            );
+        }
+    }
     let mut lm = opts.fit.lm;
     lm.max_iter = opts.joint_iters;
     // trial steps of at most one typical strength: far trials (an engine stopped by friction)
@@ -570,7 +605,7 @@ fn gap_before(
     let channels = nominal
         .channels
         .iter()
-        .zip(&nominal.resid)
+        .zip(&nominal.hp)
         .map(|(c, r)| {
             let rms = (r[a..b].iter().map(|v| v * v).sum::<f64>() / (b - a) as f64).sqrt();
             let s = ctx.noise_of(c);

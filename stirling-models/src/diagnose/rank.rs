@@ -56,7 +56,10 @@ fn screen(ctx: &Context, joint: &Joint, u0: &[f64]) -> Result<Score, String> {
         .map(|v| v.index)
         .collect();
     let bounded: Vec<bool> = strengths.iter().map(|v| v.bounded).collect();
-    Ok(robust_score(&r, &j, &test, &skip, &bounded, &blocks, ctx.lag))
+    let noise = joint.noise_draws(&ctx.input_noise);
+    Ok(robust_score(
+        &r, &j, &test, &skip, &bounded, &blocks, ctx.lag, &noise,
+    ))
 }
 
 /// Levenberg-Marquardt on the joint problem from `u0`, with the variables `fixed` held.

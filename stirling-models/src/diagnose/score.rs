@@ -88,7 +88,10 @@ pub fn long_run_cov(c: &DMatrix<f64>, blocks: &[(usize, usize)], lag: usize) -> 
 
 /// The robust one-sided score test of columns `test` of `j` at residuals `r`; `skip`: columns
 /// that are neither tested nor nuisance (shape parameters, inert at the null); `bounded`: per
-/// tested column; `blocks`: the rows of every time series; `lag`: the Bartlett bandwidth.
+/// tested column; `blocks`: the rows of every time series; `lag`: the Bartlett bandwidth;
+/// `noise`: draws of how the noise on the prescribed inputs moves `r` (their covariance of
+/// the score is added: input noise driven through a lightly damped body is correlated over
+/// longer than the record, which no bandwidth can estimate from the residuals alone).
 pub fn robust_score(
     r: &[f64],
     j: &DMatrix<f64>,
@@ -97,6 +100,7 @@ pub fn robust_score(
     bounded: &[bool],
     blocks: &[(usize, usize)],
     lag: usize,
+    noise: &[Vec<f64>],
 ) -> Score {
     let mut active: Vec<usize> = (0..test.len()).collect();
     let rv = DVector::from_column_slice(r);
@@ -125,7 +129,15 @@ pub fn robust_score(
             continue;
         }
         let c = DMatrix::from_fn(e.nrows(), e.ncols(), |i, q| e[(i, q)] * r[i]);
-        let v = long_run_cov(&c, blocks, lag);
+        let mut v = long_run_cov(&c, blocks, lag);
+        if !noise.is_empty() {
+            let mut acc = DMatrix::zeros(v.nrows(), v.ncols());
+            for d in noise {
+                let gd = e.transpose() * DVector::from_column_slice(d);
+                acc += &gd * gd.transpose();
+            }
+            v += acc / noise.len() as f64;
+        }
         let stat = match v.cholesky() {
             Some(ch) => g.dot(&ch.solve(&g)).max(0.0),
             None => return none(active.len()),

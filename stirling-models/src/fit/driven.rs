@@ -427,31 +427,23 @@ impl Stage<'_> {
         Ok(())
     }
 
-    /// Covariance of the fit variables `u` caused by the noise on the prescribed inputs
-    /// (errors in variables), by Monte Carlo: `draws` noise records (the estimated standard
-    /// deviation, white, smoothed like the signal) are added to the inputs, each moves the
-    /// weighted residuals by `dr` (the drift band projected out as in the fit), and the
-    /// first-order estimate moves by `-(J^T J)^-1 J^T dr`; returns the sample covariance of
-    /// those moves (`None` without input noise).
-    pub fn input_noise_cov(
+    /// How the noise on the prescribed inputs moves the weighted residuals, by Monte Carlo:
+    /// `draws` noise records (the estimated standard deviation, white, smoothed like the
+    /// signal) are added to the inputs; each gives the change `dr` of the residuals on `keep`
+    /// (the drift band projected out as in the fit). Empty without input noise.
+    pub fn input_noise_draws(
         &self,
         u: &[f64],
         first: usize,
         last: usize,
         keep: &[usize],
-        j: &DMatrix<f64>,
         draws: usize,
         seed: u64,
-    ) -> Result<Option<DMatrix<f64>>, FitError> {
+    ) -> Result<Vec<Vec<f64>>, FitError> {
         use rand::{rngs::StdRng, Rng, SeedableRng};
         if self.input_noise.is_empty() || draws == 0 {
-            return Ok(None);
+            return Ok(Vec::new());
         }
-        let nv = self.vars.len();
-        let jtj = j.transpose() * j;
-        let Some(inv) = jtj.clone().try_inverse() else {
-            return Ok(None);
-        };
         let base = self.run(u, first, last, false)?;
         let mut rng = StdRng::seed_from_u64(seed);
         let mut gauss = move || {
@@ -459,19 +451,11 @@ impl Stage<'_> {
             let u2: f64 = rng.gen::<f64>();
             (-2.0 * u1.ln()).sqrt() * (2.0 * std::f64::consts::PI * u2).cos()
         };
-        let mut acc = DMatrix::zeros(nv, nv);
         let mut noisy = Stage {
-            signals: self.signals.clone(),
-            given: self.given.clone(),
-            vars: self.vars.clone(),
-            outputs: self.outputs.clone(),
-            z0: self.z0.clone(),
-            p: self.p.clone(),
-            base: self.base.clone(),
-            free: self.free.clone(),
             input_noise: Vec::new(),
-            ..*self
+            ..self.clone()
         };
+        let mut out = Vec::with_capacity(draws);
         for _ in 0..draws {
             for &(s, sd, h) in &self.input_noise {
                 let e: Vec<f64> = (0..self.signals[s].val.len())
@@ -496,11 +480,39 @@ impl Stage<'_> {
                     project_drift(&mut dr[start..], self.drift);
                 }
             }
-            let g = j.transpose() * DVector::from_vec(dr);
-            let du = &inv * g;
+            out.push(dr);
+        }
+        Ok(out)
+    }
+
+    /// Covariance of the fit variables `u` caused by the noise on the prescribed inputs
+    /// (errors in variables): each draw of [`Stage::input_noise_draws`] moves the first-order
+    /// estimate by `-(J^T J)^-1 J^T dr`; returns the sample covariance of those moves (`None`
+    /// without input noise).
+    pub fn input_noise_cov(
+        &self,
+        u: &[f64],
+        first: usize,
+        last: usize,
+        keep: &[usize],
+        j: &DMatrix<f64>,
+        draws: usize,
+        seed: u64,
+    ) -> Result<Option<DMatrix<f64>>, FitError> {
+        let nv = self.vars.len();
+        let Some(inv) = (j.transpose() * j).try_inverse() else {
+            return Ok(None);
+        };
+        let drs = self.input_noise_draws(u, first, last, keep, draws, seed)?;
+        if drs.is_empty() {
+            return Ok(None);
+        }
+        let mut acc = DMatrix::zeros(nv, nv);
+        for dr in &drs {
+            let du = &inv * (j.transpose() * DVector::from_column_slice(dr));
             acc += &du * du.transpose();
         }
-        Ok(Some(acc / draws as f64))
+        Ok(Some(acc / drs.len() as f64))
     }
 
     /// Weighted residuals and Jacobian on the sample indices `keep` (within `first..=last`).
