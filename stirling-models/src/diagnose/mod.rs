@@ -557,7 +557,7 @@ pub fn diagnose(
         .iter()
         .map(|e| rank::assess(&ctx, &stages, &s2, &nominal, e, &lm))
         .collect();
-    rank::sort(&mut assessed);
+    rank::sort(&mut assessed, opts.alpha / cands.len().max(1) as f64);
     for a in assessed.iter_mut() {
         if let Some(ev) = &a.eval {
             let c = closure::closure(

@@ -227,8 +227,27 @@ fn assess_inner(
         ));
     }
     let joint = Joint::new(ctx.model, nominal, s2, e, &shapes, !shapes.is_empty())?;
-    let (res, fixed) = fit(&joint, &joint.start(nominal), &score, opts)?;
-    ctx.fits.set(ctx.fits.get() + 1);
+    // a strength with a shape (end stops) is not smooth in its strength: several starts
+    let starts: Vec<Option<f64>> = if shapes.is_empty() {
+        vec![None]
+    } else {
+        vec![None, Some(0.3), Some(1.0)]
+    };
+    let mut best: Option<(lm::LmResult, Vec<usize>)> = None;
+    let mut last_err = String::new();
+    for s0 in starts {
+        let mut sc = score.clone();
+        if let Some(v) = s0 {
+            sc.step.iter_mut().for_each(|s| *s = v);
+        }
+        ctx.fits.set(ctx.fits.get() + 1);
+        match fit(&joint, &joint.start(nominal), &sc, opts) {
+            Ok(r) if best.as_ref().is_none_or(|b| r.0.cost < b.0.cost) => best = Some(r),
+            Ok(_) => {}
+            Err(e) => last_err = e,
+        }
+    }
+    let (res, fixed) = best.ok_or(last_err)?;
     entry.params = estimates(&joint, &res, &fixed);
     let ev = ctx.eval_joint(&joint, &res.x, joint.effect_values(&res.x))?;
     let k = joint.effect.len() - fixed.len();
@@ -240,12 +259,19 @@ fn assess_inner(
     Ok(Some(ev))
 }
 
-/// Order: fitted candidates by held-out BIC change, then the rest by p-value.
-pub fn sort(entries: &mut [Assessed]) {
-    entries.sort_by(|a, b| match (a.entry.delta_bic, b.entry.delta_bic) {
-        (Some(x), Some(y)) => x.total_cmp(&y),
-        (Some(_), None) => std::cmp::Ordering::Less,
-        (None, Some(_)) => std::cmp::Ordering::Greater,
-        (None, None) => a.entry.p_value.total_cmp(&b.entry.p_value),
+/// Order: the promising candidates (score significant at `level`) by held-out BIC change,
+/// then the other fitted ones by held-out BIC change, then the rest by p-value.
+pub fn sort(entries: &mut [Assessed], level: f64) {
+    let class = |e: &RankEntry| match (e.p_value < level, e.delta_bic.is_some()) {
+        (true, true) => 0,
+        (false, true) => 1,
+        _ => 2,
+    };
+    entries.sort_by(|a, b| {
+        let (a, b) = (&a.entry, &b.entry);
+        class(a).cmp(&class(b)).then_with(|| match (a.delta_bic, b.delta_bic) {
+            (Some(x), Some(y)) => x.total_cmp(&y),
+            _ => a.p_value.total_cmp(&b.p_value),
+        })
     });
 }

@@ -113,8 +113,8 @@ pub fn settings(name: &str, m: f64) -> Vec<String> {
         .collect();
     if name == "end_stops" {
         // stops inside the recorded stroke, so that they act
-        out.push("xmax=0.003".into());
-        out.push("ymax=0.0025".into());
+        out.push("xmax=0.002".into());
+        out.push("ymax=0.0011".into());
     }
     out
 }
