@@ -81,7 +81,10 @@ fn restricted(c: f64, rho: f64, seed: u64) -> (Vec<f64>, DMatrix<f64>) {
         .collect();
     let x = cols.columns(0, 2).into_owned();
     let yv = DVector::from_vec(y);
-    let beta = (x.transpose() * &x).cholesky().unwrap().solve(&(x.transpose() * &yv));
+    let beta = (x.transpose() * &x)
+        .cholesky()
+        .unwrap()
+        .solve(&(x.transpose() * &yv));
     // residuals as model minus data, like the fit's
     let r = (&x * beta - yv).iter().copied().collect();
     (r, cols)

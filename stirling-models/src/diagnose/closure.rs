@@ -7,7 +7,7 @@
 use rand::{rngs::StdRng, Rng, SeedableRng};
 use serde::Serialize;
 
-use super::{Eval, Context};
+use super::{Context, Eval};
 use crate::data::{cycle_mean, Measured};
 
 /// The closure fraction with its interval.

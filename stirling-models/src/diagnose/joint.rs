@@ -262,7 +262,11 @@ fn kind_in(
             let mut p = st.stage.p.clone();
             for q in e.params {
                 if let Some(i) = model.param_index(q.name) {
-                    p[i] = if q.null.is_some() { q.typical } else { 1e-4 * q.typical };
+                    p[i] = if q.null.is_some() {
+                        q.typical
+                    } else {
+                        1e-4 * q.typical
+                    };
                 }
             }
             let shape = e.params.iter().any(|q| q.name == name && q.null.is_none());
@@ -276,8 +280,13 @@ fn kind_in(
                 vec![name.to_string()]
             };
             let enters = probe.iter().any(|q| {
-                classify(model, &p, std::slice::from_ref(q))
-                    .is_ok_and(|(m, g)| if mech { !m.is_empty() } else { !g.is_empty() })
+                classify(model, &p, std::slice::from_ref(q)).is_ok_and(|(m, g)| {
+                    if mech {
+                        !m.is_empty()
+                    } else {
+                        !g.is_empty()
+                    }
+                })
             });
             enters.then_some(VarKind::Param(j))
         }

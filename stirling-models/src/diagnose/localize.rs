@@ -10,7 +10,7 @@ use serde::Serialize;
 use stirling_dsl::{Model, StateKind};
 
 use super::closure::cycle_starts;
-use super::{Eval, Context};
+use super::{Context, Eval};
 use crate::data::{cycle_mean, Measured};
 use crate::fit::driven::savitzky_golay;
 use crate::sim::{simulate, SimOptions};

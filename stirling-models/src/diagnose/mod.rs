@@ -363,12 +363,7 @@ impl Context<'_> {
     }
 
     /// The evaluation of a fitted joint problem: its stages at `u`, the others nominal.
-    pub fn eval_joint(
-        &self,
-        joint: &Joint,
-        u: &[f64],
-        theta: Vec<f64>,
-    ) -> Result<Eval, String> {
+    pub fn eval_joint(&self, joint: &Joint, u: &[f64], theta: Vec<f64>) -> Result<Eval, String> {
         let last = self.hold_idx.1 - 1;
         let mut preds = Vec::new();
         for (si, nom) in self.nominal_preds.iter().enumerate() {
@@ -523,8 +518,14 @@ pub fn diagnose(
         input_noise: stages
             .iter()
             .map(|st| {
-                st.stage
-                    .input_noise_draws(&st.u, st.first, st.last, &st.keep, opts.noise_draws, opts.seed)
+                st.stage.input_noise_draws(
+                    &st.u,
+                    st.first,
+                    st.last,
+                    &st.keep,
+                    opts.noise_draws,
+                    opts.seed,
+                )
             })
             .collect::<Result<Vec<_>, _>>()
             .map_err(|e| DiagnoseError::Nominal(e.to_string()))?,

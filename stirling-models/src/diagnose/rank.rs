@@ -90,7 +90,11 @@ fn fit(
     let strengths: Vec<&EffectVar> = joint.effect.iter().filter(|v| !v.shape).collect();
     for (v, &s) in strengths.iter().zip(&score.step) {
         // a strength the screen dropped still gets a small push to explore its side
-        u0[v.index] = if v.bounded { s.clamp(0.05, 2.0) } else { s.clamp(-2.0, 2.0) };
+        u0[v.index] = if v.bounded {
+            s.clamp(0.05, 2.0)
+        } else {
+            s.clamp(-2.0, 2.0)
+        };
     }
     let mut fixed: Vec<usize> = Vec::new();
     for _ in 0..=strengths.len() {
@@ -137,7 +141,11 @@ fn estimates(joint: &Joint, res: &lm::LmResult, fixed: &[usize]) -> Vec<EffectEs
                 .and_then(|k| cov.as_ref().map(|c| c[(k, k)]))
                 .filter(|c| *c > 0.0)
                 .map(|c| v.scale * c.sqrt())
-                .unwrap_or(if fixed.contains(&v.index) { 0.0 } else { f64::NAN });
+                .unwrap_or(if fixed.contains(&v.index) {
+                    0.0
+                } else {
+                    f64::NAN
+                });
             EffectEstimate {
                 name: v.name.clone(),
                 value,
@@ -182,7 +190,11 @@ pub fn assess(
             entry.score,
             entry.dof,
             entry.p_value,
-            entry.params.iter().map(|q| (q.name.clone(), q.value, q.std_error)).collect::<Vec<_>>(),
+            entry
+                .params
+                .iter()
+                .map(|q| (q.name.clone(), q.value, q.std_error))
+                .collect::<Vec<_>>(),
             entry.holdout_error,
             clock.elapsed().as_secs_f64(),
             entry.note
@@ -269,9 +281,11 @@ pub fn sort(entries: &mut [Assessed], level: f64) {
     };
     entries.sort_by(|a, b| {
         let (a, b) = (&a.entry, &b.entry);
-        class(a).cmp(&class(b)).then_with(|| match (a.delta_bic, b.delta_bic) {
-            (Some(x), Some(y)) => x.total_cmp(&y),
-            _ => a.p_value.total_cmp(&b.p_value),
-        })
+        class(a)
+            .cmp(&class(b))
+            .then_with(|| match (a.delta_bic, b.delta_bic) {
+                (Some(x), Some(y)) => x.total_cmp(&y),
+                _ => a.p_value.total_cmp(&b.p_value),
+            })
     });
 }

@@ -374,7 +374,10 @@ impl Stage<'_> {
                     }
                     outputs.iter().for_each(|&o| gain[o] *= 1.0 + val);
                 }
-                VarKind::Sensor(Sensor::Lag { signals: ss, outputs }) => {
+                VarKind::Sensor(Sensor::Lag {
+                    signals: ss,
+                    outputs,
+                }) => {
                     for &s in ss {
                         let sig = &mut signals[s];
                         let d2 = derivative(&sig.der, sig.dt);
