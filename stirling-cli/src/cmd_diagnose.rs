@@ -41,13 +41,13 @@ pub struct DiagnoseArgs {
     #[arg(long)]
     pub self_check: bool,
     /// Self-check: record length (s)
-    #[arg(long, default_value_t = 1.0)]
+    #[arg(long, default_value_t = 2.0)]
     pub t_end: f64,
     /// Self-check: sample rate (Hz)
-    #[arg(long, default_value_t = 1000.0)]
+    #[arg(long, default_value_t = 2000.0)]
     pub rate: f64,
     /// Self-check: strengths as multiples of the typical values, comma-separated
-    #[arg(long, value_delimiter = ',', default_value = "0.5,1")]
+    #[arg(long, value_delimiter = ',', default_value = "1,2")]
     pub strengths: Vec<f64>,
     /// Machine-readable output
     #[arg(long)]

@@ -128,7 +128,17 @@ fn estimates(joint: &Joint, res: &lm::LmResult, fixed: &[usize]) -> Vec<EffectEs
     let jf = j.select_columns(&free);
     let dof = res.residuals.len().saturating_sub(free.len()).max(1);
     let s2 = DVector::from_column_slice(&res.residuals).norm_squared() / dof as f64;
-    let cov = (jf.transpose() * &jf).try_inverse().map(|c| c * s2);
+    // covariance from the SVD of J (squaring J first loses the small singular values)
+    let cov = {
+        let svd = jf.clone().svd(false, true);
+        svd.v_t.map(|vt| {
+            let smax = svd.singular_values.max();
+            let inv2 = svd
+                .singular_values
+                .map(|v| if v > 1e-12 * smax { 1.0 / (v * v) } else { 0.0 });
+            vt.transpose() * nalgebra::DMatrix::from_diagonal(&inv2) * vt * s2
+        })
+    };
     let values = joint.effect_values(&res.x);
     joint
         .effect
