@@ -226,6 +226,6 @@ pub fn run(a: &DiagnoseArgs) -> anyhow::Result<()> {
             .unwrap_or_default(),
         d.verdict.reason
     );
-    println!("{} two-stage fits, {:.1} s", d.fits, d.seconds);
+    println!("{} fits (nominal and joint), {:.1} s", d.fits, d.seconds);
     Ok(())
 }

@@ -4,21 +4,13 @@
 //! - **where** ([`localize`]): residuals per channel, per harmonic of the cycle, per phase of
 //!   the cycle, per subsystem (stage-1 mechanics vs stage-2 gas), and limit-cycle features of
 //!   the measured record against a free run of the calibrated model;
-//! - **which** ([`score`]): a score (Lagrange-multiplier) test of every candidate effect at
-//!   its null value, on the profiled cost of the driven subsystems;
-//! - fit the promising candidates jointly with the nominal parameters and rank them by
+//! - **which** ([`score`]): a robust score (Lagrange-multiplier) test of every candidate effect
+//!   at its null, from one Jacobian of the joint problem ([`joint`]: the calibrated stages the
+//!   effect touches, extended by its variables);
+//! - fit every candidate jointly with the nominal variables of those stages and rank them by
 //!   held-out error with a BIC penalty ([`rank`]);
 //! - **how far** ([`closure`]): the fraction of the held-out excess error closed by the winner,
 //!   with a bootstrap interval over whole cycles; the [`verdict`].
-//!
-//! The profile machinery ([`Profile`]): for an effect with strength parameters `theta`, the
-//! nominal free parameters are re-fitted by the two-stage identification with `theta` fixed,
-//! and the residuals are taken in the *measured* space (sensor effects act on the model
-//! outputs: a gain multiplies them, a lag filters them), normalized by each channel's noise
-//! level estimated from the data. The cost `S(theta)` is thus minimized over the nominal
-//! parameters; its gradient at the null is the score of `theta` with the nuisance parameters
-//! profiled out (envelope theorem), and its curvature is the Schur complement of the
-//! Gauss-Newton information, i.e. `[I^-1]_theta,theta ^-1`.
 
 pub mod closure;
 pub mod joint;
@@ -158,7 +150,7 @@ pub struct Diagnosis {
     pub localization: localize::Localization,
     pub ranking: Vec<RankEntry>,
     pub verdict: verdict::Verdict,
-    /// Number of two-stage fits run.
+    /// Fits run (the nominal calibration and every joint fit).
     pub fits: usize,
     pub seconds: f64,
     /// Residual series (nominal and winner) on the record, for the report.

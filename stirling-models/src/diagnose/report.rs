@@ -207,7 +207,7 @@ pub fn write(d: &Diagnosis, data: &Measured, dir: &Path) -> Result<std::path::Pa
     );
     let _ = writeln!(
         s,
-        "Training {:.3}:{:.3} s, held out {:.3}:{:.3} s; {} two-stage fits, {:.1} s.\n",
+        "Training {:.3}:{:.3} s, held out {:.3}:{:.3} s; {} fits, {:.1} s.\n",
         d.train.0, d.train.1, d.holdout.0, d.holdout.1, d.fits, d.seconds
     );
     let _ = writeln!(
