@@ -52,16 +52,7 @@ fn sample_err(ev: &Eval, prof: &Context, i: usize) -> f64 {
     ev.channels
         .iter()
         .zip(&ev.hp)
-        .map(|(c, r)| {
-            (r[i]
-                / prof
-                    .noise
-                    .iter()
-                    .find(|(n, _)| n == c)
-                    .map(|(_, s)| *s)
-                    .unwrap_or(1.0))
-            .powi(2)
-        })
+        .map(|(c, r)| (r[i] / prof.noise_of(c)).powi(2))
         .sum::<f64>()
         / ev.channels.len() as f64
 }

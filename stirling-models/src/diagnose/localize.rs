@@ -245,12 +245,7 @@ pub fn localize(
     let (mut mech, mut nm, mut gas, mut ng) = (0.0, 0, 0.0, 0);
     let mut dominant_harmonic = Vec::new();
     for (c, r) in nominal.channels.iter().zip(&nominal.hp) {
-        let s = prof
-            .noise
-            .iter()
-            .find(|(n, _)| n == c)
-            .map(|(_, s)| *s)
-            .unwrap_or(1.0);
+        let s = prof.noise_of(c);
         let ms = |a: usize, b: usize| {
             r[a..b].iter().map(|v| (v / s).powi(2)).sum::<f64>() / (b - a).max(1) as f64
         };

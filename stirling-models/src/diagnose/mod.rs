@@ -165,9 +165,6 @@ pub struct Diagnosis {
 pub struct Eval {
     /// Effect values (empty for the nominal model).
     pub theta: Vec<f64>,
-    /// Training cost: sum over channels and samples of (residual / noise)^2.
-    pub s_train: f64,
-    pub n_train: usize,
     /// Held-out mean of the per-sample, channel-averaged (residual / noise)^2.
     pub holdout_error: f64,
     pub train_error: f64,
@@ -263,7 +260,8 @@ pub fn high_pass(r: &[f64], h: usize) -> Vec<f64> {
 }
 
 impl Context<'_> {
-    fn noise_of(&self, ch: &str) -> f64 {
+    /// The noise level of a channel (1 if unknown).
+    pub fn noise_of(&self, ch: &str) -> f64 {
         self.noise
             .iter()
             .find(|(c, _)| c == ch)
@@ -324,7 +322,7 @@ impl Context<'_> {
                 h
             })
             .collect();
-        let sample_err = |range: (usize, usize)| -> Result<(f64, f64), String> {
+        let sample_err = |range: (usize, usize)| -> Result<f64, String> {
             let mut total = 0.0;
             for i in range.0..range.1 {
                 for (c, r) in channels.iter().zip(&hp) {
@@ -336,14 +334,12 @@ impl Context<'_> {
                 }
             }
             let n = ((range.1 - range.0) * channels.len()).max(1) as f64;
-            Ok((total, total / n))
+            Ok(total / n)
         };
-        let (s_train, train_error) = sample_err(self.train_idx)?;
-        let (_, holdout_error) = sample_err(self.hold_idx)?;
+        let train_error = sample_err(self.train_idx)?;
+        let holdout_error = sample_err(self.hold_idx)?;
         Ok(Eval {
             theta,
-            s_train,
-            n_train: (self.train_idx.1 - self.train_idx.0) * channels.len(),
             holdout_error,
             train_error,
             channels,
