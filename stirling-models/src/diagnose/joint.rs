@@ -18,6 +18,7 @@ use stirling_dsl::Model;
 
 use crate::effects::{EffectInfo, EffectTarget};
 use crate::fit::driven::{Sensor, Var, VarKind};
+use crate::fit::prior::prior_rows;
 use crate::fit::{classify, FitError, FittedStage};
 
 /// One effect variable of the joint problem.
@@ -56,7 +57,8 @@ fn is_mechanics(st: &FittedStage) -> bool {
 
 /// The nominal variance factor of a stage: `|r|^2 / (N - k)` at its optimum.
 pub fn variance_factor(st: &FittedStage) -> Result<f64, FitError> {
-    let (r, _) = st.stage.residuals(&st.u, st.first, st.last, &st.keep)?;
+    let (mut r, _) = st.stage.residuals(&st.u, st.first, st.last, &st.keep)?;
+    r.truncate(st.keep.len() * st.stage.outputs.len());
     let dof = r
         .len()
         .saturating_sub(st.stage.vars.len() + st.stage.drift * st.stage.outputs.len())
@@ -110,6 +112,7 @@ impl<'a> Joint<'a> {
                             initial,
                             scale,
                             kind,
+                            prior: None,
                         },
                     ));
                 }
@@ -167,13 +170,39 @@ impl<'a> Joint<'a> {
         u
     }
 
+    /// [`Joint::start`] with the nominal model parameters back at their starting values (the
+    /// engineering estimates): a start in the effect's own basin when the nominal calibration
+    /// absorbed the effect into parameters that moved far (a leak into the heat transfer).
+    pub fn reset_start(&self, nominal: &[FittedStage]) -> Vec<f64> {
+        let mut u = self.start(nominal);
+        let n_nom = self.n_vars - self.effect.len();
+        for (k, (_, st)) in self.stages.iter().enumerate() {
+            for (v, &i) in st.stage.vars.iter().zip(&self.map[k]) {
+                if i < n_nom && matches!(v.kind, VarKind::Param(_)) {
+                    u[i] = 0.0;
+                }
+            }
+        }
+        u
+    }
+
+    /// The prior cost (sum of squared prior residuals, [`crate::fit::prior`]) of the nominal
+    /// parameters at the joint variables `u`.
+    pub fn prior_cost(&self, u: &[f64]) -> f64 {
+        (0..self.stages.len())
+            .flat_map(|k| prior_rows(&self.stages[k].1.stage.vars, &self.stage_u(k, u)))
+            .map(|row| row.r * row.r)
+            .sum()
+    }
+
     /// A stage's variables from the joint ones.
     pub fn stage_u(&self, k: usize, u: &[f64]) -> Vec<f64> {
         self.map[k].iter().map(|&i| u[i]).collect()
     }
 
     /// Weighted stacked residuals and Jacobian, with the row ranges of every output block
-    /// (residuals of one output of one stage, in time order).
+    /// (residuals of one output of one stage, in time order) and of every prior row (a block
+    /// of one row; the priors are standardized already and keep weight 1).
     pub fn residuals(
         &self,
         u: &[f64],
@@ -190,18 +219,20 @@ impl<'a> Joint<'a> {
         let mut jm = DMatrix::zeros(rows, self.n_vars);
         let mut blocks = Vec::new();
         for (k, (rk, jk)) in parts.iter().enumerate() {
-            let w = self.weight[k];
+            let per = self.stages[k].1.keep.len();
+            let n_out = self.stages[k].1.stage.outputs.len();
             let row0 = r.len();
-            r.extend(rk.iter().map(|v| v * w));
+            let w = |i: usize| if i < n_out * per { self.weight[k] } else { 1.0 };
+            r.extend(rk.iter().enumerate().map(|(i, v)| v * w(i)));
             for (c, &jc) in self.map[k].iter().enumerate() {
                 for i in 0..rk.len() {
-                    jm[(row0 + i, jc)] += w * jk[(i, c)];
+                    jm[(row0 + i, jc)] += w(i) * jk[(i, c)];
                 }
             }
-            let per = self.stages[k].1.keep.len();
-            for o in 0..self.stages[k].1.stage.outputs.len() {
+            for o in 0..n_out {
                 blocks.push((row0 + o * per, row0 + (o + 1) * per));
             }
+            blocks.extend((row0 + n_out * per..row0 + rk.len()).map(|i| (i, i + 1)));
         }
         Ok((r, jm, blocks))
     }

@@ -61,7 +61,17 @@ pub struct DiagnoseOptions {
     /// Family-wise significance level of the score screen (Bonferroni over the candidates).
     pub alpha: f64,
     pub seed: u64,
+    /// Log-normal prior on the nominal parameters around their starting values (log standard
+    /// deviation; `None`: none). An omitted effect can often be mimicked by moving nominal
+    /// parameters far from their estimates (a leak by the heat-transfer coefficients); the
+    /// prior makes such a move cost, so the effect shows in the score.
+    pub prior: Option<f64>,
 }
+
+/// The default prior spread of the nominal parameters: log standard deviation 0.5 (a factor
+/// 1.65 at one standard deviation), wide against the accuracy of spring rates and masses,
+/// about the accuracy of heat-transfer and damping estimates.
+pub const DEFAULT_PRIOR: f64 = 0.5;
 
 impl Default for DiagnoseOptions {
     fn default() -> Self {
@@ -75,6 +85,7 @@ impl Default for DiagnoseOptions {
             bootstrap: 400,
             alpha: 0.01,
             seed: 7,
+            prior: Some(DEFAULT_PRIOR),
         }
     }
 }
@@ -116,7 +127,8 @@ pub struct RankEntry {
     pub p_value: f64,
     /// Fitted jointly with the nominal parameters (the promising ones only).
     pub fitted: bool,
-    /// BIC change on the held-out block (negative: better than the nominal model).
+    /// BIC change on the held-out block plus the change of the nominal parameters' prior
+    /// cost (negative: better than the nominal model; see [`rank`]).
     pub delta_bic: Option<f64>,
     pub holdout_error: Option<f64>,
     pub closure_fraction: Option<f64>,
@@ -473,6 +485,7 @@ pub fn diagnose(
     fit_opts.free_run = None;
     fit_opts.multiple_shooting = None;
     fit_opts.input_noise_draws = 0;
+    fit_opts.prior = opts.prior;
     let (id, stages) = fit::identify_stages(model, p0, data, &fit_opts)
         .map_err(|e| DiagnoseError::Nominal(e.to_string()))?;
     let mut p_nom = p0.to_vec();
@@ -530,6 +543,7 @@ pub fn diagnose(
         .map_err(|e| DiagnoseError::Nominal(e.to_string()))?;
     let localization = localize::localize(model, &p_nom, data, &nominal, &ctx);
     if std::env::var_os("STIRLING_DIAGNOSE_DEBUG").is_some() {
+        eprintln!("nominal parameters: {:?}", id.params);
         for c in &localization.channels {
             eprintln!(
                 "nominal {}: train {:.3}, held-out {:.3} x noise; s2 {s2:?}",

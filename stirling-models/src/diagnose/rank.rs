@@ -1,8 +1,12 @@
 //! Screen, fit and rank the candidates: for every effect, the score test at its null on the
 //! joint problem ([`super::joint`], [`super::score`]); then the joint Levenberg-Marquardt fit
 //! of its strengths (and shapes) with every nominal variable of the stages it touches, from
-//! the nominal optimum; then the held-out error of the fitted model and the held-out BIC
-//! change `N_h ln(err_effect / err_nominal) + k ln N_h` (negative: better than nominal).
+//! the nominal optimum (and from the nominal parameters' estimates); then the held-out error
+//! of the fitted model and the held-out BIC change
+//! `N_h ln(err_effect / err_nominal) + k ln N_h + dC` (negative: better than nominal), where
+//! `dC` is the change of the prior cost of the nominal parameters ([`crate::fit::prior`]):
+//! an effect that predicts the held-out block as well as the nominal model, but with the
+//! nominal parameters back near their estimates, explains the data better (-2 log posterior).
 //!
 //! Shape parameters (the end stops' travel) are inert at a zero strength, so the score test
 //! cannot see them (Davies' problem): it is taken at a grid of travels (fractions of the
@@ -249,21 +253,29 @@ fn assess_inner(
         ));
     }
     let joint = Joint::new(ctx.model, nominal, s2, e, &shapes, !shapes.is_empty())?;
-    // a strength with a shape (end stops) is not smooth in its strength: several starts
-    let starts: Vec<Option<f64>> = if shapes.is_empty() {
-        vec![None]
-    } else {
-        vec![None, Some(0.3), Some(1.0)]
-    };
+    // starts: from the nominal optimum at the one-step estimate; a strength with a shape (end
+    // stops) is not smooth in its strength, so also at fixed strengths; and the typical
+    // strength with the nominal parameters at their estimates (the effect's own basin when
+    // the calibration absorbed it: the score, a local test, cannot see that basin)
+    let mut starts: Vec<(Option<f64>, bool)> = vec![(None, false)];
+    if !shapes.is_empty() {
+        starts.extend([(Some(0.3), false), (Some(1.0), false)]);
+    }
+    starts.push((Some(1.0), true));
     let mut best: Option<(lm::LmResult, Vec<usize>)> = None;
     let mut last_err = String::new();
-    for s0 in starts {
+    for (s0, reset) in starts {
         let mut sc = score.clone();
         if let Some(v) = s0 {
             sc.step.iter_mut().for_each(|s| *s = v);
         }
         ctx.fits.set(ctx.fits.get() + 1);
-        match fit(&joint, &joint.start(nominal), &sc, opts) {
+        let u0 = if reset {
+            joint.reset_start(nominal)
+        } else {
+            joint.start(nominal)
+        };
+        match fit(&joint, &u0, &sc, opts) {
             Ok(r) if best.as_ref().is_none_or(|b| r.0.cost < b.0.cost) => best = Some(r),
             Ok(_) => {}
             Err(e) => last_err = e,
@@ -276,8 +288,12 @@ fn assess_inner(
     let n_h = ctx.holdout_points(nominal_eval) as f64;
     entry.fitted = true;
     entry.holdout_error = Some(ev.holdout_error);
-    entry.delta_bic =
-        Some(n_h * (ev.holdout_error / nominal_eval.holdout_error).ln() + k as f64 * n_h.ln());
+    let prior_change = joint.prior_cost(&res.x) - joint.prior_cost(&joint.start(nominal));
+    entry.delta_bic = Some(
+        n_h * (ev.holdout_error / nominal_eval.holdout_error).ln()
+            + k as f64 * n_h.ln()
+            + prior_change,
+    );
     Ok(Some(ev))
 }
 

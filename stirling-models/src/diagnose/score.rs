@@ -5,10 +5,15 @@
 //! variable; tested: the effect strengths) give the effective score
 //! `g = E_perp' r`, `E_perp = E - N (N'N)^-1 N'E` (the strength columns with what the nominal
 //! parameters can absorb projected out). Its variance is estimated robustly: the per-sample
-//! contributions `c_i = E_perp,i r_i` are correlated in time (smoothed inputs, periodic model
+//! contributions `c_i = E_perp,i r~_i` are correlated in time (smoothed inputs, periodic model
 //! error), so `V` is the Newey-West (Bartlett) long-run covariance of `c` within every output
-//! series, centered. The statistic `g' V^-1 g` is chi-square with one degree of freedom per
-//! strength under the null.
+//! series, centered. `r~ = r - E_perp (E_perp'E_perp)^-1 g` are the residuals after the
+//! one-step fit of the effect: the null residuals would carry the effect's own periodic
+//! signature, whose square inflates the long-run variance and sinks the power against large
+//! effects (under the null the two agree to first order). Standardized independent rows
+//! (priors on the nominal parameters) contribute `E_perp,i` with their known unit variance.
+//! The statistic `g' V^-1 g` is chi-square with one degree of freedom per strength under the
+//! null.
 //!
 //! Strengths that cannot be negative make the test one-sided: a strength whose one-step
 //! estimate `-(E_perp'E_perp)^-1 g` is negative is dropped (held at its null) and the test is
@@ -56,7 +61,8 @@ fn effective(j: &DMatrix<f64>, test: &[usize], skip: &[usize]) -> Option<DMatrix
     Some(e - n * b)
 }
 
-/// Newey-West covariance of the rows of `c` (centered within every block of rows).
+/// Newey-West covariance of the rows of `c` (centered within every block of rows; a block of
+/// one row is an independent term, e.g. a prior, and is not centered).
 pub fn long_run_cov(c: &DMatrix<f64>, blocks: &[(usize, usize)], lag: usize) -> DMatrix<f64> {
     let k = c.ncols();
     let mut v = DMatrix::zeros(k, k);
@@ -64,9 +70,13 @@ pub fn long_run_cov(c: &DMatrix<f64>, blocks: &[(usize, usize)], lag: usize) -> 
         if b <= a {
             continue;
         }
-        let mean: Vec<f64> = (0..k)
-            .map(|q| (a..b).map(|i| c[(i, q)]).sum::<f64>() / (b - a) as f64)
-            .collect();
+        let mean: Vec<f64> = if b == a + 1 {
+            vec![0.0; k]
+        } else {
+            (0..k)
+                .map(|q| (a..b).map(|i| c[(i, q)]).sum::<f64>() / (b - a) as f64)
+                .collect()
+        };
         let x = DMatrix::from_fn(b - a, k, |i, q| c[(a + i, q)] - mean[q]);
         for l in 0..=lag.min(b - a - 1) {
             let w = if l == 0 {
@@ -88,7 +98,8 @@ pub fn long_run_cov(c: &DMatrix<f64>, blocks: &[(usize, usize)], lag: usize) -> 
 
 /// The robust one-sided score test of columns `test` of `j` at residuals `r`; `skip`: columns
 /// that are neither tested nor nuisance (shape parameters, inert at the null); `bounded`: per
-/// tested column; `blocks`: the rows of every time series; `lag`: the Bartlett bandwidth;
+/// tested column; `blocks`: the rows of every time series (a block of one row: a standardized
+/// independent row such as a prior); `lag`: the Bartlett bandwidth;
 /// `noise`: draws of how the noise on the prescribed inputs moves `r` (their covariance of
 /// the score is added: input noise driven through a lightly damped body is correlated over
 /// longer than the record, which no bandwidth can estimate from the residuals alone).
@@ -128,7 +139,24 @@ pub fn robust_score(
             active.remove(drop);
             continue;
         }
-        let c = DMatrix::from_fn(e.nrows(), e.ncols(), |i, q| e[(i, q)] * r[i]);
+        // rows of the time series contribute `e_i r_i`; an independent row (a prior, a block
+        // of one row) has unit variance by construction, so it contributes `e_i` (its own
+        // squared residual would estimate its variance from one draw)
+        let single: Vec<bool> = {
+            let mut v = vec![false; e.nrows()];
+            blocks
+                .iter()
+                .filter(|(a, b)| *b == a + 1)
+                .for_each(|&(a, _)| v[a] = true);
+            v
+        };
+        // the residuals with the one-step fit of the tested columns removed: under the
+        // alternative the null residuals carry the effect's own periodic signature, and its
+        // square would inflate the long-run variance (and sink the power for large effects)
+        let r_alt = &rv + &e * &step;
+        let c = DMatrix::from_fn(e.nrows(), e.ncols(), |i, q| {
+            e[(i, q)] * if single[i] { 1.0 } else { r_alt[i] }
+        });
         let mut v = long_run_cov(&c, blocks, lag);
         if !noise.is_empty() {
             let mut acc = DMatrix::zeros(v.nrows(), v.ncols());

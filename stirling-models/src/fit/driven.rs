@@ -85,6 +85,9 @@ pub struct Var {
     pub initial: f64,
     pub scale: f64,
     pub kind: VarKind,
+    /// A log-normal prior centred on `initial`: `ln(value / initial) / prior` is one more
+    /// residual (`None`, or `initial = 0`: no prior). See [`super::FitOptions::prior`].
+    pub prior: Option<f64>,
 }
 
 /// What a fit variable is.
@@ -483,6 +486,8 @@ impl Stage<'_> {
                     project_drift(&mut dr[start..], self.drift);
                 }
             }
+            // the priors do not see the input noise
+            dr.resize(dr.len() + super::prior::prior_count(&self.vars), 0.0);
             out.push(dr);
         }
         Ok(out)
@@ -518,7 +523,8 @@ impl Stage<'_> {
         Ok(Some(acc / drs.len() as f64))
     }
 
-    /// Weighted residuals and Jacobian on the sample indices `keep` (within `first..=last`).
+    /// Weighted residuals and Jacobian on the sample indices `keep` (within `first..=last`):
+    /// every output's samples in turn, then the prior rows ([`super::prior`]).
     pub fn residuals(
         &self,
         u: &[f64],
@@ -528,7 +534,8 @@ impl Stage<'_> {
     ) -> Result<(Vec<f64>, DMatrix<f64>), FitError> {
         let run = self.run(u, first, last, true)?;
         let nv = self.vars.len();
-        let rows = keep.len() * self.outputs.len();
+        let priors = super::prior::prior_rows(&self.vars, u);
+        let rows = keep.len() * self.outputs.len() + priors.len();
         let mut r = Vec::with_capacity(rows);
         let mut j = DMatrix::zeros(rows, nv);
         let mut row = 0;
@@ -552,6 +559,11 @@ impl Stage<'_> {
                     }
                 }
             }
+        }
+        for pr in priors {
+            r.push(pr.r);
+            j[(row, pr.var)] = pr.dr_du;
+            row += 1;
         }
         Ok((r, j))
     }

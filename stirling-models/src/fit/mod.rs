@@ -11,6 +11,7 @@ pub mod driven;
 pub mod free_run;
 pub mod lm;
 pub mod multiple_shooting;
+pub mod prior;
 pub mod report;
 pub mod sensitivity;
 
@@ -64,6 +65,9 @@ pub struct FitOptions {
     /// Monte Carlo draws for the input-noise (errors-in-variables) part of the parameter
     /// covariance (0: skip it; the intervals then miss that part).
     pub input_noise_draws: usize,
+    /// Log-normal prior on the free model parameters around their starting values, as a log
+    /// standard deviation (see [`prior`]; `None`: plain least squares).
+    pub prior: Option<f64>,
     /// Free-run validation after the stages (on the held-out block, else the training block).
     pub free_run: Option<free_run::FreeRunOptions>,
     /// Multiple-shooting refinement of the free parameters over the training block (off by
@@ -97,6 +101,7 @@ impl Default for FitOptions {
             stage2: true,
             drift_cut: 0.5,
             input_noise_draws: 40,
+            prior: None,
             free_run: Some(free_run::FreeRunOptions::default()),
             multiple_shooting: None,
         }
@@ -529,6 +534,7 @@ pub fn identify_stages<'a>(
                 initial: p[j],
                 scale: p[j].abs().max(1e-12),
                 kind: VarKind::Param(j),
+                prior: opts.prior,
             })
             .collect();
         let names = ["x(0)", "v(0)", "y(0)", "w(0)"];
@@ -538,6 +544,7 @@ pub fn identify_stages<'a>(
                 initial: z0[k],
                 scale: if k % 2 == 0 { 1e-3 } else { 0.05 },
                 kind: VarKind::Initial(k),
+                prior: None,
             });
         }
         vars.push(Var {
@@ -545,12 +552,14 @@ pub fn identify_stages<'a>(
             initial: x_off[0],
             scale: 1e-3,
             kind: VarKind::Offset { out: 0, du: vec![] },
+            prior: None,
         });
         vars.push(Var {
             name: "y_offset".into(),
             initial: x_off[1],
             scale: 1e-3,
             kind: VarKind::Offset { out: 1, du: vec![] },
+            prior: None,
         });
         let outputs = vec![
             Output {
@@ -682,6 +691,7 @@ pub fn identify_stages<'a>(
                 initial: p[j],
                 scale: p[j].abs().max(1e-12),
                 kind: VarKind::Param(j),
+                prior: opts.prior,
             })
             .collect();
         vars.push(Var {
@@ -689,6 +699,7 @@ pub fn identify_stages<'a>(
             initial: p_off0,
             scale: 100.0,
             kind: VarKind::Offset { out: 0, du: du(0) },
+            prior: None,
         });
         let mut outputs = vec![Output {
             channel: "p".into(),
@@ -703,6 +714,7 @@ pub fn identify_stages<'a>(
                 initial: ph_off0,
                 scale: 100.0,
                 kind: VarKind::Offset { out: 1, du: du(1) },
+                prior: None,
             });
             outputs.push(Output {
                 channel: "p_hot".into(),
