@@ -127,3 +127,29 @@ fn long_run_covariance_of_white_rows_is_their_sum_of_squares() {
     let v10 = long_run_cov(&c, &[(0, 5000)], 10);
     assert!((v10[(0, 0)] / v[(0, 0)] - 1.0).abs() < 0.15);
 }
+
+#[test]
+fn single_row_blocks_are_independent_terms_not_centered() {
+    // a prior row is one standardized draw: its block of one row keeps its square
+    let c = DMatrix::from_row_slice(2, 1, &[2.0, 3.0]);
+    let v = long_run_cov(&c, &[(0, 1), (1, 2)], 5);
+    assert!((v[(0, 0)] - 13.0).abs() < 1e-12, "{}", v[(0, 0)]);
+    // the same rows as one series are centered
+    let v2 = long_run_cov(&c, &[(0, 2)], 0);
+    assert!((v2[(0, 0)] - 0.5).abs() < 1e-12, "{}", v2[(0, 0)]);
+}
+
+#[test]
+fn robust_score_keeps_its_power_as_the_effect_grows() {
+    // the variance comes from the residuals after the one-step fit, so the effect's own
+    // signature does not inflate it: the statistic grows like the squared strength (with
+    // the null residuals it would saturate, numerator and variance both growing like c^2)
+    let blocks = [(0, 600)];
+    let lag = bandwidth(600, 30);
+    let stat = |c: f64| {
+        let (r, j) = restricted(c, 0.6, 11);
+        robust_score(&r, &j, &[2], &[], &[false], &blocks, lag, &[]).stat
+    };
+    let (s2, s8) = (stat(2.0), stat(8.0));
+    assert!(s8 > 8.0 * s2, "stat(8) = {s8}, stat(2) = {s2}");
+}

@@ -34,6 +34,10 @@ pub struct DiagnoseArgs {
     /// Held-out block c:d in seconds (default: the rest)
     #[arg(long)]
     pub holdout: Option<String>,
+    /// Spread of the prior on the nominal parameters around their starting values, as a log
+    /// standard deviation (0.5: a factor 1.65 at one standard deviation; 0: no prior)
+    #[arg(long, default_value_t = diagnose::DEFAULT_PRIOR)]
+    pub prior: f64,
     /// Write report.md and SVG figures into this directory
     #[arg(long)]
     pub report: Option<PathBuf>,
@@ -52,6 +56,14 @@ pub struct DiagnoseArgs {
     /// Machine-readable output
     #[arg(long)]
     pub json: bool,
+}
+
+/// The prior spread: `None` for 0, an error for a negative or non-finite value.
+fn prior_arg(v: f64) -> anyhow::Result<Option<f64>> {
+    if !v.is_finite() || v < 0.0 {
+        bail!("--prior must be a finite log standard deviation >= 0 (0: no prior), got {v}");
+    }
+    Ok((v > 0.0).then_some(v))
 }
 
 fn effects_arg(s: &str) -> Option<Vec<String>> {
@@ -76,6 +88,10 @@ pub fn run(a: &DiagnoseArgs) -> anyhow::Result<()> {
             strengths: a.strengths.clone(),
             t_end: a.t_end,
             rate: a.rate,
+            diagnose: DiagnoseOptions {
+                prior: prior_arg(a.prior)?,
+                ..Default::default()
+            },
             ..Default::default()
         };
         let json = a.json;
@@ -126,6 +142,7 @@ pub fn run(a: &DiagnoseArgs) -> anyhow::Result<()> {
     }
     let mut opts = DiagnoseOptions {
         effects: effects_arg(&a.effects),
+        prior: prior_arg(a.prior)?,
         ..Default::default()
     };
     if let Some(s) = &a.train {
@@ -160,6 +177,18 @@ pub fn run(a: &DiagnoseArgs) -> anyhow::Result<()> {
         println!(
             "  {:<6} rms {:.4e}  noise {:.4e}  ratio {:.3}",
             c.channel, c.rms, c.noise, c.ratio
+        );
+    }
+    for s in &d.gap_before.shifts {
+        println!(
+            "  {:<6} start {:.4e} -> calibrated {:.4e} (x{:.3}{})",
+            s.name,
+            s.start,
+            s.calibrated,
+            s.factor,
+            s.prior_sd
+                .map(|z| format!(", {z:+.2} prior sd"))
+                .unwrap_or_default()
         );
     }
     let l = &d.localization;

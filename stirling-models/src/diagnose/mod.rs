@@ -115,6 +115,21 @@ pub struct GapBefore {
     pub features: localize::Features,
     /// The calibrated nominal parameters (the fitted subset).
     pub params: Vec<(String, f64)>,
+    /// How far the calibration moved each fitted parameter from its starting value: a gap
+    /// can hide in the parameters (a leak absorbed by the heat-transfer coefficients).
+    pub shifts: Vec<ParamShift>,
+}
+
+/// One calibrated parameter against its starting value.
+#[derive(Clone, Debug, Serialize)]
+pub struct ParamShift {
+    pub name: String,
+    pub start: f64,
+    pub calibrated: f64,
+    /// `calibrated / start`.
+    pub factor: f64,
+    /// `ln(factor)` in prior standard deviations (`None` without a prior).
+    pub prior_sd: Option<f64>,
 }
 
 /// One candidate effect in the ranking.
@@ -579,8 +594,14 @@ pub fn diagnose(
     }
     let after = assessed.first().and_then(|a| a.eval.clone());
     let ranking: Vec<RankEntry> = assessed.into_iter().map(|a| a.entry).collect();
-    let verdict = verdict::decide(&ranking, &nominal, opts.alpha, cands.len());
     let gap_before = gap_before(&ctx, &nominal, &stages, &localization);
+    let verdict = verdict::decide(
+        &ranking,
+        &nominal,
+        opts.alpha,
+        cands.len(),
+        &gap_before.shifts,
+    );
     Ok(Diagnosis {
         model: model.name().into(),
         n: model.n(),
@@ -620,15 +641,31 @@ fn gap_before(
             }
         })
         .collect();
-    let params = stages
+    let fitted: Vec<(&fit::driven::Var, f64)> = stages
         .iter()
         .flat_map(|st| st.stage.vars.iter())
         .filter_map(|v| match v.kind {
-            fit::driven::VarKind::Param(i) => Some((v.name.clone(), ctx.p_nom[i])),
+            fit::driven::VarKind::Param(i) => Some((v, ctx.p_nom[i])),
             _ => None,
         })
         .collect();
+    let params = fitted.iter().map(|(v, x)| (v.name.clone(), *x)).collect();
+    let shifts = fitted
+        .iter()
+        .filter(|(v, _)| v.initial != 0.0)
+        .map(|(v, x)| {
+            let factor = x / v.initial;
+            ParamShift {
+                name: v.name.clone(),
+                start: v.initial,
+                calibrated: *x,
+                factor,
+                prior_sd: v.prior.filter(|_| factor > 0.0).map(|s| factor.ln() / s),
+            }
+        })
+        .collect();
     GapBefore {
+        shifts,
         channels,
         holdout_error: nominal.holdout_error,
         train_error: nominal.train_error,

@@ -18,7 +18,7 @@ use nalgebra::DVector;
 use super::joint::{EffectVar, Joint};
 use super::score::{robust_score, Score};
 use super::{Context, EffectEstimate, Eval, RankEntry};
-use crate::effects::EffectInfo;
+use crate::effects::{EffectInfo, EffectTarget};
 use crate::fit::lm::{self, LmOptions};
 use crate::fit::FittedStage;
 
@@ -254,14 +254,17 @@ fn assess_inner(
     }
     let joint = Joint::new(ctx.model, nominal, s2, e, &shapes, !shapes.is_empty())?;
     // starts: from the nominal optimum at the one-step estimate; a strength with a shape (end
-    // stops) is not smooth in its strength, so also at fixed strengths; and the typical
-    // strength with the nominal parameters at their estimates (the effect's own basin when
-    // the calibration absorbed it: the score, a local test, cannot see that basin)
+    // stops) is not smooth in its strength, so also at fixed strengths; and for a model effect
+    // the typical strength with the nominal parameters at their estimates (the effect's own
+    // basin when the calibration absorbed it into them: the score, a local test, cannot see
+    // that basin; sensor effects rescale the data and are not absorbed that way)
     let mut starts: Vec<(Option<f64>, bool)> = vec![(None, false)];
     if !shapes.is_empty() {
         starts.extend([(Some(0.3), false), (Some(1.0), false)]);
     }
-    starts.push((Some(1.0), true));
+    if e.target == EffectTarget::Model {
+        starts.push((Some(1.0), true));
+    }
     let mut best: Option<(lm::LmResult, Vec<usize>)> = None;
     let mut last_err = String::new();
     for (s0, reset) in starts {
@@ -297,13 +300,31 @@ fn assess_inner(
     Ok(Some(ev))
 }
 
+/// Whether a fitted candidate moved a strength off its null (a fit that returns every
+/// strength to its null is the nominal model again and explains nothing).
+fn active(e: &RankEntry) -> bool {
+    let Some(info) = crate::effects::effect(&e.effect) else {
+        return true;
+    };
+    e.params.iter().any(|q| {
+        info.params
+            .iter()
+            .any(|p| p.name == q.name && p.null.is_some_and(|n| q.value != n))
+    })
+}
+
 /// Order: the promising candidates (score significant at `level`) by held-out BIC change,
-/// then the other fitted ones by held-out BIC change, then the rest by p-value.
+/// then the other fitted ones by held-out BIC change (those whose fit returned to the null
+/// after those that did not), then the rest by p-value.
 pub fn sort(entries: &mut [Assessed], level: f64) {
-    let class = |e: &RankEntry| match (e.p_value < level, e.delta_bic.is_some()) {
-        (true, true) => 0,
-        (false, true) => 1,
-        _ => 2,
+    let class = |e: &RankEntry| {
+        let fitted = e.delta_bic.is_some();
+        match (e.p_value < level, fitted && active(e), fitted) {
+            (true, true, _) => 0,
+            (false, true, _) => 1,
+            (_, false, true) => 2,
+            _ => 3,
+        }
     };
     entries.sort_by(|a, b| {
         let (a, b) = (&a.entry, &b.entry);

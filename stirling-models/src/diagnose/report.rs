@@ -223,6 +223,21 @@ pub fn write(d: &Diagnosis, data: &Measured, dir: &Path) -> Result<std::path::Pa
     }
     let _ = writeln!(
         s,
+        "\n| parameter | start | calibrated | factor | prior sd |\n|---|---|---|---|---|"
+    );
+    for p in &d.gap_before.shifts {
+        let _ = writeln!(
+            s,
+            "| {} | {:.4e} | {:.4e} | {:.3} | {} |",
+            p.name,
+            p.start,
+            p.calibrated,
+            p.factor,
+            p.prior_sd.map(|z| format!("{z:+.2}")).unwrap_or("-".into())
+        );
+    }
+    let _ = writeln!(
+        s,
         "\nSubsystems: mechanics {:.3}, gas {:.3} noise variances (dominant: {}).\n",
         loc.mechanics_error, loc.gas_error, loc.dominant_subsystem
     );

@@ -119,6 +119,16 @@ pub fn settings(name: &str, m: f64) -> Vec<String> {
     out
 }
 
+/// The rig's value of effect parameter `name`: from the settings, else the model default.
+fn truth_value(set: &[String], model: &dyn stirling_dsl::Model, p_nom: &[f64], name: &str) -> f64 {
+    set.iter()
+        .filter_map(|s| s.split_once('='))
+        .find(|(k, _)| *k == name)
+        .and_then(|(_, v)| v.parse().ok())
+        .or_else(|| model.param_index(name).map(|i| p_nom[i]))
+        .unwrap_or(f64::NAN)
+}
+
 /// Run the self-check.
 pub fn run(
     opts: &SelfCheckOptions,
@@ -209,10 +219,7 @@ pub fn run(
                 r.params
                     .iter()
                     .map(|q| {
-                        let tv = effect(truth)
-                            .and_then(|e| e.params.iter().find(|p| p.name == q.name))
-                            .map(|p| strength * base_strength(truth) * p.typical)
-                            .unwrap_or(f64::NAN);
+                        let tv = truth_value(&set, model.as_ref(), &p_nom, &q.name);
                         (q.name.clone(), tv, q.value, q.ci_low, q.ci_high)
                     })
                     .collect()

@@ -13,7 +13,7 @@
 
 use serde::Serialize;
 
-use super::{Eval, RankEntry};
+use super::{Eval, ParamShift, RankEntry};
 
 /// The lower closure bound a winner must clear.
 pub const MIN_CLOSURE: f64 = 0.2;
@@ -35,8 +35,45 @@ pub struct Verdict {
     pub reason: String,
 }
 
+/// Calibrated parameters further than this from their estimates (prior standard deviations)
+/// are named in the verdict.
+pub const SHIFT_NOTE_SD: f64 = 2.0;
+
+/// A note on parameters the calibration moved far: the gap may hide in them.
+fn shift_note(shifts: &[ParamShift], top: Option<&RankEntry>) -> String {
+    let far: Vec<String> = shifts
+        .iter()
+        .filter(|s| s.prior_sd.is_some_and(|z| z.abs() > SHIFT_NOTE_SD))
+        .map(|s| {
+            format!(
+                "{} x{:.2} ({:+.1} prior sd)",
+                s.name,
+                s.factor,
+                s.prior_sd.unwrap_or(f64::NAN)
+            )
+        })
+        .collect();
+    if far.is_empty() {
+        return String::new();
+    }
+    let lead = top
+        .filter(|t| t.fitted && t.delta_bic.is_some_and(|d| d < 0.0))
+        .map(|t| format!("; the leading candidate `{}` fits with them nearer their estimates", t.effect))
+        .unwrap_or_default();
+    format!(
+        "; but the calibration moved {} from the estimates: an omitted effect may be absorbed by them{lead}",
+        far.join(", ")
+    )
+}
+
 /// Decide from the ranking.
-pub fn decide(ranking: &[RankEntry], nominal: &Eval, alpha: f64, candidates: usize) -> Verdict {
+pub fn decide(
+    ranking: &[RankEntry],
+    nominal: &Eval,
+    alpha: f64,
+    candidates: usize,
+    shifts: &[ParamShift],
+) -> Verdict {
     let level = alpha / candidates.max(1) as f64;
     let significant: Vec<&RankEntry> = ranking.iter().filter(|r| r.p_value < level).collect();
     let better: Vec<&RankEntry> = ranking
@@ -62,7 +99,9 @@ pub fn decide(ranking: &[RankEntry], nominal: &Eval, alpha: f64, candidates: usi
         return mk("effect", Some(t), format!("`{}`: score p = {:.2e} < {:.1e}, held-out BIC change {:.1}, closure {:.2} [{:.2}, {:.2}]", t.effect, t.p_value, level, t.delta_bic.unwrap_or(f64::NAN), t.closure_fraction.unwrap_or(f64::NAN), t.ci_low.unwrap_or(f64::NAN), t.ci_high.unwrap_or(f64::NAN)));
     }
     if significant.is_empty() {
-        return mk("no_significant_gap", None, format!("no candidate is significant at {level:.1e} ({} lower the held-out BIC by more than {}; held-out error {:.3} noise variances)", better.len(), -STRONG_BIC, nominal.holdout_error));
+        let mut reason = format!("no candidate is significant at {level:.1e} ({} lower the held-out BIC by more than {}; held-out error {:.3} noise variances)", better.len(), -STRONG_BIC, nominal.holdout_error);
+        reason.push_str(&shift_note(shifts, top));
+        return mk("no_significant_gap", None, reason);
     }
     let r = top.filter(|t| t.fitted);
     mk("unexplained", r, format!("{} candidate(s) significant, {} lower the held-out BIC, but none closes more than {MIN_CLOSURE} of the gap with confidence", significant.len(), better.len()))
