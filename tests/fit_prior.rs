@@ -41,8 +41,8 @@ fn prior_derivatives_match_finite_differences() {
             let mut dn = u;
             up[row.var] += h;
             dn[row.var] -= h;
-            let fd = (prior_rows(&vars, &up)[row.var].r - prior_rows(&vars, &dn)[row.var].r)
-                / (2.0 * h);
+            let fd =
+                (prior_rows(&vars, &up)[row.var].r - prior_rows(&vars, &dn)[row.var].r) / (2.0 * h);
             assert!(
                 (fd - row.dr_du).abs() < 1e-6 * (1.0 + fd.abs()),
                 "var {}: fd {fd}, analytic {}",

@@ -58,7 +58,12 @@ fn shift_note(shifts: &[ParamShift], top: Option<&RankEntry>) -> String {
     }
     let lead = top
         .filter(|t| t.fitted && t.delta_bic.is_some_and(|d| d < 0.0))
-        .map(|t| format!("; the leading candidate `{}` fits with them nearer their estimates", t.effect))
+        .map(|t| {
+            format!(
+                "; the leading candidate `{}` fits with them nearer their estimates",
+                t.effect
+            )
+        })
         .unwrap_or_default();
     format!(
         "; but the calibration moved {} from the estimates: an omitted effect may be absorbed by them{lead}",
