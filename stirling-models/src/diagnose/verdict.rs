@@ -9,7 +9,9 @@
 //!   systematic deviation beyond the noise (output noise and the input noise driven through
 //!   the subsystems, see [`super::score`]). The held-out BIC alone does not count: on clean
 //!   data an added damping (friction) can lower the held-out error by damping the response to
-//!   input noise, which is not a gap of the model.
+//!   input noise, which is not a gap of the model. The reason names the parameters the
+//!   calibration moved by more than [`SHIFT_NOTE_SD`] prior standard deviations (a gap the
+//!   parameters absorbed) and the leading candidate that fits with them nearer their estimates.
 
 use serde::Serialize;
 
