@@ -265,6 +265,19 @@ pub struct FittedStage<'a> {
     pub keep: Vec<usize>,
 }
 
+/// The fit variables of the model parameters `free` (indices), scaled by their values.
+fn param_vars(model: &dyn Model, p: &[f64], free: &[usize], prior: Option<f64>) -> Vec<Var> {
+    free.iter()
+        .map(|&j| Var {
+            name: model.params()[j].name.into(),
+            initial: p[j],
+            scale: p[j].abs().max(1e-12),
+            kind: VarKind::Param(j),
+            prior,
+        })
+        .collect()
+}
+
 /// Fit a stage on the training indices, then report train and holdout fits.
 fn fit_stage(
     stage: &Stage,
@@ -527,16 +540,7 @@ pub fn identify_stages<'a>(
             sy.val[ta] - x_off[1],
             sy.der[ta],
         ];
-        let mut vars: Vec<Var> = mech
-            .iter()
-            .map(|&j| Var {
-                name: model.params()[j].name.into(),
-                initial: p[j],
-                scale: p[j].abs().max(1e-12),
-                kind: VarKind::Param(j),
-                prior: opts.prior,
-            })
-            .collect();
+        let mut vars = param_vars(model, &p, &mech, opts.prior);
         let names = ["x(0)", "v(0)", "y(0)", "w(0)"];
         for (k, nm) in names.iter().enumerate() {
             vars.push(Var {
@@ -684,16 +688,7 @@ pub fn identify_stages<'a>(
             .iter()
             .position(|&i| i == ps[0])
             .expect("pressure is a gas state");
-        let mut vars: Vec<Var> = gas
-            .iter()
-            .map(|&j| Var {
-                name: model.params()[j].name.into(),
-                initial: p[j],
-                scale: p[j].abs().max(1e-12),
-                kind: VarKind::Param(j),
-                prior: opts.prior,
-            })
-            .collect();
+        let mut vars = param_vars(model, &p, &gas, opts.prior);
         vars.push(Var {
             name: "p_offset".into(),
             initial: p_off0,
