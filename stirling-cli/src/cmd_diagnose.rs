@@ -41,7 +41,9 @@ pub struct DiagnoseArgs {
     /// Write report.md and SVG figures into this directory
     #[arg(long)]
     pub report: Option<PathBuf>,
-    /// Run the self-check (rig data with each effect withheld) instead of diagnosing a file
+    /// Run the self-check (rig data with each effect withheld) instead of diagnosing a file;
+    /// without MODEL, every effect of the library on the smallest model it applies to (cv1,
+    /// else nsection n = 2)
     #[arg(long)]
     pub self_check: bool,
     /// Self-check: record length (s)
@@ -95,10 +97,11 @@ pub fn run(a: &DiagnoseArgs) -> anyhow::Result<()> {
             ..Default::default()
         };
         let json = a.json;
-        let sc = selfcheck::run(&opts, |c| {
+        let progress = |c: &selfcheck::Case| {
             if !json {
                 eprintln!(
-                    "{:<16} x{:<4} -> {:<20} rank {:>4} closure {} [{}, {}]  {:>6.1} s  {}",
+                    "{:<12} {:<16} x{:<4} -> {:<20} rank {:>4} closure {} [{}, {}]  {:>6.1} s  {}",
+                    c.model,
                     c.truth,
                     c.strength,
                     c.verdict,
@@ -112,7 +115,13 @@ pub fn run(a: &DiagnoseArgs) -> anyhow::Result<()> {
                     if c.pass { "pass" } else { "FAIL" }
                 );
             }
-        })?;
+        };
+        // without a model: every effect of the library, each on the smallest model it fits
+        let sc = if a.model.is_some() {
+            selfcheck::run(&opts, progress)?
+        } else {
+            selfcheck::run_library(&opts, progress)?
+        };
         if json {
             println!("{}", serde_json::to_string_pretty(&sc)?);
         } else {
