@@ -301,6 +301,16 @@ pub fn run_library(
     mut progress: impl FnMut(&Case),
 ) -> Result<SelfCheck, DiagnoseError> {
     let clock = Instant::now();
+    if let Some(bad) = opts.effects.iter().flatten().find(|n| effect(n).is_none()) {
+        return Err(DiagnoseError::Bad(format!(
+            "unknown effect `{bad}` (the library: {})",
+            effects_for("nsection")
+                .iter()
+                .map(|e| e.name)
+                .collect::<Vec<_>>()
+                .join(", ")
+        )));
+    }
     let wanted = |name: &str| {
         opts.effects
             .as_ref()
@@ -318,7 +328,9 @@ pub fn run_library(
         .collect();
     let mut cases = Vec::new();
     for (model, n, names) in [("cv1", None, &on_cv1), ("nsection", Some(2), &on_nsection)] {
-        if names.is_empty() && model != "cv1" {
+        // a model without effects to check is skipped (cv1 keeps its clean case when
+        // nothing else runs)
+        if names.is_empty() && !(model == "cv1" && on_nsection.is_empty()) {
             continue;
         }
         let sub = SelfCheckOptions {
