@@ -172,3 +172,13 @@ fn withheld_quadratic_regenerator_friction_ranks_first_on_nsection() {
     );
     assert!(c.closure_fraction.is_some() && c.ci_low.is_some() && c.ci_high.is_some());
 }
+
+#[test]
+fn library_self_check_rejects_an_unknown_effect() {
+    let opts = SelfCheckOptions {
+        effects: Some(vec!["leak".into(), "bogus".into()]),
+        ..Default::default()
+    };
+    let err = selfcheck::run_library(&opts, log).unwrap_err().to_string();
+    assert!(err.contains("unknown effect `bogus`"), "{err}");
+}
