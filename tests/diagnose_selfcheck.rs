@@ -6,13 +6,14 @@
 use stirling::models::diagnose::selfcheck::{self, SelfCheckOptions};
 use stirling::models::diagnose::DiagnoseOptions;
 
+fn strings(v: &[&str]) -> Vec<String> {
+    v.iter().map(|s| s.to_string()).collect()
+}
+
 fn reduced(effects: &[&str], clean: bool) -> SelfCheckOptions {
-    let cands: Vec<String> = ["coulomb", "sensor_lag", "leak"]
-        .iter()
-        .map(|s| s.to_string())
-        .collect();
+    let cands = strings(&["coulomb", "sensor_lag", "leak"]);
     SelfCheckOptions {
-        effects: Some(effects.iter().map(|s| s.to_string()).collect()),
+        effects: Some(strings(effects)),
         strengths: vec![1.0],
         t_end: 0.6,
         rate: 1000.0,
@@ -26,6 +27,15 @@ fn reduced(effects: &[&str], clean: bool) -> SelfCheckOptions {
     }
 }
 
+fn assert_first(c: &selfcheck::Case) {
+    assert_eq!(
+        c.truth_rank,
+        Some(1),
+        "withheld effect not first (top {:?})",
+        c.top
+    );
+}
+
 fn log(c: &selfcheck::Case) {
     eprintln!(
         "{} -> {} (rank {:?}, closure {:?} [{:?}, {:?}], {:.1} s)",
@@ -37,12 +47,7 @@ fn log(c: &selfcheck::Case) {
 fn withheld_coulomb_friction_ranks_first_with_closure_interval() {
     let sc = selfcheck::run(&reduced(&["coulomb"], false), log).unwrap();
     let c = &sc.cases[0];
-    assert_eq!(
-        c.truth_rank,
-        Some(1),
-        "withheld effect not first (top {:?})",
-        c.top
-    );
+    assert_first(c);
     let (f, lo, hi) = (
         c.closure_fraction.unwrap(),
         c.ci_low.unwrap(),
@@ -84,12 +89,7 @@ fn clean_data_has_no_significant_gap() {
 fn withheld_sensor_lag_ranks_first() {
     let sc = selfcheck::run(&reduced(&["sensor_lag"], false), log).unwrap();
     let c = &sc.cases[0];
-    assert_eq!(
-        c.truth_rank,
-        Some(1),
-        "withheld effect not first (top {:?})",
-        c.top
-    );
+    assert_first(c);
     let (f, lo, hi) = (
         c.closure_fraction.unwrap(),
         c.ci_low.unwrap(),
@@ -109,12 +109,7 @@ fn withheld_leak_ranks_first_and_shows_in_the_parameter_shifts() {
     };
     let sc = selfcheck::run(&opts, log).unwrap();
     let c = &sc.cases[0];
-    assert_eq!(
-        c.truth_rank,
-        Some(1),
-        "withheld effect not first (top {:?})",
-        c.top
-    );
+    assert_first(c);
     let d = c.diagnosis.as_deref().unwrap();
     let far: Vec<_> = d
         .gap_before
@@ -139,10 +134,7 @@ fn withheld_leak_ranks_first_and_shows_in_the_parameter_shifts() {
 fn withheld_quadratic_regenerator_friction_ranks_first_on_nsection() {
     // nsection n = 2 (the effect needs a regenerator), 2 s at 1 kHz; the competitors are the
     // candidates that damp or rescale the displacer like it
-    let cands: Vec<String> = ["regen_quadratic", "sensor_gain", "coulomb"]
-        .iter()
-        .map(|s| s.to_string())
-        .collect();
+    let cands = strings(&["regen_quadratic", "sensor_gain", "coulomb"]);
     let opts = SelfCheckOptions {
         model: "nsection".into(),
         n: Some(2),
@@ -156,12 +148,7 @@ fn withheld_quadratic_regenerator_friction_ranks_first_on_nsection() {
     };
     let sc = selfcheck::run(&opts, log).unwrap();
     let c = &sc.cases[0];
-    assert_eq!(
-        c.truth_rank,
-        Some(1),
-        "withheld effect not first (top {:?})",
-        c.top
-    );
+    assert_first(c);
     let d = c.diagnosis.as_deref().unwrap();
     let entry = &d.ranking[0];
     assert!(entry.p_value < 0.01 / 3.0, "score p = {}", entry.p_value);
