@@ -128,6 +128,8 @@ pub mod fit;
 /// Linear analysis: equilibrium, poles, the loop broken at a pressure force, margins, locus.
 pub mod linear;
 pub mod registry;
+/// Which state of a model is what (positions, velocities, pressures, masses).
+pub mod layout;
 /// The virtual test rig: truth model plus effects, noise, offsets, sample rate.
 pub mod rig;
 /// Nonlinear simulation, limit cycles, Floquet multipliers and cycle work.

@@ -90,6 +90,43 @@ pub struct Var {
     pub prior: Option<f64>,
 }
 
+impl Var {
+    /// The variables of the model parameters `free` (indices), scaled by their values.
+    pub fn params(model: &dyn Model, p: &[f64], free: &[usize], prior: Option<f64>) -> Vec<Var> {
+        free.iter()
+            .map(|&j| Var {
+                name: model.params()[j].name.into(),
+                initial: p[j],
+                scale: p[j].abs().max(1e-12),
+                kind: VarKind::Param(j),
+                prior,
+            })
+            .collect()
+    }
+
+    /// The initial value of free state number `pos`.
+    pub fn initial(name: &str, initial: f64, scale: f64, pos: usize) -> Var {
+        Var {
+            name: name.into(),
+            initial,
+            scale,
+            kind: VarKind::Initial(pos),
+            prior: None,
+        }
+    }
+
+    /// An additive offset of output `out` that moves the prescribed inputs by `du`.
+    pub fn offset(name: &str, initial: f64, scale: f64, out: usize, du: Vec<f64>) -> Var {
+        Var {
+            name: name.into(),
+            initial,
+            scale,
+            kind: VarKind::Offset { out, du },
+            prior: None,
+        }
+    }
+}
+
 /// What a fit variable is.
 #[derive(Clone, Debug)]
 pub enum VarKind {
@@ -136,6 +173,18 @@ pub struct Output {
     pub pos: usize,
     pub data: Vec<f64>,
     pub sigma: f64,
+}
+
+impl Output {
+    /// Output `channel` at free state `pos`, its noise estimated from `data` (at least `floor`).
+    pub fn new(channel: &str, pos: usize, data: &[f64], floor: f64) -> Output {
+        Output {
+            channel: channel.into(),
+            pos,
+            data: data.to_vec(),
+            sigma: noise_sigma(data).max(floor),
+        }
+    }
 }
 
 /// A driven-subsystem fitting problem on a uniform record.
@@ -523,6 +572,27 @@ impl Stage<'_> {
         Ok(Some(acc / drs.len() as f64))
     }
 
+    /// Weighted residuals on the sample indices `keep` (within `first..=last`), drift
+    /// projected, without the prior rows and without sensitivities.
+    pub fn weighted_residuals(
+        &self,
+        u: &[f64],
+        first: usize,
+        last: usize,
+        keep: &[usize],
+    ) -> Result<Vec<f64>, FitError> {
+        let run = self.run(u, first, last, false)?;
+        let mut r = Vec::with_capacity(keep.len() * self.outputs.len());
+        for (o, out) in self.outputs.iter().enumerate() {
+            let start = r.len();
+            r.extend(keep.iter().map(|&i| (run.yhat[o][i - first] - out.data[i]) / out.sigma));
+            if self.drift > 0 {
+                project_drift(&mut r[start..], self.drift);
+            }
+        }
+        Ok(r)
+    }
+
     /// Weighted residuals and Jacobian on the sample indices `keep` (within `first..=last`):
     /// every output's samples in turn, then the prior rows ([`super::prior`]).
     pub fn residuals(
@@ -570,7 +640,7 @@ impl Stage<'_> {
 }
 
 /// Central-difference derivative of uniform samples (one-sided at the ends).
-fn derivative(y: &[f64], dt: f64) -> Vec<f64> {
+pub fn derivative(y: &[f64], dt: f64) -> Vec<f64> {
     let n = y.len();
     (0..n)
         .map(|i| {

@@ -57,6 +57,17 @@ pub struct Given {
     pub constant: f64,
 }
 
+impl Given {
+    /// State `state` read from one signal's value (or derivative) plus a constant.
+    pub fn signal(state: usize, signal: usize, derivative: bool, constant: f64) -> Given {
+        Given {
+            state,
+            terms: vec![(signal, 1.0, derivative)],
+            constant,
+        }
+    }
+}
+
 /// One sensitivity column.
 #[derive(Clone, Debug)]
 pub enum Column {

@@ -1,0 +1,157 @@
+//! Stage 2: the gas driven by the measured displacements.
+//!
+//! The body states are prescribed from the measured positions (offsets removed) and their
+//! smoothed derivatives; fitted: the free gas parameters and the pressure offsets. A pressure
+//! offset moves the position offsets stage 1 found by the static response
+//! `-J_qq^-1 J_qP off` ([`super::driven::static_shift`]), so the prescribed positions depend
+//! on it and its sensitivity column carries that input term.
+
+use stirling_dsl::Model;
+
+use super::driven::{cold_weight, noise_sigma, static_shift, Output, Stage, Var};
+use super::record::Record;
+use super::sensitivity::Given;
+use super::{FitError, FitOptions};
+use crate::layout::StateLayout;
+
+/// Stage 2 with the bookkeeping that turns its pressure offsets back into position offsets.
+pub struct GasStage<'a> {
+    pub stage: Stage<'a>,
+    /// Static position shift per unit offset of `p` (`[0]`) and `p_hot` (`[1]`), `[x, y]`.
+    pub shift: [Vec<f64>; 2],
+    /// The shift that the pressure offsets used in stage 1 caused, `[x, y]`.
+    pub used: [f64; 2],
+    /// Samples skipped at the window start while the gas forgets its initial state.
+    pub burn: usize,
+}
+
+impl GasStage<'_> {
+    /// Position offsets seen by the free model after stage 2 found offsets `p_off`, `ph_off`.
+    pub fn position_offsets(&self, x_off: [f64; 2], p_off: f64, ph_off: f64) -> [f64; 2] {
+        let s = &self.shift;
+        [0, 1].map(|k| x_off[k] + s[0][k] * p_off + s[1][k] * ph_off - self.used[k])
+    }
+}
+
+/// Build stage 2 at parameters `p` (free gas parameters `free`), with the position offsets
+/// `x_off` stage 1 found under the pressure offsets `rec.p_off0`, `rec.ph_off0`.
+pub fn stage<'a>(
+    model: &'a dyn Model,
+    layout: &StateLayout,
+    rec: &Record,
+    p: &[f64],
+    free: &[usize],
+    x_off: [f64; 2],
+    opts: &FitOptions,
+) -> Result<GasStage<'a>, FitError> {
+    let data = rec.data;
+    let (Some(xm), Some(ym), Some(pm)) = (data.x.as_ref(), data.y.as_ref(), data.p.as_ref())
+    else {
+        return Err(FitError::MissingColumns {
+            file: data.source.clone(),
+            stage: "stage 2 (gas)",
+        });
+    };
+    let have_hot = rec.have_hot;
+    let (p_off0, ph_off0) = (rec.p_off0, rec.ph_off0);
+    let mut eq = vec![0.0; model.n_states()];
+    model.equilibrium_guess(p, &mut eq);
+    let shift = static_shift(model, p, have_hot)?;
+    let (sx, sy) = rec.positions().expect("checked");
+    let used = [0, 1].map(|k| shift[0][k] * p_off0 + shift[1][k] * ph_off0);
+    let (pos, vel) = (&layout.positions, &layout.velocities);
+    let given = vec![
+        Given::signal(pos[0], 0, false, -x_off[0] + used[0]),
+        Given::signal(vel[0], 0, true, 0.0),
+        Given::signal(pos[1], 1, false, -x_off[1] + used[1]),
+        Given::signal(vel[1], 1, true, 0.0),
+    ];
+    let du = |ch: usize| vec![-shift[ch][0], 0.0, -shift[ch][1], 0.0];
+    let ps = &layout.pressures;
+    let pmean = ps.first().map(|&i| eq[i]).unwrap_or(0.0);
+    let cold_pos = layout.gas_pos(*ps.last().expect("CVs")).expect("gas state");
+    let hot_pos = layout.gas_pos(ps[0]).expect("gas state");
+    let mut vars = Var::params(model, p, free, opts.prior);
+    vars.push(Var::offset("p_offset", p_off0, 100.0, 0, du(0)));
+    let mut outputs = vec![Output::new("p", cold_pos, pm, 1e-6 * pmean)];
+    if have_hot {
+        let ph = data.p_hot.as_ref().expect("have_hot");
+        vars.push(Var::offset("p_hot_offset", ph_off0, 100.0, 1, du(1)));
+        outputs.push(Output::new("p_hot", hot_pos, ph, 1e-6 * pmean));
+    }
+    let x_start = initial_state(model, layout, rec, p, &eq, x_off);
+    let z0: Vec<f64> = layout.gas.iter().map(|&i| x_start[i]).collect();
+    let (tr, dt) = (rec.tr, rec.dt);
+    let burn = ((opts.burn_in / dt).round() as usize).min(tr.1 - tr.0 - 5);
+    let stage = Stage {
+        drift: 0,
+        input_noise: vec![(0, noise_sigma(xm), rec.h), (1, noise_sigma(ym), rec.h)],
+        name: "stage 2 (gas driven by measured displacements)",
+        model,
+        p: p.to_vec(),
+        base: eq,
+        free: layout.gas.clone(),
+        given,
+        signals: vec![sx, sy],
+        z0,
+        vars,
+        outputs,
+        t0: rec.t0,
+        dt,
+        sim: opts.sim,
+    };
+    Ok(GasStage {
+        stage,
+        shift,
+        used,
+        burn,
+    })
+}
+
+/// The initial gas state at the window start: measured pressures, masses sharing the
+/// model's inventory in proportion to `P V / T_rest`.
+fn initial_state(
+    model: &dyn Model,
+    layout: &StateLayout,
+    rec: &Record,
+    p: &[f64],
+    eq: &[f64],
+    x_off: [f64; 2],
+) -> Vec<f64> {
+    let (sx, sy) = rec.positions().expect("checked");
+    let sp = rec.sig_p.as_ref().expect("checked");
+    let mut x = eq.to_vec();
+    let ta = rec.tr.0;
+    let (pos, vel) = (&layout.positions, &layout.velocities);
+    x[pos[0]] = sx.val[ta] - x_off[0];
+    x[vel[0]] = sx.der[ta];
+    x[pos[1]] = sy.val[ta] - x_off[1];
+    x[vel[1]] = sy.der[ta];
+    let ps = &layout.pressures;
+    let ncv = ps.len();
+    let mut t_rest = vec![0.0; ncv];
+    model.temperatures(p, eq, &mut t_rest);
+    let hot = rec
+        .sig_ph
+        .as_ref()
+        .filter(|_| rec.have_hot)
+        .map(|s| s.val[ta] - rec.ph_off0)
+        .unwrap_or(0.0);
+    for (i, &s) in ps.iter().enumerate() {
+        let wc = cold_weight(i, ncv, rec.have_hot);
+        x[s] = wc * (sp.val[ta] - rec.p_off0) + (1.0 - wc) * hot;
+    }
+    let masses = &layout.masses;
+    if !masses.is_empty() {
+        let nv = model.vessel_names().len();
+        let (mut pr, mut vol) = (vec![0.0; nv], vec![0.0; nv]);
+        model.pv(p, &x, &mut pr, &mut vol);
+        let total: f64 = masses.iter().map(|&i| eq[i]).sum();
+        let share: Vec<f64> = (0..ncv).map(|i| x[ps[i]] * vol[i] / t_rest[i]).collect();
+        let ssum: f64 = share.iter().sum();
+        for (k, &mi) in masses.iter().enumerate() {
+            x[mi] = total * share[k] / ssum;
+        }
+    }
+    x
+}

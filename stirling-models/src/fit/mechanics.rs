@@ -1,0 +1,142 @@
+//! Stage 1: the mechanics (both bodies) driven by the pressures on their faces.
+//!
+//! Every CV pressure the bodies feel is prescribed: the cold side from the measured `p`, the
+//! hot side from `p_hot` when it is measured (sections in between interpolated linearly), and
+//! otherwise from the measured `p` plus the pressure differences `P_i - P_cold` that the gas
+//! stage computes from the measured positions ([`super::unmeasured`]). Fitted: the free
+//! mechanical parameters, the initial body states and the position offsets (which also
+//! absorb the static shift of a pressure offset).
+
+use stirling_dsl::Model;
+
+use super::driven::{cold_weight, cycle_frequency, drift_count, noise_sigma, Output, Stage, Var};
+use super::record::Record;
+use super::sensitivity::{Given, Signal};
+use super::{FitError, FitOptions};
+use crate::layout::StateLayout;
+
+/// What stage 1 is built from besides the record.
+pub struct MechInputs<'s> {
+    /// Current parameters and the free mechanical ones (indices).
+    pub p: &'s [f64],
+    pub free: &'s [usize],
+    /// Position offsets to start from.
+    pub x_off: [f64; 2],
+    /// Pressure offsets subtracted from the measured `p` and `p_hot`.
+    pub p_off: f64,
+    pub ph_off: f64,
+    /// Model pressure differences `P_i - P_cold`, one per CV (in [`StateLayout::pressures`]
+    /// order), when the hot side is not measured; `None`: prescribe from the measurements.
+    pub dp: Option<&'s [Signal]>,
+}
+
+/// Build stage 1.
+pub fn stage<'a>(
+    model: &'a dyn Model,
+    layout: &StateLayout,
+    rec: &Record,
+    inp: &MechInputs,
+    opts: &FitOptions,
+) -> Result<Stage<'a>, FitError> {
+    let data = rec.data;
+    let (Some(xm), Some(ym), Some(sp)) = (data.x.as_ref(), data.y.as_ref(), rec.sig_p.as_ref())
+    else {
+        return Err(FitError::MissingColumns {
+            file: data.source.clone(),
+            stage: "stage 1 (mechanics)",
+        });
+    };
+    if layout.positions.len() != 2 {
+        return Err(FitError::Bodies {
+            model: model.name().into(),
+            found: layout.positions.len(),
+        });
+    }
+    let have_hot = rec.have_hot;
+    let mut signals = vec![sp.clone()];
+    if have_hot {
+        signals.push(rec.sig_ph.clone().expect("have_hot"));
+    }
+    let ps = &layout.pressures;
+    let given: Vec<Given> = match inp.dp {
+        Some(dp) => {
+            let cold = ps.len() - 1;
+            ps.iter()
+                .enumerate()
+                .map(|(i, &s)| {
+                    let mut terms = vec![(0, 1.0, false)];
+                    if i != cold {
+                        terms.push((signals.len(), 1.0, false));
+                        signals.push(dp[i].clone());
+                    }
+                    Given {
+                        state: s,
+                        terms,
+                        constant: -inp.p_off,
+                    }
+                })
+                .collect()
+        }
+        None => ps
+            .iter()
+            .enumerate()
+            .map(|(i, &s)| {
+                let wc = cold_weight(i, ps.len(), have_hot);
+                let mut terms = vec![(0, wc, false)];
+                if have_hot {
+                    terms.push((1, 1.0 - wc, false));
+                }
+                let hot = if have_hot { (1.0 - wc) * inp.ph_off } else { 0.0 };
+                Given {
+                    state: s,
+                    terms,
+                    constant: -wc * inp.p_off - hot,
+                }
+            })
+            .collect(),
+    };
+    let (sx, sy) = rec.positions().expect("checked");
+    let ta = rec.tr.0;
+    let x_off = inp.x_off;
+    let z0 = vec![
+        sx.val[ta] - x_off[0],
+        sx.der[ta],
+        sy.val[ta] - x_off[1],
+        sy.der[ta],
+    ];
+    let mut vars = Var::params(model, inp.p, inp.free, opts.prior);
+    for (k, nm) in ["x(0)", "v(0)", "y(0)", "w(0)"].iter().enumerate() {
+        vars.push(Var::initial(nm, z0[k], if k % 2 == 0 { 1e-3 } else { 0.05 }, k));
+    }
+    vars.push(Var::offset("x_offset", x_off[0], 1e-3, 0, vec![]));
+    vars.push(Var::offset("y_offset", x_off[1], 1e-3, 1, vec![]));
+    let outputs = vec![Output::new("x", 0, xm, 1e-9), Output::new("y", 2, ym, 1e-9)];
+    let (tr, dt) = (rec.tr, rec.dt);
+    let f0 = cycle_frequency(&ym[tr.0..=tr.1], dt)
+        .or_else(|| cycle_frequency(&xm[tr.0..=tr.1], dt))
+        .unwrap_or(0.0);
+    let hp = (rec.h / 2).max(3);
+    let mut input_noise = vec![(0, noise_sigma(data.p.as_ref().expect("checked")), hp)];
+    if let Some(v) = data.p_hot.as_ref().filter(|_| have_hot) {
+        input_noise.push((1, noise_sigma(v), hp));
+    }
+    let mut base = vec![0.0; model.n_states()];
+    model.equilibrium_guess(inp.p, &mut base);
+    Ok(Stage {
+        drift: drift_count(tr.1 - tr.0 + 1, dt, opts.drift_cut * f0),
+        input_noise,
+        name: "stage 1 (mechanics driven by measured pressure)",
+        model,
+        p: inp.p.to_vec(),
+        base,
+        free: layout.bodies.clone(),
+        given,
+        signals,
+        z0,
+        vars,
+        outputs,
+        t0: rec.t0,
+        dt,
+        sim: opts.sim,
+    })
+}

@@ -1,0 +1,136 @@
+//! The measured record as the stages see it: the uniform time grid, the training and
+//! held-out windows as sample indices, the smoothed signals and the first guesses of the
+//! sensor offsets.
+
+use stirling_dsl::Model;
+
+use super::driven::savitzky_golay;
+use super::sensitivity::Signal;
+use super::{FitError, FitOptions};
+use crate::data::{cycle_mean, Measured};
+use crate::layout::StateLayout;
+
+/// A record prepared for the two stages.
+pub struct Record<'a> {
+    pub data: &'a Measured,
+    pub t0: f64,
+    pub dt: f64,
+    /// Savitzky-Golay half-width for the positions (samples); pressures use half of it.
+    pub h: usize,
+    /// Training block (s) and its inclusive sample indices.
+    pub train: (f64, f64),
+    pub tr: (usize, usize),
+    /// Held-out block (s) and its sample indices.
+    pub holdout: Option<(f64, f64)>,
+    pub ho: Option<(usize, usize)>,
+    /// Whether the hot-side pressure is measured (and the model has more than one CV).
+    pub have_hot: bool,
+    /// Smoothed pressure signals.
+    pub sig_p: Option<Signal>,
+    pub sig_ph: Option<Signal>,
+    /// Whole-cycle means of the positions (first position offsets) and of the pressures
+    /// minus the charge pressure (first pressure offsets).
+    pub x_off0: [f64; 2],
+    pub p_off0: f64,
+    pub ph_off0: f64,
+}
+
+impl<'a> Record<'a> {
+    /// Check the sampling, place the windows and smooth the signals.
+    pub fn new(
+        model: &dyn Model,
+        layout: &StateLayout,
+        p: &[f64],
+        data: &'a Measured,
+        opts: &FitOptions,
+    ) -> Result<Self, FitError> {
+        let (t0, dt) = uniform(data)?;
+        let nt = data.t.len();
+        let idx = |t: f64| (((t - t0) / dt).round().max(0.0) as usize).min(nt - 1);
+        let t_last = data.t[nt - 1];
+        let train = opts.train.unwrap_or((t0, t0 + 0.7 * (t_last - t0)));
+        let holdout = match (opts.holdout, opts.train) {
+            (Some(h), _) => Some(h),
+            (None, None) => Some((train.1, t_last)),
+            (None, Some(_)) => None,
+        };
+        let tr = (idx(train.0), idx(train.1));
+        if tr.1 < tr.0 + 10 {
+            return Err(FitError::ShortTraining {
+                from: train.0,
+                to: train.1,
+                samples: tr.1.saturating_sub(tr.0) + 1,
+            });
+        }
+        let h = ((opts.smooth / dt).round() as usize).max(3);
+        let ps = &layout.pressures;
+        let have_hot = data.p_hot.is_some() && ps.len() > 1;
+        let mut eq = vec![0.0; model.n_states()];
+        model.equilibrium_guess(p, &mut eq);
+        let pmean = ps.first().map(|&i| eq[i]).unwrap_or(0.0);
+        let mean_of = |v: Option<&Vec<f64>>, base: f64| v.map(|v| cycle_mean(v) - base);
+        let smooth = |v: &Vec<f64>| signal(t0, dt, v, (h / 2).max(3));
+        Ok(Self {
+            data,
+            t0,
+            dt,
+            h,
+            train,
+            tr,
+            holdout,
+            ho: holdout.map(|h| (idx(h.0), idx(h.1))),
+            have_hot,
+            sig_p: data.p.as_ref().map(smooth),
+            sig_ph: data.p_hot.as_ref().map(smooth),
+            x_off0: [
+                mean_of(data.x.as_ref(), 0.0).unwrap_or(0.0),
+                mean_of(data.y.as_ref(), 0.0).unwrap_or(0.0),
+            ],
+            p_off0: mean_of(data.p.as_ref(), pmean).unwrap_or(0.0),
+            ph_off0: mean_of(data.p_hot.as_ref(), pmean).unwrap_or(0.0),
+        })
+    }
+
+    /// The smoothed position signals `x`, `y` (value and derivative).
+    pub fn positions(&self) -> Option<(Signal, Signal)> {
+        let (x, y) = (self.data.x.as_ref()?, self.data.y.as_ref()?);
+        Some((
+            signal(self.t0, self.dt, x, self.h),
+            signal(self.t0, self.dt, y, self.h),
+        ))
+    }
+
+    /// The last sample index any block uses.
+    pub fn end(&self) -> usize {
+        self.ho.map_or(self.tr.1, |h| h.1.max(self.tr.1))
+    }
+}
+
+/// The start time and the interval of a uniformly sampled record.
+fn uniform(data: &Measured) -> Result<(f64, f64), FitError> {
+    if data.t.len() < 20 {
+        return Err(FitError::TooFewSamples {
+            file: data.source.clone(),
+            samples: data.t.len(),
+        });
+    }
+    let dt = data.dt();
+    for k in 1..data.t.len() {
+        let d = data.t[k] - data.t[k - 1];
+        if (d - dt).abs() > 1e-3 * dt {
+            return Err(FitError::NonUniform {
+                file: data.source.clone(),
+                t: data.t[k],
+                interval: d,
+                mean: dt,
+            });
+        }
+    }
+    Ok((data.t[0], dt))
+}
+
+/// A smoothed signal (quartic Savitzky-Golay of half-width `h`).
+pub fn signal(t0: f64, dt: f64, y: &[f64], h: usize) -> Signal {
+    let (val, der) = savitzky_golay(y, dt, h, 4);
+    Signal { t0, dt, val, der }
+}

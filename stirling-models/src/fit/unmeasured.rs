@@ -1,0 +1,131 @@
+//! Pressures the mechanics need but the record lacks (the seed's engine measured only the
+//! cold-side `p`): the gas stage, driven by the measured positions, computes every CV's
+//! pressure; its differences to the cold side, `P_i - P_cold`, join the measured `p` as the
+//! prescribed pressures of stage 1 (see [`super::mechanics`]).
+//!
+//! Why this route: the regenerator pressure drop is set almost entirely by the flow, which
+//! the measured positions fix, so the gas stage predicts it well without any mechanical
+//! parameter; stage 1 then sees the force `A (P_hot - P_cold)` on the displacer instead of
+//! turning it into damping. The estimate depends on the gas parameters, so stage 1's
+//! covariance gets the part carried in from stage 2 (the two-step estimator's correction of
+//! Murphy and Topel): `G C_2 G^T` with `G = -(J_1^T J_1)^-1 J_1^T dr_1/du_2`, the columns
+//! `dr_1/du_2` by central differences of whole runs.
+
+use nalgebra::{DMatrix, DVector};
+
+use super::driven::{Output, Stage, VarKind};
+use super::record::Record;
+use super::report::FitStats;
+use super::sensitivity::Signal;
+use super::FitError;
+use crate::layout::StateLayout;
+
+/// Step of the scaled stage-2 variables for the carried covariance.
+const DU: f64 = 0.01;
+
+/// `P_i - P_cold` of the gas stage at its variables `u`, one signal per CV (the cold one is
+/// zero), over the whole record (held at the first value before the training start).
+pub fn pressure_differences(
+    gas: &Stage,
+    u: &[f64],
+    layout: &StateLayout,
+    rec: &Record,
+) -> Result<Vec<Signal>, FitError> {
+    let mut st = gas.clone();
+    st.outputs = layout
+        .pressures
+        .iter()
+        .map(|&s| Output {
+            channel: String::new(),
+            pos: layout.gas_pos(s).expect("gas state"),
+            data: Vec::new(),
+            sigma: 1.0,
+        })
+        .collect();
+    // offsets still move the prescribed positions, but no output carries them
+    for v in &mut st.vars {
+        if let VarKind::Offset { out, .. } = &mut v.kind {
+            *out = usize::MAX;
+        }
+    }
+    let (first, last) = (rec.tr.0, rec.data.t.len() - 1);
+    let run = st.run(u, first, last, false)?;
+    let cold = run.yhat.len() - 1;
+    let signals = (0..run.yhat.len())
+        .map(|i| {
+            let mut val = vec![0.0; last + 1];
+            for (k, v) in val.iter_mut().enumerate() {
+                let j = k.saturating_sub(first);
+                *v = run.yhat[i][j] - run.yhat[cold][j];
+            }
+            let der = super::driven::derivative(&val, rec.dt);
+            Signal {
+                t0: rec.t0,
+                dt: rec.dt,
+                val,
+                der,
+            }
+        })
+        .collect();
+    Ok(signals)
+}
+
+/// Covariance of stage 1's scaled variables carried in from stage 2's: stage 1 (`mech`, at
+/// its optimum `u1` with Jacobian `j1`) reads the pressure differences of stage 2 (`gas` at
+/// `u2`, statistics `stats2`) through its signals `1..`.
+pub fn carried_covariance(
+    mech: &Stage,
+    u1: &[f64],
+    j1: &DMatrix<f64>,
+    keep: &[usize],
+    gas: &Stage,
+    u2: &[f64],
+    stats2: &FitStats,
+    layout: &StateLayout,
+    rec: &Record,
+) -> Result<Option<DMatrix<f64>>, FitError> {
+    let jtj = j1.transpose() * j1;
+    let Some(inv) = jtj.try_inverse() else {
+        return Ok(None);
+    };
+    let (first, last) = (keep[0].min(rec.tr.0), rec.tr.1);
+    let residuals_at = |u2: &[f64]| -> Result<Vec<f64>, FitError> {
+        let dp = pressure_differences(gas, u2, layout, rec)?;
+        let mut st = mech.clone();
+        let cold = dp.len() - 1;
+        st.signals.truncate(1);
+        st.signals.extend(dp.into_iter().take(cold));
+        let mut r = st.weighted_residuals(u1, first, last, keep)?;
+        r.resize(j1.nrows(), 0.0);
+        Ok(r)
+    };
+    let nv2 = u2.len();
+    let mut g = DMatrix::zeros(u1.len(), nv2);
+    for k in 0..nv2 {
+        let (mut ua, mut ub) = (u2.to_vec(), u2.to_vec());
+        ua[k] -= DU;
+        ub[k] += DU;
+        let (ra, rb) = (residuals_at(&ua)?, residuals_at(&ub)?);
+        let d = DVector::from_iterator(ra.len(), ra.iter().zip(&rb).map(|(a, b)| (b - a) / (2.0 * DU)));
+        let col = -(&inv * (j1.transpose() * d));
+        g.set_column(k, &col);
+    }
+    let c2 = scaled_covariance(stats2, &gas.vars.iter().map(|v| v.scale).collect::<Vec<_>>());
+    Ok(Some(&g * c2 * g.transpose()))
+}
+
+/// The covariance of the scaled variables from reported standard errors and correlations.
+fn scaled_covariance(stats: &FitStats, scale: &[f64]) -> DMatrix<f64> {
+    let k = stats.estimates.len();
+    let se: Vec<f64> = stats
+        .estimates
+        .iter()
+        .zip(scale)
+        .map(|(e, s)| e.std_error / s.abs().max(1e-300))
+        .collect();
+    DMatrix::from_fn(k, k, |a, b| {
+        let c = stats.correlation[a][b];
+        let c = if c.is_finite() { c } else { f64::from(u8::from(a == b)) };
+        c * se[a] * se[b]
+    })
+}
