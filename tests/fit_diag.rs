@@ -129,6 +129,7 @@ fn diag_ns_clean() {
 fn timing_nsection2_3s() {
     let cfg = RigConfig {
         model: "nsection".into(),
+        channels: ["p", "p_hot", "x", "y"].map(String::from).to_vec(),
         n: Some(2),
         set: [
             "kd=680", "kp=58", "bd=0.55", "bp=8.4", "hh=560", "hk=450", "Rf=1.3e5",

@@ -218,6 +218,7 @@ fn cv1_free_run_and_multiple_shooting() {
 fn nsection_free_run_at_truth() {
     let cfg = RigConfig {
         model: "nsection".into(),
+        channels: ["p", "p_hot", "x", "y"].map(String::from).to_vec(),
         n: Some(2),
         t_end: 0.4,
         settle: 0.4,

@@ -11,6 +11,7 @@ fn nsection2_two_stage_recovers_perturbed_parameters() {
     ];
     let cfg = RigConfig {
         model: "nsection".into(),
+        channels: ["p", "p_hot", "x", "y"].map(String::from).to_vec(),
         n: Some(2),
         set: truth.iter().map(|s| s.to_string()).collect(),
         t_end: 0.8,

@@ -61,6 +61,7 @@ fn rig_writes_csv_and_truth_and_is_reproducible() {
 fn nsection_rig_has_hot_pressure() {
     let cfg = RigConfig {
         model: "nsection".into(),
+        channels: ["p", "p_hot", "x", "y"].map(String::from).to_vec(),
         n: Some(2),
         t_end: 0.05,
         effects: vec!["regen_quadratic=1e9".into()],
@@ -69,4 +70,95 @@ fn nsection_rig_has_hot_pressure() {
     let out = rig::run(&cfg).unwrap();
     assert_eq!(out.data.channels(), vec!["p", "p_hot", "x", "y"]);
     assert_eq!(out.truth.model, "nsection_fx");
+}
+
+#[test]
+fn rig_writes_the_seeds_sensor_set_by_default() {
+    let cfg = RigConfig {
+        model: "nsection".into(),
+        n: Some(2),
+        t_end: 0.02,
+        ..Default::default()
+    };
+    let out = rig::run(&cfg).unwrap();
+    assert_eq!(out.data.channels(), vec!["p", "x", "y"]);
+    assert!(!out.truth.offsets.contains_key("p_hot"));
+}
+
+#[test]
+fn rig_refuses_nonphysical_truths() {
+    let base = RigConfig {
+        model: "cv1".into(),
+        t_end: 0.02,
+        ..Default::default()
+    };
+    let cases: Vec<(RigConfig, &str)> = vec![
+        (
+            RigConfig {
+                effects: vec!["coulomb=-0.3".into()],
+                ..base.clone()
+            },
+            "`Fcd` = -0.3 is not physical",
+        ),
+        (
+            RigConfig {
+                effects: vec!["leak=-1e-8".into()],
+                ..base.clone()
+            },
+            "`Gleak` = -0.00000001 is not physical",
+        ),
+        (
+            RigConfig {
+                effects: vec!["xmax=-0.01".into()],
+                ..base.clone()
+            },
+            "must be > 0",
+        ),
+        (
+            RigConfig {
+                effects: vec!["gain_x=-2".into()],
+                ..base.clone()
+            },
+            "between -0.5 and 0.5",
+        ),
+        (
+            RigConfig {
+                effects: vec!["sensor_lag=-0.001".into()],
+                ..base.clone()
+            },
+            "`tau_p`",
+        ),
+        (
+            RigConfig {
+                rate: 1.0,
+                ..base.clone()
+            },
+            "--rate must be between",
+        ),
+        (
+            RigConfig {
+                noise_p: 1e5,
+                ..base.clone()
+            },
+            "pressure would go negative",
+        ),
+        (
+            RigConfig {
+                channels: vec!["p_hot".into()],
+                ..base.clone()
+            },
+            "single gas volume",
+        ),
+        (
+            RigConfig {
+                channels: vec!["q".into()],
+                ..base.clone()
+            },
+            "unknown channel `q`",
+        ),
+    ];
+    for (cfg, want) in cases {
+        let e = rig::run(&cfg).unwrap_err().to_string();
+        assert!(e.contains(want), "expected `{want}` in: {e}");
+    }
 }

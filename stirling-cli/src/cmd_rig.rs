@@ -50,6 +50,10 @@ pub struct RigArgs {
     /// Noise seed
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
+    /// Channels to write besides t: the seed's sensors p (cold side), x, y by default; add
+    /// p_hot (hot-side pressure, multi-CV models) for a richer rig than the seed's engine had
+    #[arg(long, value_delimiter = ',', default_value = "p,x,y")]
+    pub channels: Vec<String>,
     /// Output CSV (the truth goes to FILE.truth.json)
     #[arg(long)]
     pub out: PathBuf,
@@ -77,6 +81,7 @@ pub fn run(a: &RigArgs) -> anyhow::Result<()> {
         offset_y: a.offset_y,
         x0: a.x0,
         seed: a.seed,
+        channels: a.channels.clone(),
     };
     // refuse before the (long) simulation
     for f in [a.out.clone(), rig::sidecar_path(&a.out)] {

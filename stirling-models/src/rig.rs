@@ -42,6 +42,9 @@ pub struct RigConfig {
     /// Initial displacement of the displacer from rest (m).
     pub x0: f64,
     pub seed: u64,
+    /// Channels written besides `t` (default: the seed's sensors `p`, `x`, `y`; `p_hot` on
+    /// request for multi-CV models).
+    pub channels: Vec<String>,
 }
 
 impl Default for RigConfig {
@@ -61,6 +64,7 @@ impl Default for RigConfig {
             offset_y: 0.0,
             x0: 2e-3,
             seed: 1,
+            channels: vec!["p".into(), "x".into(), "y".into()],
         }
     }
 }
@@ -154,17 +158,69 @@ pub fn first_order_lag(u: &[f64], dt: f64, tau: f64) -> Vec<f64> {
     y
 }
 
-/// Run the rig.
-pub fn run(cfg: &RigConfig) -> Result<RigOutput, RigError> {
-    if !(cfg.t_end > 0.0 && cfg.rate > 0.0 && cfg.settle >= 0.0) {
-        return Err(RigError::Bad(format!(
-            "need --t-end > 0, --rate > 0, --settle >= 0 (got {}, {}, {})",
-            cfg.t_end, cfg.rate, cfg.settle
-        )));
+/// Lowest sample rate the rig accepts (Hz): the family runs near 13 Hz, and the fit's
+/// smoothing derivatives need several samples per millisecond-scale feature.
+pub const MIN_RATE: f64 = 200.0;
+
+/// Check the settings before the (long) simulation.
+fn validate(cfg: &RigConfig) -> Result<(), RigError> {
+    let bad = |what: String| Err(RigError::Bad(what));
+    if !(cfg.t_end > 0.0 && cfg.t_end.is_finite()) {
+        return bad(format!("--t-end must be a positive number of seconds (got {})", cfg.t_end));
+    }
+    if !(cfg.settle >= 0.0 && cfg.settle.is_finite()) {
+        return bad(format!("--settle must be >= 0 s (got {})", cfg.settle));
+    }
+    if !(cfg.rate >= MIN_RATE && cfg.rate <= 1e6) {
+        return bad(format!(
+            "--rate must be between {MIN_RATE} Hz and 1 MHz (got {}): the engine runs near 13 Hz and the fit needs its waveform resolved",
+            cfg.rate
+        ));
+    }
+    if cfg.t_end * cfg.rate > 5e6 {
+        return bad(format!(
+            "--t-end {} s at --rate {} Hz is {:.0} samples, more than the 5 million the rig writes",
+            cfg.t_end,
+            cfg.rate,
+            cfg.t_end * cfg.rate
+        ));
     }
     if !(cfg.noise_p >= 0.0 && cfg.noise_x >= 0.0) {
-        return Err(RigError::Bad("noise levels must be non-negative".into()));
+        return bad(format!(
+            "noise levels must be non-negative (got --noise-p {}, --noise-x {})",
+            cfg.noise_p, cfg.noise_x
+        ));
     }
+    for c in &cfg.channels {
+        if !crate::data::CHANNELS.contains(&c.as_str()) {
+            return bad(format!(
+                "unknown channel `{c}` in --channels: expected some of {}",
+                crate::data::CHANNELS.join(", ")
+            ));
+        }
+    }
+    if cfg.channels.is_empty() {
+        return bad("--channels is empty: name at least one of p, p_hot, x, y".into());
+    }
+    Ok(())
+}
+
+/// Refuse a record whose absolute pressure can go negative (noise or offset larger than
+/// the pressure itself).
+fn check_pressure(p: &[f64], cfg: &RigConfig) -> Result<(), RigError> {
+    let lo = p.iter().copied().fold(f64::INFINITY, f64::min);
+    if lo + cfg.offset_p - 5.0 * cfg.noise_p <= 0.0 {
+        return Err(RigError::Bad(format!(
+            "the measured pressure would go negative: its minimum {lo:.0} Pa plus --offset-p {} minus 5 x --noise-p {} is not positive",
+            cfg.offset_p, cfg.noise_p
+        )));
+    }
+    Ok(())
+}
+
+/// Run the rig.
+pub fn run(cfg: &RigConfig) -> Result<RigOutput, RigError> {
+    validate(cfg)?;
     let model = augmented(&cfg.model, cfg.n, Closure::Full)?;
     let fx = EffectSettings::parse(&cfg.model, &cfg.effects)?;
     let mut p = crate::params::load(model.as_ref(), None, &cfg.set)?;
@@ -219,16 +275,24 @@ pub fn run(cfg: &RigConfig) -> Result<RigOutput, RigError> {
     } else {
         None
     };
+    check_pressure(&col(ic), cfg)?;
     let x = noisy(col(0), gx, cfg.offset_x, cfg.noise_x);
     let y = noisy(col(2), gy, cfg.offset_y, cfg.noise_x);
     let t: Vec<f64> = (0..=count).map(|k| k as f64 * dt).collect();
+    let want = |c: &str| cfg.channels.iter().any(|k| k == c);
+    if want("p_hot") && ph.is_none() {
+        return Err(RigError::Bad(format!(
+            "channel p_hot asked for, but `{}` has a single gas volume",
+            cfg.model
+        )));
+    }
     let data = Measured {
         source: format!("rig:{}", model.name()),
         t,
-        p: Some(pc),
-        p_hot: ph,
-        x: Some(x),
-        y: Some(y),
+        p: Some(pc).filter(|_| want("p")),
+        p_hot: ph.filter(|_| want("p_hot")),
+        x: Some(x).filter(|_| want("x")),
+        y: Some(y).filter(|_| want("y")),
     };
     let parameters = model
         .params()
@@ -243,6 +307,7 @@ pub fn run(cfg: &RigConfig) -> Result<RigOutput, RigError> {
         ("y", cfg.offset_y),
     ]
     .into_iter()
+    .filter(|(k, _)| want(k))
     .map(|(k, v)| (k.to_string(), v))
     .collect();
     let truth = Truth {
@@ -266,6 +331,17 @@ pub fn run(cfg: &RigConfig) -> Result<RigOutput, RigError> {
     Ok(RigOutput { data, truth })
 }
 
+/// A channel's meaning and unit, for the CSV header comment.
+fn describe(channel: &str) -> &'static str {
+    match channel {
+        "p" => "p cold-side pressure [Pa]",
+        "p_hot" => "p_hot hot-side pressure [Pa]",
+        "x" => "x displacer [m]",
+        "y" => "y piston [m]",
+        _ => "unknown",
+    }
+}
+
 /// The sidecar path of a CSV: `FILE.truth.json`.
 pub fn sidecar_path(csv: &Path) -> PathBuf {
     let mut s = csv.as_os_str().to_owned();
@@ -285,7 +361,7 @@ pub fn write(out: &RigOutput, path: &Path, force: bool) -> Result<PathBuf, RigEr
     let comments = vec![
         format!("stirling rig: truth model {} (n = {}), effects: {}", tr.model, tr.n, if tr.active_effects.is_empty() { "none".to_string() } else { tr.active_effects.join(", ") }),
         format!("rate {} Hz, noise p {} Pa, x {} m, seed {}; truth in {}", tr.rate, tr.noise.p, tr.noise.x, tr.seed, side.display()),
-        "columns: t [s], p cold-side pressure [Pa], p_hot hot-side pressure [Pa], x displacer [m], y piston [m]".to_string(),
+        format!("columns: t [s], {}", out.data.channels().iter().map(|c| describe(c)).collect::<Vec<_>>().join(", ")),
     ];
     write_csv(path, &out.data, &comments).map_err(|e| RigError::Io(path.to_path_buf(), e))?;
     let json = serde_json::to_string_pretty(&out.truth).expect("serializable");

@@ -31,6 +31,8 @@ pub struct SelfCheckOptions {
     pub diagnose: DiagnoseOptions,
     /// Include the clean case (no added effect).
     pub clean: bool,
+    /// Channels of the rig records (see [`RigConfig::channels`]).
+    pub channels: Vec<String>,
 }
 
 impl Default for SelfCheckOptions {
@@ -47,6 +49,9 @@ impl Default for SelfCheckOptions {
             perturb: 0.08,
             diagnose: DiagnoseOptions::default(),
             clean: true,
+            // the hot-side pressure stays in the self-check's records until the diagnosis
+            // verdicts are measured on the seed's sensor set (docs/diagnosis.md)
+            channels: ["p", "p_hot", "x", "y"].map(String::from).to_vec(),
         }
     }
 }
@@ -202,6 +207,7 @@ pub fn run(
             settle: opts.settle,
             rate: opts.rate,
             seed: opts.seed + k as u64,
+            channels: opts.channels.clone(),
             ..Default::default()
         };
         let out = rig::run(&cfg).map_err(|e| DiagnoseError::Bad(format!("rig ({truth}): {e}")))?;

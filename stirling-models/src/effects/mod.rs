@@ -127,7 +127,7 @@ pub const EFFECTS: &[EffectInfo] = &[
 ];
 
 /// Why an effect request cannot be served.
-#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum EffectError {
     #[error("unknown effect or effect parameter `{0}`: expected one of {1}")]
     Unknown(String, String),
@@ -139,6 +139,12 @@ pub enum EffectError {
     },
     #[error("model `{0}` has no augmented member: effects are declared for cv1 and nsection (aliases order5, order7, order8)")]
     NoAugmented(String),
+    #[error("effect parameter `{name}` = {value} is not physical: it must be {range}")]
+    OutOfRange {
+        name: String,
+        value: f64,
+        range: &'static str,
+    },
     #[error("bad effect setting `{0}`: expected NAME=VALUE with a finite number, e.g. leak=2e-8 or Gleak=2e-8")]
     BadSetting(String),
     #[error("{0}")]
@@ -193,6 +199,26 @@ pub fn augmented(
             Box::new(NSectionFx::new(n, closure).map_err(|e| EffectError::Model(e.to_string()))?)
         }
     })
+}
+
+/// Reject an effect parameter outside its physical range: strengths are non-negative,
+/// smoothing widths and end-stop travels positive, sensor gains above -1 (a gain of -1 would
+/// read zero for every position).
+pub fn check_range(name: &str, v: f64) -> Result<(), EffectError> {
+    let (ok, range) = match name {
+        "v_eps" | "xmax" | "ymax" => (v > 0.0, "> 0"),
+        "gain_x" | "gain_y" => (v > -0.5 && v < 0.5, "between -0.5 and 0.5"),
+        _ => (v >= 0.0, ">= 0"),
+    };
+    if ok {
+        Ok(())
+    } else {
+        Err(EffectError::OutOfRange {
+            name: name.into(),
+            value: v,
+            range,
+        })
+    }
 }
 
 /// Parameters of the augmented model with every effect at its null (the nominal model).
@@ -253,6 +279,7 @@ impl EffectSettings {
                     applies: e.applies_to.join(", "),
                 });
             }
+            check_range(p.name, v)?;
             let list = if e.target == EffectTarget::Model {
                 &mut out.model
             } else {
