@@ -1,12 +1,18 @@
 //! `stirling diagnose`: the sim-to-real gap diagnosis (where, which effect, how far), and its
 //! self-check on rig data with withheld effects.
 
-use std::path::PathBuf;
+use std::io::{self, Write};
+use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Context};
 use clap::Args;
-use stirling_models::data::{parse_span, read_csv};
-use stirling_models::diagnose::{self, selfcheck, DiagnoseOptions};
+use stirling_models::data::read_csv;
+use stirling_models::diagnose::{self, selfcheck, DiagnoseOptions, Diagnosis};
+
+use crate::common::{self, files, ranges};
+
+/// What `--report` writes: the report and its figures (named after the channels).
+const REPORT: [&str; 2] = ["report.md", "*.svg"];
 
 /// Arguments of `stirling diagnose`.
 #[derive(Args, Debug)]
@@ -14,7 +20,7 @@ pub struct DiagnoseArgs {
     /// Model with an augmented member: cv1 or nsection (aliases order5, order7, order8)
     pub model: Option<String>,
     /// Number of regenerator sections (nsection)
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true, value_parser = ranges::at_least_one)]
     pub n: Option<usize>,
     /// Measured data (CSV: t and p, x, y; p_hot optional)
     #[arg(long)]
@@ -29,31 +35,34 @@ pub struct DiagnoseArgs {
     #[arg(long, default_value = "all")]
     pub effects: String,
     /// Training block a:b in seconds (default: first 60 %)
-    #[arg(long)]
+    #[arg(long, allow_hyphen_values = true)]
     pub train: Option<String>,
-    /// Held-out block c:d in seconds (default: the rest)
-    #[arg(long)]
+    /// Held-out block c:d in seconds, after the training block (default: the rest)
+    #[arg(long, allow_hyphen_values = true)]
     pub holdout: Option<String>,
     /// Spread of the prior on the nominal parameters around their starting values, as a log
     /// standard deviation (0.5: a factor 1.65 at one standard deviation; 0: no prior)
-    #[arg(long, default_value_t = diagnose::DEFAULT_PRIOR)]
+    #[arg(long, default_value_t = diagnose::DEFAULT_PRIOR, allow_negative_numbers = true)]
     pub prior: f64,
-    /// Write report.md and SVG figures into this directory
+    /// Write report.md and SVG figures into this directory (created if missing)
     #[arg(long)]
     pub report: Option<PathBuf>,
+    /// Overwrite an existing report and figures
+    #[arg(long)]
+    pub force: bool,
     /// Run the self-check (rig data with each effect withheld) instead of diagnosing a file;
     /// without MODEL, every effect of the library on the smallest model it applies to (cv1,
     /// else nsection n = 2)
     #[arg(long)]
     pub self_check: bool,
-    /// Self-check: record length (s)
-    #[arg(long, default_value_t = 2.0)]
+    /// Self-check: record length (s, > 0)
+    #[arg(long, default_value_t = 2.0, allow_negative_numbers = true, value_parser = ranges::positive)]
     pub t_end: f64,
-    /// Self-check: sample rate (Hz)
-    #[arg(long, default_value_t = 2000.0)]
+    /// Self-check: sample rate (Hz, > 0)
+    #[arg(long, default_value_t = 2000.0, allow_negative_numbers = true, value_parser = ranges::positive)]
     pub rate: f64,
-    /// Self-check: strengths as multiples of the typical values, comma-separated
-    #[arg(long, value_delimiter = ',', default_value = "1,2")]
+    /// Self-check: strengths as multiples of the typical values (> 0), comma-separated
+    #[arg(long, value_delimiter = ',', default_value = "1,2", allow_negative_numbers = true, value_parser = ranges::positive)]
     pub strengths: Vec<f64>,
     /// Machine-readable output
     #[arg(long)]
@@ -99,7 +108,7 @@ pub fn run(a: &DiagnoseArgs) -> anyhow::Result<()> {
         let json = a.json;
         let progress = |c: &selfcheck::Case| {
             if !json {
-                eprintln!(
+                common::note(format_args!(
                     "{:<12} {:<16} x{:<4} -> {:<20} rank {:>4} closure {} [{}, {}]  {:>6.1} s  {}",
                     c.model,
                     c.truth,
@@ -113,7 +122,7 @@ pub fn run(a: &DiagnoseArgs) -> anyhow::Result<()> {
                     c.ci_high.map(|v| format!("{v:.2}")).unwrap_or("-".into()),
                     c.seconds,
                     if c.pass { "pass" } else { "FAIL" }
-                );
+                ));
             }
         };
         // without a model: every effect of the library, each on the smallest model it fits
@@ -123,10 +132,11 @@ pub fn run(a: &DiagnoseArgs) -> anyhow::Result<()> {
             selfcheck::run_library(&opts, progress)?
         };
         if json {
-            println!("{}", serde_json::to_string_pretty(&sc)?);
+            common::print_json(&sc)?;
         } else {
-            println!("{}", selfcheck::matrix_markdown(&sc));
-            println!("{}/{} cases pass, {:.1} s", sc.passed, sc.total, sc.seconds);
+            let mut o = common::stdout();
+            writeln!(o, "{}", selfcheck::matrix_markdown(&sc))?;
+            writeln!(o, "{}/{} cases pass, {:.1} s", sc.passed, sc.total, sc.seconds)?;
         }
         if sc.passed < sc.total {
             bail!(
@@ -140,7 +150,11 @@ pub fn run(a: &DiagnoseArgs) -> anyhow::Result<()> {
     let (Some(model_name), Some(path)) = (a.model.as_ref(), a.data.as_ref()) else {
         bail!("usage: stirling diagnose <model> --data FILE ... (or --self-check)");
     };
+    if let Some(dir) = &a.report {
+        files::prepare_dir(dir, &REPORT, a.force, "--report")?;
+    }
     let data = read_csv(path)?;
+    let (train, holdout) = common::blocks(a.train.as_deref(), a.holdout.as_deref(), &data, 0.6)?;
     let (model, mut p0) = diagnose::nominal_model(model_name, a.n)?;
     if let Some(f) = &a.params {
         stirling_models::params::apply_file(model.as_ref(), f, &mut p0)
@@ -149,29 +163,33 @@ pub fn run(a: &DiagnoseArgs) -> anyhow::Result<()> {
     for s in &a.set {
         stirling_models::params::apply_override(model.as_ref(), s, &mut p0)?;
     }
-    let mut opts = DiagnoseOptions {
+    let opts = DiagnoseOptions {
         effects: effects_arg(&a.effects),
         prior: prior_arg(a.prior)?,
+        train,
+        holdout,
         ..Default::default()
     };
-    if let Some(s) = &a.train {
-        opts.train = Some(parse_span(s, &data).map_err(anyhow::Error::msg)?);
-    }
-    if let Some(s) = &a.holdout {
-        opts.holdout = Some(parse_span(s, &data).map_err(anyhow::Error::msg)?);
-    }
     let d = diagnose::diagnose(model.as_ref(), &p0, &data, &opts)?;
     if let Some(dir) = &a.report {
+        let start = std::time::SystemTime::now();
         let p = diagnose::report::write(&d, &data, dir).map_err(anyhow::Error::msg)?;
+        for f in files::matching(dir, &REPORT, Some(start))? {
+            files::wrote(&f);
+        }
         if !a.json {
-            println!("report: {}", p.display());
+            writeln!(common::stdout(), "report: {}", p.display())?;
         }
     }
     if a.json {
-        println!("{}", serde_json::to_string_pretty(&d)?);
-        return Ok(());
+        return common::print_json(&d);
     }
-    println!(
+    Ok(print_text(&mut common::stdout(), path, &d)?)
+}
+
+fn print_text(o: &mut impl Write, path: &Path, d: &Diagnosis) -> io::Result<()> {
+    writeln!(
+        o,
         "model {} (n = {}), data {}, train {:.3}:{:.3} s, held out {:.3}:{:.3} s",
         d.model,
         d.n,
@@ -180,16 +198,18 @@ pub fn run(a: &DiagnoseArgs) -> anyhow::Result<()> {
         d.train.1,
         d.holdout.0,
         d.holdout.1
-    );
-    println!("\ngap before (held out):");
+    )?;
+    writeln!(o, "\ngap before (held out):")?;
     for c in &d.gap_before.channels {
-        println!(
+        writeln!(
+            o,
             "  {:<6} rms {:.4e}  noise {:.4e}  ratio {:.3}",
             c.channel, c.rms, c.noise, c.ratio
-        );
+        )?;
     }
     for s in &d.gap_before.shifts {
-        println!(
+        writeln!(
+            o,
             "  {:<6} start {:.4e} -> calibrated {:.4e} (x{:.3}{})",
             s.name,
             s.start,
@@ -198,15 +218,17 @@ pub fn run(a: &DiagnoseArgs) -> anyhow::Result<()> {
             s.prior_sd
                 .map(|z| format!(", {z:+.2} prior sd"))
                 .unwrap_or_default()
-        );
+        )?;
     }
     let l = &d.localization;
-    println!(
+    writeln!(
+        o,
         "  subsystems: mechanics {:.3}, gas {:.3} noise variances; dominant {}",
         l.mechanics_error, l.gas_error, l.dominant_subsystem
-    );
+    )?;
     for c in &l.channels {
-        println!(
+        writeln!(
+            o,
             "  {:<6} harmonics {:?} (noise level {:.2e})",
             c.channel,
             c.harmonics
@@ -214,35 +236,38 @@ pub fn run(a: &DiagnoseArgs) -> anyhow::Result<()> {
                 .map(|v| format!("{v:.2e}"))
                 .collect::<Vec<_>>(),
             c.harmonic_noise
-        );
-        println!(
+        )?;
+        writeln!(
+            o,
             "  {:<6} phase bins {:?}",
             c.channel,
             c.phase_bins
                 .iter()
                 .map(|v| format!("{v:.2}"))
                 .collect::<Vec<_>>()
-        );
+        )?;
     }
-    println!("\nranking:");
-    println!(
+    writeln!(o, "\nranking:")?;
+    writeln!(
+        o,
         "  {:<16} {:>10} {:>10} {:>10} {:>10} {:>22}  params",
         "effect", "score", "p", "dBIC", "holdout", "closure [95% CI]"
-    );
+    )?;
     for r in &d.ranking {
-        let o = |v: Option<f64>| v.map(|v| format!("{v:.3}")).unwrap_or("-".into());
-        println!(
+        let fmt = |v: Option<f64>| v.map(|v| format!("{v:.3}")).unwrap_or("-".into());
+        writeln!(
+            o,
             "  {:<16} {:>10.2} {:>10.2e} {:>10} {:>10} {:>22}  {}",
             r.effect,
             r.score,
             r.p_value,
-            o(r.delta_bic),
-            o(r.holdout_error),
+            fmt(r.delta_bic),
+            fmt(r.holdout_error),
             format!(
                 "{} [{}, {}]",
-                o(r.closure_fraction),
-                o(r.ci_low),
-                o(r.ci_high)
+                fmt(r.closure_fraction),
+                fmt(r.ci_low),
+                fmt(r.ci_high)
             ),
             r.params
                 .iter()
@@ -252,9 +277,10 @@ pub fn run(a: &DiagnoseArgs) -> anyhow::Result<()> {
                 ))
                 .collect::<Vec<_>>()
                 .join(" ")
-        );
+        )?;
     }
-    println!(
+    writeln!(
+        o,
         "\nverdict: {}{} ({})",
         d.verdict.verdict,
         d.verdict
@@ -263,7 +289,7 @@ pub fn run(a: &DiagnoseArgs) -> anyhow::Result<()> {
             .map(|e| format!(" `{e}`"))
             .unwrap_or_default(),
         d.verdict.reason
-    );
-    println!("{} fits (nominal and joint), {:.1} s", d.fits, d.seconds);
+    )?;
+    writeln!(o, "{} fits (nominal and joint), {:.1} s", d.fits, d.seconds)?;
     Ok(())
 }

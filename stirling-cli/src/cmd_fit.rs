@@ -1,13 +1,19 @@
 //! `stirling fit`: the two-stage identification (mechanics driven by measured pressure, gas
 //! driven by measured displacements) with estimates, intervals, correlations and fit %.
 
-use std::path::PathBuf;
+use std::io::{self, Write};
+use std::path::{Path, PathBuf};
 
 use anyhow::Context;
 use clap::Args;
 use stirling_dsl::Closure;
-use stirling_models::data::{parse_span, read_csv};
-use stirling_models::fit::{self, report::plot_series, FitOptions};
+use stirling_models::data::read_csv;
+use stirling_models::fit::{self, report::plot_series, FitOptions, Identification};
+
+use crate::common::{self, files, ranges};
+
+/// The figures `--plot` writes (one per stage and channel).
+const FIGURES: [&str; 3] = ["stage1_*.svg", "stage2_*.svg", "free_run_*.svg"];
 
 /// Arguments of `stirling fit`.
 #[derive(Args, Debug)]
@@ -15,7 +21,7 @@ pub struct FitArgs {
     /// Model: cv1, cv2, nsection (aliases order5..order8)
     pub model: String,
     /// Number of regenerator sections (nsection)
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true, value_parser = ranges::at_least_one)]
     pub n: Option<usize>,
     /// Measured data (CSV: t and p, x, y; p_hot optional)
     #[arg(long)]
@@ -30,29 +36,36 @@ pub struct FitArgs {
     #[arg(long, value_delimiter = ',')]
     pub free: Option<Vec<String>>,
     /// Training block a:b in seconds (default: first 70 %)
-    #[arg(long)]
+    #[arg(long, allow_hyphen_values = true)]
     pub train: Option<String>,
-    /// Held-out block c:d in seconds (default: the rest)
-    #[arg(long)]
+    /// Held-out block c:d in seconds, after the training block (default: the rest)
+    #[arg(long, allow_hyphen_values = true)]
     pub holdout: Option<String>,
     /// Machine-readable output
     #[arg(long)]
     pub json: bool,
-    /// Write measured-vs-model SVGs into this directory
+    /// Write measured-vs-model SVGs into this directory (created if missing)
     #[arg(long)]
     pub plot: Option<PathBuf>,
+    /// Overwrite existing figures
+    #[arg(long)]
+    pub force: bool,
     /// Refine by multiple shooting over segments of about this many cycles (on up to 0.5 s
     /// of the training block) before the free run
-    #[arg(long, value_name = "CYCLES")]
+    #[arg(long, value_name = "CYCLES", allow_negative_numbers = true, value_parser = ranges::cycles)]
     pub multiple_shooting: Option<f64>,
 }
 
 pub fn run(a: &FitArgs) -> anyhow::Result<()> {
+    if let Some(dir) = &a.plot {
+        files::prepare_dir(dir, &FIGURES, a.force, "--plot")?;
+    }
     let data = read_csv(&a.data)?;
+    let (train, holdout) = common::blocks(a.train.as_deref(), a.holdout.as_deref(), &data, 0.7)?;
     let model = stirling_models::build(&a.model, a.n, Closure::Full)?;
     let p0 = stirling_models::params::load(model.as_ref(), a.params.as_deref(), &a.set)
         .with_context(|| format!("parameters of model `{}`", model.name()))?;
-    let mut opts = FitOptions {
+    let opts = FitOptions {
         free: a.free.clone(),
         multiple_shooting: a
             .multiple_shooting
@@ -60,51 +73,58 @@ pub fn run(a: &FitArgs) -> anyhow::Result<()> {
                 cycles: c,
                 ..Default::default()
             }),
+        train,
+        holdout,
         ..Default::default()
     };
-    if let Some(s) = &a.train {
-        opts.train = Some(parse_span(s, &data).map_err(anyhow::Error::msg)?);
-    }
-    if let Some(s) = &a.holdout {
-        opts.holdout = Some(parse_span(s, &data).map_err(anyhow::Error::msg)?);
-    }
     let res = fit::identify(model.as_ref(), &p0, &data, &opts)?;
     if let Some(dir) = &a.plot {
-        std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
-        for (k, st) in [&res.stage1, &res.stage2].into_iter().enumerate() {
-            for s in st.iter().flat_map(|s| &s.series) {
-                let f = dir.join(format!("stage{}_{}.svg", k + 1, s.channel));
-                plot_series(
-                    &f,
-                    &format!("stage {}: {} measured vs model", k + 1, s.channel),
-                    s,
-                )
-                .map_err(anyhow::Error::msg)?;
-            }
-        }
-        for s in res.free_run.iter().flat_map(|f| &f.series) {
-            let f = dir.join(format!("free_run_{}.svg", s.channel));
-            plot_series(&f, &format!("free run: {} measured vs model", s.channel), s)
-                .map_err(anyhow::Error::msg)?;
-        }
+        plots(dir, &res)?;
     }
     if a.json {
-        println!("{}", serde_json::to_string_pretty(&res)?);
-        return Ok(());
+        return common::print_json(&res);
     }
-    println!(
+    Ok(print_text(&mut common::stdout(), &a.data, &res)?)
+}
+
+fn plots(dir: &Path, res: &Identification) -> anyhow::Result<()> {
+    for (k, st) in [&res.stage1, &res.stage2].into_iter().enumerate() {
+        for s in st.iter().flat_map(|s| &s.series) {
+            let f = dir.join(format!("stage{}_{}.svg", k + 1, s.channel));
+            plot_series(
+                &f,
+                &format!("stage {}: {} measured vs model", k + 1, s.channel),
+                s,
+            )
+            .map_err(anyhow::Error::msg)?;
+            files::wrote(&f);
+        }
+    }
+    for s in res.free_run.iter().flat_map(|f| &f.series) {
+        let f = dir.join(format!("free_run_{}.svg", s.channel));
+        plot_series(&f, &format!("free run: {} measured vs model", s.channel), s)
+            .map_err(anyhow::Error::msg)?;
+        files::wrote(&f);
+    }
+    Ok(())
+}
+
+fn print_text(o: &mut impl Write, data: &Path, res: &Identification) -> io::Result<()> {
+    writeln!(
+        o,
         "model {} (n = {}), data {}, train {:.3}:{:.3} s{}",
         res.model,
         res.n,
-        a.data.display(),
+        data.display(),
         res.train.0,
         res.train.1,
         res.holdout
             .map(|h| format!(", holdout {:.3}:{:.3} s", h.0, h.1))
             .unwrap_or_default()
-    );
+    )?;
     for st in [&res.stage1, &res.stage2].into_iter().flatten() {
-        println!(
+        writeln!(
+            o,
             "\n{} ({} iterations, {} evaluations, {}, {:.2} s)",
             st.stage,
             st.iterations,
@@ -115,46 +135,52 @@ pub fn run(a: &FitArgs) -> anyhow::Result<()> {
                 "NOT converged"
             },
             st.seconds
-        );
-        println!(
+        )?;
+        writeln!(
+            o,
             "  {:<14} {:>14} {:>14} {:>12} {:>28}",
             "quantity", "initial", "estimate", "std error", "95 % interval"
-        );
+        )?;
         for e in &st.stats.estimates {
-            println!(
+            writeln!(
+                o,
                 "  {:<14} {:>14.6e} {:>14.6e} {:>12.3e}   [{:.6e}, {:.6e}]",
                 e.name, e.initial, e.value, e.std_error, e.ci_low, e.ci_high
-            );
+            )?;
         }
         let names: Vec<&str> = st.stats.estimates.iter().map(|e| e.name.as_str()).collect();
-        println!("  correlation:");
-        println!(
+        writeln!(o, "  correlation:")?;
+        writeln!(
+            o,
             "  {:>12} {}",
             "",
             names
                 .iter()
                 .map(|n| format!("{:>9}", &n[..n.len().min(9)]))
                 .collect::<String>()
-        );
+        )?;
         for (i, row) in st.stats.correlation.iter().enumerate() {
-            println!(
+            writeln!(
+                o,
                 "  {:>12} {}",
                 &names[i][..names[i].len().min(12)],
                 row.iter().map(|v| format!("{v:>9.3}")).collect::<String>()
-            );
+            )?;
         }
         for w in &st.stats.warnings {
-            println!("  WARNING: {w}");
+            writeln!(o, "  WARNING: {w}")?;
         }
         for f in &st.fits {
-            println!(
+            writeln!(
+                o,
                 "  fit {:<6} {:<8} {:>7.2} %  (rms {:.3e}, {} samples)",
                 f.channel, f.block, f.fit_percent, f.rms, f.samples
-            );
+            )?;
         }
     }
     if let Some(ms) = &res.multiple_shooting {
-        println!(
+        writeln!(
+            o,
             "\nmultiple shooting ({} segments, {} iterations, {}, {:.2} s, largest defect {:.2e})",
             ms.segments.len(),
             ms.iterations,
@@ -165,71 +191,78 @@ pub fn run(a: &FitArgs) -> anyhow::Result<()> {
             },
             ms.seconds,
             ms.segments.iter().map(|s| s.defect).fold(0.0, f64::max)
-        );
+        )?;
         for e in ms
             .stats
             .estimates
             .iter()
             .filter(|e| !e.name.starts_with("seg"))
         {
-            println!(
+            writeln!(
+                o,
                 "  {:<14} {:>14.6e} {:>14.6e} {:>12.3e}   [{:.6e}, {:.6e}]",
                 e.name, e.initial, e.value, e.std_error, e.ci_low, e.ci_high
-            );
+            )?;
         }
         // collinear segment initial states (fast gas modes) are expected: count them only
         let (seg, other): (Vec<&String>, Vec<&String>) =
             ms.stats.warnings.iter().partition(|w| w.contains("`seg"));
         for w in other {
-            println!("  WARNING: {w}");
+            writeln!(o, "  WARNING: {w}")?;
         }
         if !seg.is_empty() {
-            println!(
+            writeln!(
+                o,
                 "  note: {} nearly collinear pairs involve segment initial states (see --json)",
                 seg.len()
-            );
+            )?;
         }
         for f in &ms.fits {
-            println!(
+            writeln!(
+                o,
                 "  fit {:<6} {:<8} {:>7.2} %",
                 f.channel, f.block, f.fit_percent
-            );
+            )?;
         }
     }
     if let Some(fr) = &res.free_run {
-        println!(
+        writeln!(
+            o,
             "\nfree run from the measured state at {:.3} s (to {:.3} s; short window {:.3} s)",
             fr.block.0, fr.block.1, fr.short_window
-        );
+        )?;
         for f in &fr.fits {
-            println!(
+            writeln!(
+                o,
                 "  fit {:<6} {:<15} {:>7.2} %  (rms {:.3e})",
                 f.channel, f.block, f.fit_percent, f.rms
-            );
+            )?;
         }
         if let (Some(m), Some(s)) = (&fr.measured, &fr.simulated) {
-            println!(
+            writeln!(
+                o,
                 "  frequency   measured {:.4} Hz, model {:.4} Hz",
                 m.frequency, s.frequency
-            );
+            )?;
             for (((c, am), (_, asim)), ((_, pm), (_, psim))) in m
                 .amplitude
                 .iter()
                 .zip(&s.amplitude)
                 .zip(m.phase.iter().zip(&s.phase))
             {
-                println!(
+                writeln!(
+                    o,
                     "  {c:<6} amplitude {am:.4e} / {asim:.4e}, phase vs x {pm:+.4} / {psim:+.4} rad"
-                );
+                )?;
             }
         }
         if let Some(l) = fr.x_phase_lag {
-            println!("  displacer phase drift at the block end {l:+.4} rad");
+            writeln!(o, "  displacer phase drift at the block end {l:+.4} rad")?;
         }
     }
     for n in &res.notes {
-        println!("NOTE: {n}");
+        writeln!(o, "NOTE: {n}")?;
     }
-    println!("\ntotal {:.2} s", res.seconds);
+    writeln!(o, "\ntotal {:.2} s", res.seconds)?;
     Ok(())
 }

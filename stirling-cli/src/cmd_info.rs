@@ -2,14 +2,12 @@
 //! parameters with unit, value and doc, the generated equations (text or LaTeX),
 //! or the energetic (bond-graph) view as Graphviz DOT.
 
-use std::io::Write;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
-use anyhow::{bail, Context};
 use clap::Args;
 use stirling_dsl::{Model, Style};
 
-use crate::common::ModelArgs;
+use crate::common::{self, files, ModelArgs};
 
 /// Arguments of `stirling info`.
 #[derive(Args, Debug, Clone)]
@@ -20,9 +18,10 @@ pub struct InfoArgs {
     #[arg(long)]
     pub latex: bool,
     /// Write the bond-graph view of the topology as Graphviz DOT instead of the listing
-    #[arg(long, conflicts_with = "json")]
+    /// (DOT has no equations: not with --latex or --json)
+    #[arg(long, conflicts_with_all = ["json", "latex"])]
     pub graph: bool,
-    /// With --graph: write the DOT to this file instead of stdout
+    /// With --graph: write the DOT to this file instead of stdout (folders created if missing)
     #[arg(long, requires = "graph", value_name = "FILE")]
     pub out: Option<PathBuf>,
     /// With --out: overwrite an existing file
@@ -40,11 +39,8 @@ pub fn run(args: &InfoArgs) -> anyhow::Result<()> {
     if args.graph {
         let dot = stirling_dsl::to_dot(model.topology());
         return match &args.out {
-            Some(path) => write_new(path, &dot, args.force),
-            None => {
-                print!("{dot}");
-                Ok(())
-            }
+            Some(path) => files::write_text(path, &dot, args.force, "--out"),
+            None => Ok(common::print(&dot)?),
         };
     }
     let style = if args.latex {
@@ -53,33 +49,10 @@ pub fn run(args: &InfoArgs) -> anyhow::Result<()> {
         Style::Text
     };
     if args.json {
-        println!("{}", serde_json::to_string_pretty(&json(model, &p, style))?);
+        common::print_json(&json(model, &p, style))
     } else {
-        print!("{}", listing(model, &p, style));
+        Ok(common::print(&listing(model, &p, style))?)
     }
-    Ok(())
-}
-
-/// Write `text` to a new file; an existing file is kept unless `force`.
-fn write_new(path: &Path, text: &str, force: bool) -> anyhow::Result<()> {
-    let mut opts = std::fs::OpenOptions::new();
-    opts.write(true);
-    if force {
-        opts.create(true).truncate(true);
-    } else {
-        opts.create_new(true);
-    }
-    let mut f = match opts.open(path) {
-        Ok(f) => f,
-        Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => {
-            bail!("{} exists; pass --force to overwrite it", path.display())
-        }
-        Err(e) => return Err(e).with_context(|| format!("cannot create {}", path.display())),
-    };
-    f.write_all(text.as_bytes())
-        .with_context(|| format!("cannot write {}", path.display()))?;
-    eprintln!("wrote {}", path.display());
-    Ok(())
 }
 
 /// The title line: name, sections, closure, state count and the declaration's doc.

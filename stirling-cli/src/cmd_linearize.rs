@@ -2,6 +2,7 @@
 //! channel and its margins (PHYSICS.md sections 6-7); `--json` prints the `LinearReport`,
 //! `--plot DIR` writes the pole map and the Bode diagram as SVG.
 
+use std::io::{self, Write};
 use std::path::{Path, PathBuf};
 
 use anyhow::Context;
@@ -10,7 +11,10 @@ use stirling_dsl::Model;
 use stirling_models::linear::{self, bode, LinearOptions, LinearReport, Linearization, Pole};
 use stirling_models::plot;
 
-use crate::common::ModelArgs;
+use crate::common::{self, files, ModelArgs};
+
+/// The figures `--plot` writes.
+const FIGURES: [&str; 2] = ["poles.svg", "bode.svg"];
 
 /// Arguments of `stirling linearize`.
 #[derive(Args, Debug)]
@@ -24,13 +28,19 @@ pub struct LinearizeArgs {
     /// Machine-readable output (the LinearReport)
     #[arg(long)]
     pub json: bool,
-    /// Write poles.svg and bode.svg into this directory
+    /// Write poles.svg and bode.svg into this directory (created if missing)
     #[arg(long)]
     pub plot: Option<PathBuf>,
+    /// Overwrite existing figures
+    #[arg(long)]
+    pub force: bool,
 }
 
 /// Run the analysis and print it.
 pub fn run(a: &LinearizeArgs) -> anyhow::Result<()> {
+    if let Some(dir) = &a.plot {
+        files::prepare_dir(dir, &FIGURES, a.force, "--plot")?;
+    }
     let (model, p) = a.model.load()?;
     let opts = LinearOptions {
         channel: a.channel.clone(),
@@ -43,22 +53,22 @@ pub fn run(a: &LinearizeArgs) -> anyhow::Result<()> {
         plots(dir, model.as_ref(), &lin)?;
     }
     if a.json {
-        println!("{}", serde_json::to_string_pretty(&report)?);
+        common::print_json(&report)
     } else {
-        print_text(&report);
+        Ok(print_text(&mut common::stdout(), &report)?)
     }
-    Ok(())
 }
 
 fn plots(dir: &Path, model: &dyn Model, lin: &Linearization) -> anyhow::Result<()> {
-    std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
     let tag = format!("{} (n = {}, {})", model.name(), model.n(), model.closure());
+    let poles = dir.join(FIGURES[0]);
     plot::poles::pole_map(
-        &dir.join("poles.svg"),
+        &poles,
         &format!("Poles of {tag}"),
         &lin.dynamics.poles,
         &lin.open_loop.poles,
     )?;
+    files::wrote(&poles);
     let center = lin
         .margins
         .gain_crossover_rad_s
@@ -70,7 +80,9 @@ fn plots(dir: &Path, model: &dyn Model, lin: &Linearization) -> anyhow::Result<(
         "Open loop at the {} input of {tag}",
         lin.open_loop.full.name
     );
-    plot::bode::bode_diagram(&dir.join("bode.svg"), &title, &data, &lin.margins)?;
+    let bode_svg = dir.join(FIGURES[1]);
+    plot::bode::bode_diagram(&bode_svg, &title, &data, &lin.margins)?;
+    files::wrote(&bode_svg);
     Ok(())
 }
 
@@ -87,59 +99,73 @@ fn opt(v: Option<f64>, prec: usize) -> String {
     v.map_or("none".into(), |v| format!("{v:.prec$}"))
 }
 
-fn print_pole(p: &Pole) {
+fn print_pole(o: &mut impl Write, p: &Pole) -> io::Result<()> {
     let flag = if p.rhp { "  RHP" } else { "" };
-    println!(
+    writeln!(
+        o,
         "  {:>14.6} {:>+14.6}j   {:>10.4} rad/s {:>9.4} Hz   zeta {:>8.4}{flag}",
         p.re, p.im, p.freq_rad_s, p.freq_hz, p.damping_ratio
-    );
+    )
 }
 
-fn print_text(r: &LinearReport) {
-    println!(
+fn print_text(o: &mut impl Write, r: &LinearReport) -> io::Result<()> {
+    writeln!(
+        o,
         "model {} (n = {}, closure {}), {} states",
         r.model, r.n, r.closure, r.n_states
-    );
+    )?;
     let eq = &r.equilibrium;
-    println!(
+    writeln!(
+        o,
         "equilibrium: residual max|f| = {:.3e}, scaled {:.3e} 1/s, {} Newton iterations",
         eq.residual, eq.scaled_residual, eq.iterations
-    );
+    )?;
     if let Some(inv) = &r.inventory_mode {
-        println!(
+        writeln!(
+            o,
             "inventory mode: eigenvalue {:.3e}, mass conservation defect {:.1e} (removed)",
             inv.eigenvalue, inv.conservation_defect
-        );
+        )?;
     }
-    println!(
+    writeln!(
+        o,
         "closed-loop poles ({} in the right half plane):",
         r.rhp_count
-    );
-    r.poles.iter().for_each(print_pole);
+    )?;
+    for p in &r.poles {
+        print_pole(o, p)?;
+    }
     let l = &r.loop_break;
-    println!(
+    writeln!(
+        o,
         "loop broken at the {} input ({}); open-loop poles ({} RHP):",
         l.channel, l.unit, l.open_loop_rhp_count
-    );
-    l.open_loop_poles.iter().for_each(print_pole);
+    )?;
+    for p in &l.open_loop_poles {
+        print_pole(o, p)?;
+    }
     let m = &r.margins;
-    println!(
+    writeln!(
+        o,
         "margins: Gm = {} dB at {} rad/s, Pm = {} deg at {} rad/s",
         opt(m.gain_db, 3),
         opt(m.phase_crossover_rad_s, 2),
         opt(m.phase_deg, 2),
         opt(m.gain_crossover_rad_s, 2)
-    );
+    )?;
     for g in &m.all_gain {
-        println!(
+        writeln!(
+            o,
             "  phase crossover {:>10.3} rad/s: Gm = {:.3} dB",
             g.phase_crossover_rad_s, g.gain_db
-        );
+        )?;
     }
     for p in &m.all_phase {
-        println!(
+        writeln!(
+            o,
             "  gain crossover  {:>10.3} rad/s: Pm = {:.2} deg",
             p.gain_crossover_rad_s, p.phase_deg
-        );
+        )?;
     }
+    Ok(())
 }

@@ -1,13 +1,14 @@
 //! `stirling locus`: the poles over a parameter range (root locus), as a table, JSON or SVG.
 
+use std::io::Write;
 use std::path::PathBuf;
 
-use anyhow::{bail, Context};
+use anyhow::Context;
 use clap::Args;
 use stirling_models::linear::{locus, NewtonOptions};
 use stirling_models::plot;
 
-use crate::common::ModelArgs;
+use crate::common::{self, files, ranges, ModelArgs};
 
 /// Arguments of `stirling locus`.
 #[derive(Args, Debug)]
@@ -18,26 +19,29 @@ pub struct LocusArgs {
     #[arg(long)]
     pub param: String,
     /// First value
-    #[arg(long, allow_hyphen_values = true)]
+    #[arg(long, allow_negative_numbers = true, value_parser = ranges::finite)]
     pub from: f64,
     /// Last value
-    #[arg(long, allow_hyphen_values = true)]
+    #[arg(long, allow_negative_numbers = true, value_parser = ranges::finite)]
     pub to: f64,
     /// Number of values (at least 1)
-    #[arg(long, default_value_t = 21)]
+    #[arg(long, default_value_t = 21, allow_negative_numbers = true, value_parser = ranges::at_least_one)]
     pub steps: usize,
     /// Machine-readable output
     #[arg(long)]
     pub json: bool,
-    /// Write locus.svg into this directory
+    /// Write locus.svg into this directory (created if missing)
     #[arg(long)]
     pub plot: Option<PathBuf>,
+    /// Overwrite an existing figure
+    #[arg(long)]
+    pub force: bool,
 }
 
 /// Compute the locus and print it.
 pub fn run(a: &LocusArgs) -> anyhow::Result<()> {
-    if a.steps == 0 {
-        bail!("--steps must be at least 1");
+    if let Some(dir) = &a.plot {
+        files::prepare_dir(dir, &["locus.svg"], a.force, "--plot")?;
     }
     let (model, p) = a.model.load()?;
     let values = locus::linspace(a.from, a.to, a.steps);
@@ -50,28 +54,31 @@ pub fn run(a: &LocusArgs) -> anyhow::Result<()> {
     )
     .with_context(|| format!("root locus of `{}` over `{}`", model.name(), a.param))?;
     if let Some(dir) = &a.plot {
-        std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
-        plot::locus::root_locus(&dir.join("locus.svg"), &l)?;
+        let f = dir.join("locus.svg");
+        plot::locus::root_locus(&f, &l)?;
+        files::wrote(&f);
     }
     if a.json {
-        println!("{}", serde_json::to_string_pretty(&l)?);
-        return Ok(());
+        return common::print_json(&l);
     }
-    println!(
+    let mut o = common::stdout();
+    writeln!(
+        o,
         "root locus of {} over {} ({} values); least stable pair per value:",
         l.model,
         l.param,
         l.points.len()
-    );
+    )?;
     for pt in &l.points {
         let top = pt.poles.first();
         let rhp = pt.poles.iter().filter(|p| p.rhp).count();
         match top {
-            Some(q) => println!(
+            Some(q) => writeln!(
+                o,
                 "  {} = {:<12} {:>12.5} {:>+12.5}j   ({rhp} RHP)",
                 l.param, pt.value, q.re, q.im
-            ),
-            None => println!("  {} = {}: no poles", l.param, pt.value),
+            )?,
+            None => writeln!(o, "  {} = {}: no poles", l.param, pt.value)?,
         }
     }
     Ok(())

@@ -1,6 +1,10 @@
 //! `stirling models`: the family and its aliases.
 
+use std::io::Write;
+
 use stirling_models::FAMILY;
+
+use crate::common;
 
 /// Print the family, or JSON with `--json`.
 pub fn run(json: bool) -> anyhow::Result<()> {
@@ -9,11 +13,11 @@ pub fn run(json: bool) -> anyhow::Result<()> {
             .iter()
             .map(|e| serde_json::json!({ "name": e.name, "aliases": e.aliases, "summary": e.summary }))
             .collect();
-        println!("{}", serde_json::to_string_pretty(&list)?);
-        return Ok(());
+        return common::print_json(&list);
     }
+    let mut o = common::stdout();
     for e in FAMILY {
-        println!("{:<9} {:<16} {}", e.name, e.aliases.join(","), e.summary);
+        writeln!(o, "{:<9} {:<16} {}", e.name, e.aliases.join(","), e.summary)?;
     }
     Ok(())
 }

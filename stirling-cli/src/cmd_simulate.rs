@@ -10,38 +10,45 @@ use indicatif::{ProgressBar, ProgressStyle};
 use stirling_dsl::{Model, StateKind};
 use stirling_models::sim::{self, SimOptions, SimSummary, Trajectory};
 
-use crate::common::ModelArgs;
+use crate::common::{self, files, ranges, ModelArgs};
+
+/// The largest CSV `--out` writes (bytes).
+const MAX_CSV_BYTES: f64 = 1e9;
 
 /// Arguments of `stirling simulate`.
 #[derive(Args, Debug)]
 pub struct SimulateArgs {
     #[command(flatten)]
     pub model: ModelArgs,
-    /// End time (s); with --limit-cycle, the longest settling time
-    #[arg(long)]
+    /// End time (s, > 0); with --limit-cycle, the longest settling time
+    #[arg(long, allow_negative_numbers = true, value_parser = ranges::positive)]
     pub t_end: f64,
-    /// Initial state, comma-separated, all states in order (see `stirling models`)
+    /// Initial state, comma-separated, all states in the order `stirling info MODEL` lists
     #[arg(long, conflicts_with = "perturb", allow_hyphen_values = true)]
     pub x0: Option<String>,
     /// Start from equilibrium with the displacer displaced by X metres (default 5e-3)
-    #[arg(long, allow_hyphen_values = true)]
+    #[arg(long, allow_negative_numbers = true, value_parser = ranges::finite)]
     pub perturb: Option<f64>,
-    /// Number of output samples
-    #[arg(long, default_value_t = 2000)]
+    /// Number of output samples (2 to 1e6)
+    #[arg(long, default_value_t = 2000, allow_negative_numbers = true, value_parser = ranges::samples)]
     pub samples: usize,
-    /// Relative (and scaled absolute) tolerance
-    #[arg(long, default_value_t = 1e-7)]
+    /// Relative tolerance, in (0, 0.1]
+    #[arg(long, default_value_t = 1e-7, allow_negative_numbers = true, value_parser = ranges::tolerance)]
     pub rtol: f64,
-    /// Write the sampled trajectory as CSV
+    /// Scaled absolute tolerance, in (0, 0.1] (default: --rtol)
+    #[arg(long, allow_negative_numbers = true, value_parser = ranges::tolerance)]
+    pub atol: Option<f64>,
+    /// Write the sampled trajectory as CSV (folders created if missing)
     #[arg(long)]
     pub out: Option<PathBuf>,
-    /// Overwrite an existing --out file
+    /// Overwrite an existing --out file and existing --plot figures
     #[arg(long)]
     pub force: bool,
     /// Print the summary as JSON
     #[arg(long)]
     pub json: bool,
     /// Write SVG plots (start-up response; PV diagrams with --limit-cycle) into this folder
+    /// (created if missing)
     #[arg(long)]
     pub plot: Option<PathBuf>,
     /// Run until periodic, refine by shooting, report the cycle
@@ -52,16 +59,12 @@ pub struct SimulateArgs {
 pub fn run(args: &SimulateArgs) -> anyhow::Result<()> {
     let (model, p) = args.model.load()?;
     let model = model.as_ref();
-    if let Some(out) = &args.out {
-        if out.exists() && !args.force {
-            bail!("{} exists; pass --force to overwrite it", out.display());
-        }
-    }
+    check_outputs(args, model)?;
     let x0 = initial_state(model, &p, args)?;
-    let samples = sim::uniform_samples(args.t_end, args.samples.max(1));
+    let samples = sim::uniform_samples(args.t_end, args.samples);
     let opts = SimOptions {
         rtol: args.rtol,
-        atol: args.rtol,
+        atol: args.atol.unwrap_or(args.rtol),
         ..Default::default()
     };
     let bar = ProgressBar::new(1000);
@@ -110,15 +113,46 @@ pub fn run(args: &SimulateArgs) -> anyhow::Result<()> {
     };
     bar.finish_and_clear();
     if let Some(out) = &args.out {
-        write_csv(out, model, &traj)?;
+        write_csv(out, args.force, model, &traj)?;
     }
     if let Some(dir) = &args.plot {
         plots(dir, model, &p, &traj, lc.as_ref())?;
     }
     if args.json {
-        println!("{}", serde_json::to_string_pretty(&summary)?);
+        common::print_json(&summary)
     } else {
-        print_summary(&summary);
+        Ok(print_summary(&mut common::stdout(), &summary)?)
+    }
+}
+
+/// The figures `--plot` writes.
+fn figures(args: &SimulateArgs) -> &'static [&'static str] {
+    if args.limit_cycle {
+        &["startup.svg", "pv.svg"]
+    } else {
+        &["startup.svg"]
+    }
+}
+
+/// Refuse, before the run, outputs that exist (without --force) or a CSV too large to use.
+fn check_outputs(args: &SimulateArgs, model: &dyn Model) -> anyhow::Result<()> {
+    if let Some(out) = &args.out {
+        let columns = model.n_states() + 1;
+        // `{:.10e}` and a separator: 18 bytes a value at most
+        let bytes = args.samples as f64 * columns as f64 * 18.0;
+        if bytes > MAX_CSV_BYTES {
+            bail!(
+                "--out {}: {} samples of {columns} columns would write about {:.1} GB (the limit is {:.0} GB); lower --samples",
+                out.display(),
+                args.samples,
+                bytes / 1e9,
+                MAX_CSV_BYTES / 1e9
+            );
+        }
+        files::prepare_file(out, args.force, "--out")?;
+    }
+    if let Some(dir) = &args.plot {
+        files::prepare_dir(dir, figures(args), args.force, "--plot")?;
     }
     Ok(())
 }
@@ -131,16 +165,19 @@ fn initial_state(model: &dyn Model, p: &[f64], args: &SimulateArgs) -> anyhow::R
             .map(|v| {
                 v.trim()
                     .parse::<f64>()
-                    .with_context(|| format!("--x0: `{v}` is not a number"))
+                    .ok()
+                    .filter(|v| v.is_finite())
+                    .with_context(|| format!("--x0: `{v}` is not a finite number"))
             })
             .collect::<Result<_, _>>()?;
         if x.len() != n {
             bail!(
-                "--x0 has {} values; `{}` has {} states: {}",
+                "--x0 has {} values; `{}` has {} states: {} (see `stirling info {}`)",
                 x.len(),
                 model.name(),
                 n,
-                model.state_names().join(", ")
+                model.state_names().join(", "),
+                model.name()
             );
         }
         return Ok(x);
@@ -156,15 +193,18 @@ fn initial_state(model: &dyn Model, p: &[f64], args: &SimulateArgs) -> anyhow::R
     Ok(x)
 }
 
-fn write_csv(path: &Path, model: &dyn Model, tr: &Trajectory) -> anyhow::Result<()> {
-    let mut f = std::io::BufWriter::new(
-        std::fs::File::create(path).with_context(|| format!("cannot create {}", path.display()))?,
-    );
-    writeln!(f, "t,{}", model.state_names().join(","))?;
-    for (t, x) in tr.t.iter().zip(&tr.x) {
-        let row: Vec<String> = x.iter().map(|v| format!("{v:.10e}")).collect();
-        writeln!(f, "{t:.10e},{}", row.join(","))?;
-    }
+fn write_csv(path: &Path, force: bool, model: &dyn Model, tr: &Trajectory) -> anyhow::Result<()> {
+    let mut f = files::create(path, force, "--out")?;
+    let mut rows = || -> std::io::Result<()> {
+        writeln!(f, "t,{}", model.state_names().join(","))?;
+        for (t, x) in tr.t.iter().zip(&tr.x) {
+            let row: Vec<String> = x.iter().map(|v| format!("{v:.10e}")).collect();
+            writeln!(f, "{t:.10e},{}", row.join(","))?;
+        }
+        f.flush()
+    };
+    rows().with_context(|| format!("cannot write {}", path.display()))?;
+    files::wrote(path);
     Ok(())
 }
 
@@ -175,7 +215,6 @@ fn plots(
     tr: &Trajectory,
     lc: Option<&sim::LimitCycleReport>,
 ) -> anyhow::Result<()> {
-    std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
     let states = model.states();
     let find = |k: StateKind| states.iter().position(|s| s.kind == k);
     let (ix, iy) = (
@@ -189,8 +228,9 @@ fn plots(
         .map(|(i, s)| (s.name.clone(), i))
         .collect();
     let title = format!("{} (n = {})", model.name(), model.n());
+    let startup = dir.join("startup.svg");
     stirling_models::plot::timeseries::startup_svg(
-        &dir.join("startup.svg"),
+        &startup,
         &title,
         &tr.t,
         &tr.x,
@@ -199,39 +239,42 @@ fn plots(
         &pressures,
     )
     .map_err(anyhow::Error::msg)?;
+    files::wrote(&startup);
     if let Some(lc) = lc {
         let loops = sim::work::pv_loops(model, p, &lc.orbit);
+        let pv = dir.join("pv.svg");
         stirling_models::plot::pv::pv_svg(
-            &dir.join("pv.svg"),
+            &pv,
             &title,
             &lc.work.vessels,
             &loops,
             &lc.work.per_vessel,
         )
         .map_err(anyhow::Error::msg)?;
+        files::wrote(&pv);
     }
-    eprintln!("plots written to {}", dir.display());
     Ok(())
 }
 
-fn print_summary(s: &SimSummary) {
-    println!(
+fn print_summary(o: &mut impl Write, s: &SimSummary) -> std::io::Result<()> {
+    writeln!(
+        o,
         "model {} (n = {}, closure {}, {} states), t_end = {:.4} s",
         s.model, s.n, s.closure, s.n_states, s.t_end
-    );
+    )?;
     if let (Some(f), Some(xa), Some(ya), Some(ph)) = (s.frequency_hz, s.x_amp, s.y_amp, s.phase_deg)
     {
-        println!("limit cycle: f = {f:.4} Hz ({:.2} rad/s), x_amp = {:.3} mm, y_amp = {:.3} mm, phase(x - y) = {ph:.2} deg", f * std::f64::consts::TAU, 1e3 * xa, 1e3 * ya);
+        writeln!(o, "limit cycle: f = {f:.4} Hz ({:.2} rad/s), x_amp = {:.3} mm, y_amp = {:.3} mm, phase(x - y) = {ph:.2} deg", f * std::f64::consts::TAU, 1e3 * xa, 1e3 * ya)?;
         if let Some(pa) = &s.p_amp {
             let pa: Vec<String> = pa.iter().map(|v| format!("{:.1}", v)).collect();
-            println!("pressure amplitudes (Pa): {}", pa.join(", "));
+            writeln!(o, "pressure amplitudes (Pa): {}", pa.join(", "))?;
         }
         if let (Some(w), Some(pw)) = (s.work_per_cycle_j, s.power_w) {
-            println!("work per cycle {w:.5} J, indicated power {pw:.4} W");
+            writeln!(o, "work per cycle {w:.5} J, indicated power {pw:.4} W")?;
         }
         if let Some(v) = &s.work_per_vessel_j {
             for (name, w) in v {
-                println!("  {name:>12}: {w:+.5} J");
+                writeln!(o, "  {name:>12}: {w:+.5} J")?;
             }
         }
         if let Some(fl) = &s.floquet {
@@ -246,14 +289,16 @@ fn print_summary(s: &SimSummary) {
                     }
                 })
                 .collect();
-            println!("Floquet multipliers (largest): {}", fl.join(", "));
+            writeln!(o, "Floquet multipliers (largest): {}", fl.join(", "))?;
         }
     } else {
         let x: Vec<String> = s.final_state.iter().map(|v| format!("{v:.6e}")).collect();
-        println!("final state: {}", x.join(", "));
+        writeln!(o, "final state: {}", x.join(", "))?;
     }
-    println!(
+    writeln!(
+        o,
         "solver: {} steps, {} RHS calls, {} Jacobian calls, {} LU factorizations",
         s.steps, s.rhs_calls, s.jacobian_calls, s.lu_factorizations
-    );
+    )?;
+    Ok(())
 }

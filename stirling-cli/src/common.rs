@@ -1,4 +1,14 @@
-//! Arguments shared by the commands: which model, at which `n` and closure, with which parameters.
+//! What the commands share: which model, at which `n` and closure, with which parameters
+//! ([`ModelArgs`]); the checked stdout ([`stdout`]); the rule for files written ([`files`]);
+//! the range checks of numeric options ([`ranges`]); the training and held-out blocks.
+
+mod blocks;
+pub mod files;
+pub mod ranges;
+mod stdout;
+
+pub use blocks::blocks;
+pub use stdout::{is_stdout_closed, note, print, print_json, stdout};
 
 use std::path::PathBuf;
 
@@ -12,7 +22,7 @@ pub struct ModelArgs {
     /// Model: schmidt, cv1, cv2, nsection (aliases order4..order8)
     pub model: String,
     /// Number of regenerator sections (nsection only; default 1)
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true, value_parser = ranges::at_least_one)]
     pub n: Option<usize>,
     /// Inventory closure: full (mass states, default) or frozen (seed's order count)
     #[arg(long, default_value = "full")]

@@ -60,7 +60,11 @@ fn main() {
         Command::Info(a) => cmd_info::run(&a),
     };
     if let Err(e) = result {
-        eprintln!("error: {e:#}");
+        // a reader that stopped early (`| head`) is the end of the output, not an error
+        if common::is_stdout_closed(&e) {
+            std::process::exit(0);
+        }
+        common::note(format_args!("error: {e:#}"));
         std::process::exit(2);
     }
 }

@@ -176,7 +176,7 @@ fn clear_errors() {
         ),
         (
             &["info", "nsection", "--n", "0"],
-            &["--n must be at least 1"],
+            &["'--n <N>': must be at least 1"],
         ),
         (
             &["info", "cv2", "--n", "3"],

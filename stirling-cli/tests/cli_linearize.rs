@@ -123,7 +123,7 @@ fn malformed_requests_fail_clearly() {
     fails_with(&["linearize", "stirling9"], "unknown model `stirling9`");
     fails_with(
         &["linearize", "nsection", "--n", "0"],
-        "--n must be at least 1",
+        "invalid value '0' for '--n <N>': must be at least 1",
     );
     fails_with(
         &["linearize", "schmidt", "--set", "Tx=3"],
@@ -153,6 +153,6 @@ fn malformed_requests_fail_clearly() {
         &[
             "locus", "schmidt", "--param", "Th", "--from", "500", "--to", "600", "--steps", "0",
         ],
-        "--steps must be at least 1",
+        "invalid value '0' for '--steps <STEPS>': must be at least 1",
     );
 }

@@ -123,14 +123,26 @@ impl Measured {
     }
 }
 
-/// `a:b` as two times (either may be empty: start or end of the record).
-pub fn parse_span(s: &str, rec: &Measured) -> Result<(f64, f64), String> {
-    let (a, b) = s
-        .split_once(':')
-        .ok_or_else(|| format!("bad time span `{s}`: expected a:b in seconds, e.g. 0:0.6"))?;
+/// A malformed `a:b` time span.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum SpanError {
+    #[error("expected a:b in seconds, e.g. 0:0.6")]
+    Syntax,
+    #[error("`{0}` is not a finite number of seconds")]
+    Time(String),
+    #[error("the block is empty: its end must be after its start")]
+    Empty,
+    #[error("the block reaches outside the record, which runs from {t0} s to {t1} s")]
+    Outside { t0: f64, t1: f64 },
+}
+
+/// `a:b` as two times inside the record (either may be empty: start or end of the record);
+/// one sample interval of slack is allowed at each end.
+pub fn parse_span(s: &str, rec: &Measured) -> Result<(f64, f64), SpanError> {
+    let (a, b) = s.split_once(':').ok_or(SpanError::Syntax)?;
     let t0 = rec.t.first().copied().unwrap_or(0.0);
     let t1 = rec.t.last().copied().unwrap_or(0.0);
-    let num = |x: &str, d: f64| -> Result<f64, String> {
+    let num = |x: &str, d: f64| -> Result<f64, SpanError> {
         if x.trim().is_empty() {
             Ok(d)
         } else {
@@ -138,14 +150,16 @@ pub fn parse_span(s: &str, rec: &Measured) -> Result<(f64, f64), String> {
                 .parse::<f64>()
                 .ok()
                 .filter(|v| v.is_finite())
-                .ok_or_else(|| format!("bad time `{x}` in span `{s}`"))
+                .ok_or_else(|| SpanError::Time(x.trim().to_string()))
         }
     };
     let (a, b) = (num(a, t0)?, num(b, t1)?);
     if !(b > a) {
-        return Err(format!(
-            "empty time span `{s}`: the end must be after the start"
-        ));
+        return Err(SpanError::Empty);
+    }
+    let slack = if rec.t.len() > 1 { rec.dt() } else { 0.0 } + 1e-12 * t1.abs().max(t0.abs());
+    if a < t0 - slack || b > t1 + slack {
+        return Err(SpanError::Outside { t0, t1 });
     }
     Ok((a, b))
 }

@@ -1,0 +1,100 @@
+//! Value parsers for the numeric options: each refuses a value outside its range with a
+//! message clap prefixes with the option and the value (`invalid value '-1' for '--n <N>'`).
+//! Options that may receive a negative number are declared `allow_negative_numbers`, so that
+//! the range check, not clap's "unexpected argument", answers.
+
+/// The largest `--samples`.
+pub const MAX_SAMPLES: usize = 1_000_000;
+
+fn number(s: &str) -> Result<f64, String> {
+    let v: f64 = s
+        .trim()
+        .parse()
+        .map_err(|_| format!("`{s}` is not a number"))?;
+    if !v.is_finite() {
+        return Err(format!("`{s}` is not a finite number"));
+    }
+    Ok(v)
+}
+
+/// An integer, also written as `1e5`.
+fn integer(s: &str) -> Result<f64, String> {
+    let v = number(s)?;
+    if v.fract() != 0.0 {
+        return Err(format!("`{s}` is not a whole number"));
+    }
+    Ok(v)
+}
+
+/// Any finite number.
+pub fn finite(s: &str) -> Result<f64, String> {
+    number(s)
+}
+
+/// A finite number > 0.
+pub fn positive(s: &str) -> Result<f64, String> {
+    let v = number(s)?;
+    if v <= 0.0 {
+        return Err("must be a finite number > 0".into());
+    }
+    Ok(v)
+}
+
+/// A solver tolerance in (0, 0.1].
+pub fn tolerance(s: &str) -> Result<f64, String> {
+    let v = number(s)?;
+    if !(v > 0.0 && v <= 0.1) {
+        return Err("a tolerance must lie in (0, 0.1], e.g. 1e-7".into());
+    }
+    Ok(v)
+}
+
+/// A count >= 1 (sections, steps).
+pub fn at_least_one(s: &str) -> Result<usize, String> {
+    let v = integer(s)?;
+    if v < 1.0 {
+        return Err("must be at least 1".into());
+    }
+    if v > 1e9 {
+        return Err("is too large".into());
+    }
+    Ok(v as usize)
+}
+
+/// A number of output samples in [2, MAX_SAMPLES].
+pub fn samples(s: &str) -> Result<usize, String> {
+    let v = integer(s)?;
+    if !(2.0..=MAX_SAMPLES as f64).contains(&v) {
+        return Err(format!(
+            "must lie between 2 and {MAX_SAMPLES} (a record needs two samples; more than 1e6 is not a plot or a CSV one can use)"
+        ));
+    }
+    Ok(v as usize)
+}
+
+/// A number of cycles >= 1 (multiple-shooting segments).
+pub fn cycles(s: &str) -> Result<f64, String> {
+    let v = number(s)?;
+    if v < 1.0 {
+        return Err("must be at least 1 cycle per segment".into());
+    }
+    Ok(v)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn ranges() {
+        assert_eq!(tolerance("1e-7"), Ok(1e-7));
+        assert!(tolerance("0").is_err() && tolerance("1").is_err() && tolerance("-1").is_err());
+        assert!(tolerance("nan").is_err());
+        assert_eq!(samples("1e5"), Ok(100_000));
+        assert!(samples("1e8").is_err() && samples("1").is_err() && samples("2.5").is_err());
+        assert_eq!(at_least_one("3"), Ok(3));
+        assert!(at_least_one("0").is_err() && at_least_one("-1").is_err());
+        assert!(positive("-1").is_err() && positive("inf").is_err());
+        assert!(cycles("0.5").is_err() && cycles("2").is_ok());
+    }
+}
