@@ -136,7 +136,11 @@ pub fn run(a: &DiagnoseArgs) -> anyhow::Result<()> {
         } else {
             let mut o = common::stdout();
             writeln!(o, "{}", selfcheck::matrix_markdown(&sc))?;
-            writeln!(o, "{}/{} cases pass, {:.1} s", sc.passed, sc.total, sc.seconds)?;
+            writeln!(
+                o,
+                "{}/{} cases pass, {:.1} s",
+                sc.passed, sc.total, sc.seconds
+            )?;
         }
         if sc.passed < sc.total {
             bail!(

@@ -61,7 +61,8 @@ pub fn run(args: &SimulateArgs) -> anyhow::Result<()> {
     let model = model.as_ref();
     check_outputs(args, model)?;
     let x0 = initial_state(model, &p, args)?;
-    let samples = sim::uniform_samples(args.t_end, args.samples);
+    // `--samples` counts the rows: the first at 0, the last at t_end
+    let samples = sim::uniform_samples(args.t_end, args.samples - 1);
     let opts = SimOptions {
         rtol: args.rtol,
         atol: args.atol.unwrap_or(args.rtol),
@@ -230,13 +231,7 @@ fn plots(
     let title = format!("{} (n = {})", model.name(), model.n());
     let startup = dir.join("startup.svg");
     stirling_models::plot::timeseries::startup_svg(
-        &startup,
-        &title,
-        &tr.t,
-        &tr.x,
-        ix,
-        iy,
-        &pressures,
+        &startup, &title, &tr.t, &tr.x, ix, iy, &pressures,
     )
     .map_err(anyhow::Error::msg)?;
     files::wrote(&startup);

@@ -20,7 +20,11 @@ fn closed_stdout(args: &[&str]) {
         !err.contains("panicked") && !err.contains("Broken pipe") && !err.contains("error"),
         "{args:?}: stderr `{err}`"
     );
-    assert!(out.status.success(), "{args:?}: {:?}, stderr `{err}`", out.status);
+    assert!(
+        out.status.success(),
+        "{args:?}: {:?}, stderr `{err}`",
+        out.status
+    );
 }
 
 #[test]

@@ -38,10 +38,7 @@ pub fn prepare_file(path: &Path, force: bool, option: &str) -> anyhow::Result<()
 /// `dir`, and create it. Without `force`, any existing file matching a pattern is refused.
 pub fn prepare_dir(dir: &Path, patterns: &[&str], force: bool, option: &str) -> anyhow::Result<()> {
     if dir.exists() && !dir.is_dir() {
-        bail!(
-            "{option} {}: is a file, expected a folder",
-            dir.display()
-        );
+        bail!("{option} {}: is a file, expected a folder", dir.display());
     }
     create_dir(dir, option)?;
     if force {
