@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Context};
 use clap::Args;
-use stirling_models::data::read_csv;
+use stirling_models::data::{check_uniform, read_csv_lines};
 use stirling_models::diagnose::{self, selfcheck, DiagnoseOptions, Diagnosis};
 
 use crate::common::{self, files, ranges};
@@ -157,7 +157,8 @@ pub fn run(a: &DiagnoseArgs) -> anyhow::Result<()> {
     if let Some(dir) = &a.report {
         files::prepare_dir(dir, &REPORT, a.force, "--report")?;
     }
-    let data = read_csv(path)?;
+    let (data, lines) = read_csv_lines(path)?;
+    check_uniform(&data, Some(&lines))?;
     let (train, holdout) = common::blocks(a.train.as_deref(), a.holdout.as_deref(), &data, 0.6)?;
     let (model, mut p0) = diagnose::nominal_model(model_name, a.n)?;
     if let Some(f) = &a.params {

@@ -7,7 +7,7 @@ use std::path::{Path, PathBuf};
 use anyhow::Context;
 use clap::Args;
 use stirling_dsl::Closure;
-use stirling_models::data::read_csv;
+use stirling_models::data::{check_uniform, read_csv_lines};
 use stirling_models::fit::{self, report::plot_series, FitOptions, Identification};
 
 use crate::common::{self, files, ranges};
@@ -60,7 +60,8 @@ pub fn run(a: &FitArgs) -> anyhow::Result<()> {
     if let Some(dir) = &a.plot {
         files::prepare_dir(dir, &FIGURES, a.force, "--plot")?;
     }
-    let data = read_csv(&a.data)?;
+    let (data, lines) = read_csv_lines(&a.data)?;
+    check_uniform(&data, Some(&lines))?;
     let (train, holdout) = common::blocks(a.train.as_deref(), a.holdout.as_deref(), &data, 0.7)?;
     let model = stirling_models::build(&a.model, a.n, Closure::Full)?;
     let p0 = stirling_models::params::load(model.as_ref(), a.params.as_deref(), &a.set)

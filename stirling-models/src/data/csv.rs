@@ -3,29 +3,63 @@
 use std::io::Write;
 use std::path::Path;
 
+use super::text::{fixed4, format_hint, names as list, quote, short};
 use super::{DataError, Measured, CHANNELS};
 
 /// Read a measured record from a file.
 pub fn read_csv(path: &Path) -> Result<Measured, DataError> {
+    read_csv_lines(path).map(|(m, _)| m)
+}
+
+/// Read a measured record and the file line of each sample (for messages about samples).
+pub fn read_csv_lines(path: &Path) -> Result<(Measured, Vec<usize>), DataError> {
     let file = path.display().to_string();
-    let text = std::fs::read_to_string(path).map_err(|e| DataError {
+    let bytes = std::fs::read(path).map_err(|e| DataError {
         file: file.clone(),
         row: 0,
         column: String::new(),
         message: format!("cannot read the file: {e}"),
     })?;
-    parse_csv(&file, &text)
+    parse(&file, text(&file, &bytes)?)
+}
+
+/// Parse a measured record from bytes (UTF-8, an optional byte-order mark); `file` labels
+/// the errors.
+pub fn parse_csv_bytes(file: &str, bytes: &[u8]) -> Result<Measured, DataError> {
+    parse(file, text(file, bytes)?).map(|(m, _)| m)
 }
 
 /// Parse a measured record; `file` labels the errors.
 pub fn parse_csv(file: &str, text: &str) -> Result<Measured, DataError> {
+    parse(file, text).map(|(m, _)| m)
+}
+
+fn text<'a>(file: &str, bytes: &'a [u8]) -> Result<&'a str, DataError> {
+    std::str::from_utf8(bytes).map_err(|e| {
+        let at = e.valid_up_to();
+        let line = 1 + bytes[..at].iter().filter(|&&b| b == b'\n').count();
+        DataError {
+            file: file.to_string(),
+            row: line,
+            column: String::new(),
+            message: format!(
+                "not a text file: invalid UTF-8 at byte {at}{}",
+                format_hint(file, "")
+            ),
+        }
+    })
+}
+
+fn parse(file: &str, text: &str) -> Result<(Measured, Vec<usize>), DataError> {
     let err = |row: usize, column: &str, message: String| DataError {
         file: file.to_string(),
         row,
         column: column.to_string(),
         message,
     };
-    let mut lines = text
+    // an invisible byte-order mark would otherwise glue itself to the first column name
+    let body = text.strip_prefix('\u{feff}').unwrap_or(text);
+    let mut lines = body
         .lines()
         .enumerate()
         .map(|(i, l)| (i + 1, l.trim()))
@@ -56,8 +90,9 @@ pub fn parse_csv(file: &str, text: &str) -> Result<Measured, DataError> {
             hrow,
             "t",
             format!(
-                "missing column `t` (time in s); the header has: {}",
-                names.join(", ")
+                "missing column `t` (time in s); the header has: {}{}",
+                list(&names),
+                format_hint(file, body)
             ),
         ));
     };
@@ -66,7 +101,7 @@ pub fn parse_csv(file: &str, text: &str) -> Result<Measured, DataError> {
         .filter_map(|c| names.iter().position(|n| n == c).map(|i| (i, *c)))
         .collect();
     if cols.is_empty() {
-        return Err(err(hrow, "p", format!("no measured channel: expected at least one of the columns p, p_hot, x, y; the header has: {}", names.join(", "))));
+        return Err(err(hrow, "p", format!("no measured channel: expected at least one of the columns p, p_hot, x, y; the header has: {}{}", list(&names), format_hint(file, body))));
     }
     let mut t = Vec::new();
     let mut data: Vec<Vec<f64>> = vec![Vec::new(); cols.len()];
@@ -85,31 +120,29 @@ pub fn parse_csv(file: &str, text: &str) -> Result<Measured, DataError> {
                     ),
                 ));
             };
-            if s.is_empty() {
-                return Err(err(row, name, "empty value: expected a number".into()));
-            }
-            let v: f64 = s
-                .parse()
-                .map_err(|_| err(row, name, format!("not a number: `{s}`")))?;
-            if !v.is_finite() {
-                return Err(err(
-                    row,
-                    name,
-                    format!("NaN or infinite value `{s}`: expected a finite number"),
-                ));
-            }
-            Ok(v)
+            number(s).map_err(|m| err(row, name, m))
         };
         let tv = get(it, "t")?;
         if let Some(&prev) = t.last() {
             if tv == prev {
-                return Err(err(row, "t", format!("duplicate time {tv} (same as the previous row): time must increase strictly")));
+                return Err(err(
+                    row,
+                    "t",
+                    format!(
+                        "duplicate time {} (same as the previous row): time must increase strictly",
+                        short(tv)
+                    ),
+                ));
             }
             if tv < prev {
                 return Err(err(
                     row,
                     "t",
-                    format!("time goes backwards ({tv} after {prev}): time must increase strictly"),
+                    format!(
+                        "time goes backwards ({} after {}): time must increase strictly",
+                        short(tv),
+                        short(prev)
+                    ),
                 ));
             }
         }
@@ -136,12 +169,13 @@ pub fn parse_csv(file: &str, text: &str) -> Result<Measured, DataError> {
     };
     for (k, (_, name)) in cols.iter().enumerate() {
         let v = std::mem::take(&mut data[k]);
-        check_units(name, &v).map_err(|msg| {
-            err(
+        check_units(name, &v).map_err(|(at, msg)| match at {
+            Some(i) => err(rows[i], name, msg),
+            None => err(
                 rows[0],
                 name,
                 format!("{msg} (rows {}-{})", rows[0], rows[rows.len() - 1]),
-            )
+            ),
         })?;
         *match *name {
             "p" => &mut m.p,
@@ -150,7 +184,30 @@ pub fn parse_csv(file: &str, text: &str) -> Result<Measured, DataError> {
             _ => &mut m.y,
         } = Some(v);
     }
-    Ok(m)
+    Ok((m, rows))
+}
+
+/// A finite number, or why not.
+fn number(s: &str) -> Result<f64, String> {
+    if s.is_empty() {
+        return Err("empty value: expected a number".into());
+    }
+    let v: f64 = s
+        .parse()
+        .map_err(|_| format!("not a number: {}", quote(s)))?;
+    if v.is_finite() {
+        Ok(v)
+    } else if s.to_ascii_lowercase().contains("n") {
+        Err(format!(
+            "NaN or infinite value {}: expected a finite number",
+            quote(s)
+        ))
+    } else {
+        Err(format!(
+            "{} is out of the range of a 64-bit number (about 1.8e308): expected a finite number",
+            quote(s)
+        ))
+    }
 }
 
 fn median(v: &[f64]) -> f64 {
@@ -159,31 +216,58 @@ fn median(v: &[f64]) -> f64 {
     s[s.len() / 2]
 }
 
-/// Units off by orders of magnitude: absolute pressure in Pa lies in 5e3..5e7 (an engine
-/// charged between a twentieth of an atmosphere and 500 bar); positions in m within 0.5 m.
-fn check_units(name: &str, v: &[f64]) -> Result<(), String> {
+/// The largest absolute pressure taken as a measurement (Pa): 10 kbar.
+const P_MAX: f64 = 1e9;
+/// The largest position magnitude (m).
+const X_MAX: f64 = 0.5;
+
+/// Units off by orders of magnitude (judged on the median: the whole column, `None`), then
+/// single values out of range (`Some(index)`). Absolute pressure in Pa lies in 5e3..5e7 (an
+/// engine charged between a twentieth of an atmosphere and 500 bar); positions in m within
+/// 0.5 m.
+fn check_units(name: &str, v: &[f64]) -> Result<(), (Option<usize>, String)> {
+    let first = |bad: &dyn Fn(f64) -> bool| v.iter().position(|&x| bad(x));
     match name {
         "p" | "p_hot" => {
             let m = median(v);
-            if m <= 0.0 {
-                Err(format!("pressure must be absolute (Pa, > 0); median is {m:.4}: gauge pressure? add the ambient pressure"))
+            let whole = if m <= 0.0 {
+                Some(format!("pressure must be absolute (Pa, > 0); median is {}: gauge pressure? add the ambient pressure", fixed4(m)))
             } else if m < 5.0e1 {
-                Err(format!("pressure looks like bar or MPa (median {m:.4}): expected absolute pressure in Pa, e.g. 101325"))
+                Some(format!("pressure looks like bar or MPa (median {}): expected absolute pressure in Pa, e.g. 101325", fixed4(m)))
             } else if m < 5.0e3 {
-                Err(format!("pressure looks like kPa (median {m:.4}): expected absolute pressure in Pa, e.g. 101325"))
+                Some(format!("pressure looks like kPa (median {}): expected absolute pressure in Pa, e.g. 101325", fixed4(m)))
             } else if m > 5.0e7 {
-                Err(format!("pressure too large for Pa (median {m:.4e}): expected absolute pressure in Pa, e.g. 101325"))
+                Some(format!("pressure too large for Pa (median {:.4e}): expected absolute pressure in Pa, e.g. 101325", m))
             } else {
-                Ok(())
+                None
+            };
+            if let Some(msg) = whole {
+                return Err((None, msg));
             }
+            if let Some(i) = first(&|x| x <= 0.0) {
+                return Err((
+                    Some(i),
+                    format!(
+                        "pressure {} Pa: pressure must be absolute (> 0)",
+                        short(v[i])
+                    ),
+                ));
+            }
+            if let Some(i) = first(&|x| x > P_MAX) {
+                return Err((Some(i), format!("pressure {} Pa is out of range (at most {P_MAX:.0e} Pa; the median is {}): a corrupt value?", short(v[i]), fixed4(m))));
+            }
+            Ok(())
         }
         _ => {
-            let peak = v.iter().fold(0.0f64, |a, b| a.max(b.abs()));
-            if peak > 0.5 {
-                Err(format!("position looks like mm (largest magnitude {peak:.4}): expected metres, e.g. 0.005 for 5 mm"))
-            } else {
-                Ok(())
+            let mags: Vec<f64> = v.iter().map(|x| x.abs()).collect();
+            if median(&mags) > X_MAX {
+                let peak = mags.iter().fold(0.0f64, |a, &b| a.max(b));
+                return Err((None, format!("position looks like mm (largest magnitude {}): expected metres, e.g. 0.005 for 5 mm", fixed4(peak))));
             }
+            if let Some(i) = first(&|x| x.abs() > X_MAX) {
+                return Err((Some(i), format!("position {} m is out of range (|{name}| <= {X_MAX} m; the median magnitude is {}): a corrupt value?", short(v[i]), fixed4(median(&mags)))));
+            }
+            Ok(())
         }
     }
 }

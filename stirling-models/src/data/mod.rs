@@ -6,8 +6,11 @@
 
 mod csv;
 pub mod offsets;
+mod sampling;
+mod text;
 
-pub use csv::{parse_csv, read_csv, write_csv};
+pub use csv::{parse_csv, parse_csv_bytes, read_csv, read_csv_lines, write_csv};
+pub use sampling::{check_uniform, UNIFORM_TOLERANCE};
 pub use offsets::{cycle_mean, remove_position_offsets, PositionOffsets};
 
 use std::fmt;
