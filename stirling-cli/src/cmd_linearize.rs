@@ -7,7 +7,9 @@ use std::path::{Path, PathBuf};
 
 use anyhow::Context;
 use clap::Args;
+use serde::Serialize;
 use stirling_dsl::Model;
+use stirling_models::linear::export::{self, StateSpaceExport};
 use stirling_models::linear::{self, bode, LinearOptions, LinearReport, Linearization, Pole};
 use stirling_models::plot;
 
@@ -25,21 +27,36 @@ pub struct LinearizeArgs {
     /// displacer); default: pressure where there is one, else piston
     #[arg(long)]
     pub channel: Option<String>,
-    /// Machine-readable output (the LinearReport)
+    /// Machine-readable output: the report and, as `state_space`, the export of --ss
     #[arg(long)]
     pub json: bool,
+    /// Write the state-space A, B, C, D of the broken and the closed loop, the Bode data and
+    /// the pole tables as JSON (python-control and MATLAB read it; see the user guide)
+    #[arg(long, value_name = "FILE")]
+    pub ss: Option<PathBuf>,
     /// Write poles.svg and bode.svg into this directory (created if missing)
     #[arg(long)]
     pub plot: Option<PathBuf>,
-    /// Overwrite existing figures
+    /// Overwrite existing figures and an existing --ss file
     #[arg(long)]
     pub force: bool,
+}
+
+/// `--json`: the report with the state-space export.
+#[derive(Serialize)]
+struct Json<'a> {
+    #[serde(flatten)]
+    report: &'a LinearReport,
+    state_space: &'a StateSpaceExport,
 }
 
 /// Run the analysis and print it.
 pub fn run(a: &LinearizeArgs) -> anyhow::Result<()> {
     if let Some(dir) = &a.plot {
         files::prepare_dir(dir, &FIGURES, a.force, "--plot")?;
+    }
+    if let Some(f) = &a.ss {
+        files::prepare_file(f, a.force, "--ss")?;
     }
     let (model, p) = a.model.load()?;
     let opts = LinearOptions {
@@ -52,8 +69,15 @@ pub fn run(a: &LinearizeArgs) -> anyhow::Result<()> {
     if let Some(dir) = &a.plot {
         plots(dir, model.as_ref(), &lin)?;
     }
-    if a.json {
-        common::print_json(&report)
+    let ss = (a.json || a.ss.is_some()).then(|| export::export(model.as_ref(), &lin));
+    if let (Some(f), Some(ss)) = (&a.ss, &ss) {
+        files::write_text(f, &serde_json::to_string_pretty(ss)?, a.force, "--ss")?;
+    }
+    if let (true, Some(ss)) = (a.json, &ss) {
+        common::print_json(&Json {
+            report: &report,
+            state_space: ss,
+        })
     } else {
         Ok(print_text(&mut common::stdout(), &report)?)
     }

@@ -15,6 +15,7 @@
 pub mod balance;
 pub mod bode;
 pub mod equilibrium;
+pub mod export;
 pub mod locus;
 pub mod loop_break;
 pub mod margins;
