@@ -5,13 +5,15 @@ use std::path::PathBuf;
 use clap::Args;
 use stirling_models::rig::{self, RigConfig};
 
+use crate::common::ranges;
+
 /// Arguments of `stirling rig`.
 #[derive(Args, Debug)]
 pub struct RigArgs {
     /// Base model: cv1 or nsection (aliases order5, order7, order8)
     pub model: String,
     /// Number of regenerator sections (nsection)
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true, value_parser = ranges::at_least_one)]
     pub n: Option<usize>,
     /// Effect or effect parameter, e.g. --effect leak=2e-8 --effect xmax=0.004 (repeatable);
     /// effects: leak, coulomb, regen_quadratic, end_stops, sensor_lag, sensor_gain
@@ -21,31 +23,31 @@ pub struct RigArgs {
     #[arg(long = "set", value_name = "NAME=VALUE")]
     pub set: Vec<String>,
     /// Record length (s)
-    #[arg(long, default_value_t = 1.0)]
+    #[arg(long, default_value_t = 1.0, allow_negative_numbers = true, value_parser = ranges::finite)]
     pub t_end: f64,
     /// Simulated time discarded before the record starts (s)
-    #[arg(long, default_value_t = 0.0)]
+    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true, value_parser = ranges::finite)]
     pub settle: f64,
     /// Sample rate (Hz)
-    #[arg(long, default_value_t = 2000.0)]
+    #[arg(long, default_value_t = 2000.0, allow_negative_numbers = true, value_parser = ranges::finite)]
     pub rate: f64,
     /// Pressure noise standard deviation (Pa)
-    #[arg(long, default_value_t = 50.0)]
+    #[arg(long, default_value_t = 50.0, allow_negative_numbers = true, value_parser = ranges::finite)]
     pub noise_p: f64,
     /// Position noise standard deviation (m)
-    #[arg(long, default_value_t = 20e-6)]
+    #[arg(long, default_value_t = 20e-6, allow_negative_numbers = true, value_parser = ranges::finite)]
     pub noise_x: f64,
     /// Pressure sensor offset (Pa), on p and p_hot
-    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
+    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true, value_parser = ranges::finite)]
     pub offset_p: f64,
     /// Displacer position sensor offset (m)
-    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
+    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true, value_parser = ranges::finite)]
     pub offset_x: f64,
     /// Piston position sensor offset (m)
-    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
+    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true, value_parser = ranges::finite)]
     pub offset_y: f64,
     /// Initial displacer displacement from rest (m)
-    #[arg(long, default_value_t = 2e-3, allow_hyphen_values = true)]
+    #[arg(long, default_value_t = 2e-3, allow_negative_numbers = true, value_parser = ranges::finite)]
     pub x0: f64,
     /// Noise seed
     #[arg(long, default_value_t = 1)]

@@ -163,3 +163,29 @@ fn multiple_shooting_and_finite_values() {
         &["--x0", "`nan`", "finite"],
     );
 }
+
+#[test]
+fn rig_negative_values_reach_the_range_check() {
+    let dir = scratch("rig_ranges");
+    let out = dir.join("r.csv");
+    let rig = |extra: &[&'static str]| -> Vec<String> {
+        ["rig", "cv1", "--out", s(&out)]
+            .iter()
+            .map(|a| a.to_string())
+            .chain(extra.iter().map(|a| a.to_string()))
+            .collect()
+    };
+    let run = |extra: &[&'static str], needles: &[&str]| {
+        let args = rig(extra);
+        let args: Vec<&str> = args.iter().map(String::as_str).collect();
+        let err = fails_with(&args, needles);
+        assert!(!err.contains("unexpected argument"), "{args:?}: {err}");
+    };
+    run(&["--t-end", "-1"], &["--t-end", "-1"]);
+    run(&["--rate", "-5"], &["--rate", "-5"]);
+    run(&["--settle", "-1"], &["--settle", "-1"]);
+    run(&["--noise-p", "-1"], &["--noise-p", "-1"]);
+    run(&["--n", "-1"], &["'--n <N>': must be at least 1"]);
+    run(&["--offset-p", "nan"], &["--offset-p", "finite"]);
+    assert!(!out.exists());
+}
