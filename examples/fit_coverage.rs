@@ -7,7 +7,7 @@
 //! Prints per parameter the coverage and the median interval width relative to the value,
 //! and the free run's amplitude and frequency errors on the held-out block.
 //!
-//!     cargo run --release --example fit_coverage -- [--seeds 20] [--n 2] [--t-end 3]
+//!     cargo run --release --example fit_coverage -- [--seeds 20] [--first 1] [--n 2] [--t-end 3]
 //!                                                   [--perturb 0.08] [--threads 2]
 
 use std::sync::Mutex;
@@ -20,6 +20,7 @@ use stirling::models::rig::{self, RigConfig};
 const FREE: [&str; 7] = ["kd", "kp", "bd", "bp", "hh", "hk", "Rf"];
 
 struct Args {
+    first: u64,
     seeds: u64,
     n: usize,
     t_end: f64,
@@ -29,6 +30,7 @@ struct Args {
 
 fn args() -> Result<Args, String> {
     let mut a = Args {
+        first: 1,
         seeds: 20,
         n: 2,
         t_end: 3.0,
@@ -41,6 +43,7 @@ fn args() -> Result<Args, String> {
         let bad = |_| format!("bad value `{val}` for {}", w[0]);
         match w[0].as_str() {
             "--seeds" => a.seeds = val.parse().map_err(bad)?,
+            "--first" => a.first = val.parse().map_err(bad)?,
             "--n" => a.n = val.parse().map_err(bad)?,
             "--t-end" => a.t_end = val.parse().map_err(|_| format!("bad --t-end {val}"))?,
             "--perturb" => a.perturb = val.parse().map_err(|_| format!("bad --perturb {val}"))?,
@@ -81,6 +84,11 @@ fn one(seed: u64, a: &Args) -> Result<Outcome, String> {
         ..Default::default()
     };
     let id = fit::identify(model.as_ref(), &p0, &out.data, &opts).map_err(|e| e.to_string())?;
+    for st in [&id.stage1, &id.stage2].into_iter().flatten() {
+        if !st.converged {
+            eprintln!("seed {seed}: {} did not converge in {} iterations", st.stage, st.iterations);
+        }
+    }
     let mut per = Vec::new();
     for name in FREE {
         let truth = out.truth.parameters[name];
@@ -89,6 +97,12 @@ fn one(seed: u64, a: &Args) -> Result<Outcome, String> {
             .flatten()
             .find_map(|s| s.estimate(name))
             .ok_or(format!("{name} not estimated"))?;
+        if !e.covers(truth) {
+            eprintln!(
+                "seed {seed}: {name} {:.5e} [{:.5e}, {:.5e}], truth {truth:.5e}, start {:.5e}",
+                e.value, e.ci_low, e.ci_high, e.initial
+            );
+        }
         per.push((
             e.covers(truth),
             (e.ci_high - e.ci_low) / truth.abs(),
@@ -120,7 +134,7 @@ fn main() {
         }
     };
     let results: Mutex<Vec<(u64, Result<Outcome, String>)>> = Mutex::new(Vec::new());
-    let next = Mutex::new(1u64);
+    let next = Mutex::new(a.first);
     std::thread::scope(|s| {
         for _ in 0..a.threads.max(1) {
             s.spawn(|| loop {
@@ -130,7 +144,7 @@ fn main() {
                     *g += 1;
                     k
                 };
-                if seed > a.seeds {
+                if seed >= a.first + a.seeds {
                     break;
                 }
                 let r = one(seed, &a);

@@ -2,6 +2,8 @@
 
 use std::path::PathBuf;
 
+use std::io::Write;
+
 use clap::Args;
 use stirling_models::rig::{self, RigConfig};
 
@@ -92,14 +94,21 @@ pub fn run(a: &RigArgs) -> anyhow::Result<()> {
         }
     }
     let out = rig::run(&cfg)?;
+    if let Some(dir) = a.out.parent().filter(|d| !d.as_os_str().is_empty()) {
+        std::fs::create_dir_all(dir)
+            .map_err(|e| anyhow::anyhow!("cannot create `{}`: {e}", dir.display()))?;
+    }
     let side = rig::write(&out, &a.out, a.force)?;
+    let mut o = crate::common::stdout();
     if a.json {
-        println!(
+        writeln!(
+            o,
             "{}",
             serde_json::json!({ "csv": a.out, "truth": side, "samples": out.data.len(), "channels": out.data.channels(), "model": out.truth.model, "active_effects": out.truth.active_effects })
-        );
+        )?;
     } else {
-        println!(
+        writeln!(
+            o,
             "wrote {} ({} samples, channels t,{}) and {}; truth model {} with effects: {}",
             a.out.display(),
             out.data.len(),
@@ -111,7 +120,7 @@ pub fn run(a: &RigArgs) -> anyhow::Result<()> {
             } else {
                 out.truth.active_effects.join(", ")
             }
-        );
+        )?;
     }
     Ok(())
 }

@@ -78,6 +78,9 @@ pub fn noise_sigma(y: &[f64]) -> f64 {
     d[d.len() / 2] / 0.6745 / 20f64.sqrt()
 }
 
+/// Lowest ratio of a positive model parameter to its starting value that a stage simulates.
+pub const MIN_RATIO: f64 = 0.02;
+
 /// One fit variable.
 #[derive(Clone, Debug)]
 pub struct Var {
@@ -303,6 +306,17 @@ impl Stage<'_> {
         for (k, (v, &val)) in self.vars.iter().zip(&th).enumerate() {
             match &v.kind {
                 VarKind::Param(i) => {
+                    if sens && v.initial > 0.0 && val < MIN_RATIO * v.initial {
+                        // a positive parameter far below its start (a regenerator resistance
+                        // near zero) makes the model arbitrarily stiff: refuse the trial
+                        // point instead of integrating it for minutes (optimizer steps only:
+                        // they are the runs with sensitivities)
+                        return Err(FitError::ParamRange {
+                            name: v.name.clone(),
+                            value: val,
+                            floor: MIN_RATIO * v.initial,
+                        });
+                    }
                     p[*i] = val;
                     col_of[k] = Some(columns.len());
                     columns.push(Column::Param {
@@ -363,7 +377,16 @@ impl Stage<'_> {
         let x0 = sys.initial(&z0);
         let samples: Vec<f64> = (0..=last - first).map(|k| k as f64 * self.dt).collect();
         let t_end = samples[samples.len() - 1].max(self.dt);
-        let traj = integrate(&sys, &x0, t_end, &samples, &self.sim, Hooks::default())
+        let sim = if std::env::var_os("STIRLING_DENSE_SENS").is_none() && sys.columns.len() >= 2 {
+            // block-diagonal Newton matrix: the sparse LU factors the blocks one by one
+            SimOptions {
+                linear_solver: crate::sim::LinearSolverKind::Sparse,
+                ..self.sim
+            }
+        } else {
+            self.sim
+        };
+        let traj = integrate(&sys, &x0, t_end, &samples, &sim, Hooks::default())
             .map_err(|e| FitError::Sim(self.name.to_string(), e.to_string()))?;
         let nz = self.free.len();
         let mut yhat = vec![Vec::new(); self.outputs.len()];

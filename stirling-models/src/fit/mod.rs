@@ -47,17 +47,14 @@ pub enum FitError {
     NotInEquations { name: String, model: String },
     #[error("{file}: {samples} samples are too few to fit")]
     TooFewSamples { file: String, samples: usize },
-    #[error("{file}: the fit needs uniform sampling; the interval ending at t = {t} is {interval}, the mean {mean}")]
-    NonUniform {
-        file: String,
-        t: f64,
-        interval: f64,
-        mean: f64,
-    },
+    #[error(transparent)]
+    Sampling(crate::data::DataError),
     #[error("the training block {from}:{to} holds {samples} samples, fewer than 11")]
     ShortTraining { from: f64, to: f64, samples: usize },
     #[error("{file}: {stage} needs the columns p, x and y")]
     MissingColumns { file: String, stage: &'static str },
+    #[error("parameter `{name}` = {value:.4e} fell below {floor:.4e} (2 % of its start): the data push it out of the physical range")]
+    ParamRange { name: String, value: f64, floor: f64 },
     #[error("stage 1 expects two bodies (displacer x, piston y); `{model}` has {found}")]
     Bodies { model: String, found: usize },
 }

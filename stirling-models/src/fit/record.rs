@@ -114,18 +114,7 @@ fn uniform(data: &Measured) -> Result<(f64, f64), FitError> {
             samples: data.t.len(),
         });
     }
-    let dt = data.dt();
-    for k in 1..data.t.len() {
-        let d = data.t[k] - data.t[k - 1];
-        if (d - dt).abs() > 1e-3 * dt {
-            return Err(FitError::NonUniform {
-                file: data.source.clone(),
-                t: data.t[k],
-                interval: d,
-                mean: dt,
-            });
-        }
-    }
+    let dt = crate::data::check_uniform(data, None).map_err(FitError::Sampling)?;
     Ok((data.t[0], dt))
 }
 

@@ -125,6 +125,34 @@ impl Driven<'_> {
     }
 }
 
+impl Driven<'_> {
+    /// Call `f(row, col, value)` for every entry of the augmented Jacobian: the free-state
+    /// block of `df/dx` repeated along the diagonal.
+    fn for_each_block_entry(&self, t: f64, xa: &[f64], mut f: impl FnMut(usize, usize, f64)) {
+        let nz = self.free.len();
+        let n = self.model.n_states();
+        let x = self.full_state(t, &xa[..nz]);
+        let mut j = vec![0.0; n * n];
+        self.model.jacobian(
+            &self.p,
+            &x,
+            t,
+            &mut JacSink::Dense {
+                data: &mut j,
+                nrows: n,
+            },
+        );
+        for b in 0..=self.columns.len() {
+            let off = b * nz;
+            for (c, &ic) in self.free.iter().enumerate() {
+                for (r, &ir) in self.free.iter().enumerate() {
+                    f(off + r, off + c, j[ir + n * ic]);
+                }
+            }
+        }
+    }
+}
+
 impl OdeSystem for Driven<'_> {
     fn dim(&self) -> usize {
         self.free.len() * (1 + self.columns.len())
@@ -178,28 +206,26 @@ impl OdeSystem for Driven<'_> {
     }
 
     fn jac(&self, t: f64, xa: &[f64], jac: &mut [f64]) {
-        let nz = self.free.len();
-        let n = self.model.n_states();
         let d = self.dim();
-        let x = self.full_state(t, &xa[..nz]);
-        let mut j = vec![0.0; n * n];
-        self.model.jacobian(
-            &self.p,
-            &x,
-            t,
-            &mut JacSink::Dense {
-                data: &mut j,
-                nrows: n,
-            },
-        );
-        for b in 0..=self.columns.len() {
-            let off = b * nz;
-            for (c, &ic) in self.free.iter().enumerate() {
-                for (r, &ir) in self.free.iter().enumerate() {
-                    jac[(off + r) + (off + c) * d] += j[ir + n * ic];
-                }
-            }
-        }
+        self.for_each_block_entry(t, xa, |r, c, v| jac[r + c * d] += v);
+    }
+
+    /// Block diagonal: the free states' Jacobian block once per sensitivity column (the
+    /// staggered structure), dense within a block. The sparse LU then factors the blocks
+    /// separately, `(1 + columns) nz^3` instead of `((1 + columns) nz)^3`.
+    fn sparsity(&self) -> Option<Vec<(usize, usize)>> {
+        let nz = self.free.len();
+        Some(
+            (0..=self.columns.len())
+                .flat_map(|b| {
+                    (0..nz).flat_map(move |c| (0..nz).map(move |r| (b * nz + r, b * nz + c)))
+                })
+                .collect(),
+        )
+    }
+
+    fn jac_triplets(&self, t: f64, xa: &[f64], out: &mut Vec<(usize, usize, f64)>) {
+        self.for_each_block_entry(t, xa, |r, c, v| out.push((r, c, v)));
     }
 
     fn scale(&self) -> Vec<f64> {

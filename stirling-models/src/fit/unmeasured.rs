@@ -20,7 +20,7 @@ use super::sensitivity::Signal;
 use super::FitError;
 use crate::layout::StateLayout;
 
-/// Step of the scaled stage-2 variables for the carried covariance.
+/// Relative step of the stage-2 variables for the carried covariance.
 const DU: f64 = 0.01;
 
 /// `P_i - P_cold` of the gas stage at its variables `u`, one signal per CV (the cold one is
@@ -101,12 +101,16 @@ pub fn carried_covariance(
     };
     let nv2 = u2.len();
     let mut g = DMatrix::zeros(u1.len(), nv2);
+    let values = gas.values(u2);
     for k in 0..nv2 {
+        // relative to the value, so a parameter far below its start stays positive
+        let v = &gas.vars[k];
+        let h = DU * (values[k].abs() / v.scale.abs().max(1e-300)).clamp(1e-3, 1.0);
         let (mut ua, mut ub) = (u2.to_vec(), u2.to_vec());
-        ua[k] -= DU;
-        ub[k] += DU;
+        ua[k] -= h;
+        ub[k] += h;
         let (ra, rb) = (residuals_at(&ua)?, residuals_at(&ub)?);
-        let d = DVector::from_iterator(ra.len(), ra.iter().zip(&rb).map(|(a, b)| (b - a) / (2.0 * DU)));
+        let d = DVector::from_iterator(ra.len(), ra.iter().zip(&rb).map(|(a, b)| (b - a) / (2.0 * h)));
         let col = -(&inv * (j1.transpose() * d));
         g.set_column(k, &col);
     }
