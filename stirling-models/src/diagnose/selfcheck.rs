@@ -31,7 +31,8 @@ pub struct SelfCheckOptions {
     pub diagnose: DiagnoseOptions,
     /// Include the clean case (no added effect).
     pub clean: bool,
-    /// Channels of the rig records (see [`RigConfig::channels`]).
+    /// Channels of the rig records (see [`RigConfig::channels`]; `p_hot` is dropped for a
+    /// single-CV model).
     pub channels: Vec<String>,
 }
 
@@ -165,6 +166,14 @@ pub fn run(
         }
     }
     let (model, p_nom) = nominal_model(&opts.model, opts.n)?;
+    // `p_hot` only where the model has a hot side (more than one CV)
+    let multi_cv = crate::layout::StateLayout::of(model.as_ref()).pressures.len() > 1;
+    let channels: Vec<String> = opts
+        .channels
+        .iter()
+        .filter(|c| multi_cv || c.as_str() != "p_hot")
+        .cloned()
+        .collect();
     let label = match opts.n {
         Some(n) => format!("{} n={n}", opts.model),
         None => opts.model.clone(),
@@ -207,7 +216,7 @@ pub fn run(
             settle: opts.settle,
             rate: opts.rate,
             seed: opts.seed + k as u64,
-            channels: opts.channels.clone(),
+            channels: channels.clone(),
             ..Default::default()
         };
         let out = rig::run(&cfg).map_err(|e| DiagnoseError::Bad(format!("rig ({truth}): {e}")))?;
