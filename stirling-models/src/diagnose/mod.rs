@@ -258,7 +258,7 @@ pub struct Context<'a> {
     /// Per nominal stage: Monte Carlo draws of how input noise moves its weighted residuals.
     pub input_noise: Vec<Vec<Vec<f64>>>,
     /// Joint fits run.
-    pub fits: std::cell::Cell<usize>,
+    pub fits: std::sync::atomic::AtomicUsize,
 }
 
 /// Remove the centered moving average of half-width `h` (over the finite samples), scaled so
@@ -545,7 +545,7 @@ pub fn diagnose(
             })
             .collect::<Result<Vec<_>, _>>()
             .map_err(|e| DiagnoseError::Nominal(e.to_string()))?,
-        fits: std::cell::Cell::new(1),
+        fits: std::sync::atomic::AtomicUsize::new(1),
     };
     let all: Vec<Prediction> = ctx.nominal_preds.iter().flatten().cloned().collect();
     let nominal = ctx
@@ -571,10 +571,14 @@ pub fn diagnose(
     // trial steps of at most one typical strength: far trials (an engine stopped by friction)
     // are slow to integrate and rejected anyway
     lm.max_step = 1.0;
-    let mut assessed: Vec<rank::Assessed> = cands
-        .iter()
-        .map(|e| rank::assess(&ctx, &stages, &s2, &nominal, e, &lm))
-        .collect();
+    // the candidates are independent: one per core
+    let mut assessed: Vec<rank::Assessed> = {
+        use rayon::prelude::*;
+        cands
+            .par_iter()
+            .map(|e| rank::assess(&ctx, &stages, &s2, &nominal, e, &lm))
+            .collect()
+    };
     rank::sort(&mut assessed, opts.alpha / cands.len().max(1) as f64);
     for a in assessed.iter_mut() {
         if let Some(ev) = &a.eval {
@@ -611,7 +615,7 @@ pub fn diagnose(
         localization,
         ranking,
         verdict,
-        fits: ctx.fits.get(),
+        fits: ctx.fits.load(std::sync::atomic::Ordering::Relaxed),
         seconds: clock.elapsed().as_secs_f64(),
         before: Some(nominal),
         after,

@@ -272,7 +272,7 @@ fn assess_inner(
         if let Some(v) = s0 {
             sc.step.iter_mut().for_each(|s| *s = v);
         }
-        ctx.fits.set(ctx.fits.get() + 1);
+        ctx.fits.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
         let u0 = if reset {
             joint.reset_start(nominal)
         } else {
