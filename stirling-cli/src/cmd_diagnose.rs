@@ -64,6 +64,13 @@ pub struct DiagnoseArgs {
     /// Self-check: strengths as multiples of the typical values (> 0), comma-separated
     #[arg(long, value_delimiter = ',', default_value = "1,2", allow_negative_numbers = true, value_parser = ranges::positive)]
     pub strengths: Vec<f64>,
+    /// Self-check: channels of the rig records (the seed's p,x,y by default; add p_hot for the
+    /// richer rig, dropped on single-CV models)
+    #[arg(long, value_delimiter = ',', default_value = "p,x,y")]
+    pub channels: Vec<String>,
+    /// Self-check: noise seed of the first record (case k uses seed + k)
+    #[arg(long, default_value_t = 5)]
+    pub seed: u64,
     /// Machine-readable output
     #[arg(long)]
     pub json: bool,
@@ -99,6 +106,8 @@ pub fn run(a: &DiagnoseArgs) -> anyhow::Result<()> {
             strengths: a.strengths.clone(),
             t_end: a.t_end,
             rate: a.rate,
+            channels: a.channels.clone(),
+            seed: a.seed,
             diagnose: DiagnoseOptions {
                 prior: prior_arg(a.prior)?,
                 ..Default::default()
@@ -121,7 +130,7 @@ pub fn run(a: &DiagnoseArgs) -> anyhow::Result<()> {
                     c.ci_low.map(|v| format!("{v:.2}")).unwrap_or("-".into()),
                     c.ci_high.map(|v| format!("{v:.2}")).unwrap_or("-".into()),
                     c.seconds,
-                    if c.pass { "pass" } else { "FAIL" }
+                    if c.pass { "right" } else { "WRONG" }
                 ));
             }
         };
@@ -138,13 +147,13 @@ pub fn run(a: &DiagnoseArgs) -> anyhow::Result<()> {
             writeln!(o, "{}", selfcheck::matrix_markdown(&sc))?;
             writeln!(
                 o,
-                "{}/{} cases pass, {:.1} s",
-                sc.passed, sc.total, sc.seconds
+                "verdicts right: {}/{}; false alarms on clean records: {}/{}; {:.1} s",
+                sc.passed, sc.total, sc.false_alarms, sc.clean, sc.seconds
             )?;
         }
         if sc.passed < sc.total {
             bail!(
-                "self-check: {} of {} cases fail",
+                "self-check: {} of {} verdicts wrong",
                 sc.total - sc.passed,
                 sc.total
             );

@@ -77,6 +77,8 @@ pub struct Case {
     pub ci_high: Option<f64>,
     /// Fitted parameters of the withheld effect (value, interval) vs truth.
     pub fitted: Vec<(String, f64, f64, f64, f64)>,
+    /// The verdict is right: the withheld effect's name, or `no_significant_gap` on clean data
+    /// (what a user reads; the rank alone is `truth_rank`).
     pub pass: bool,
     pub seconds: f64,
     pub fits: usize,
@@ -94,8 +96,12 @@ pub struct SelfCheck {
     /// `matrix[truth][verdict]` counts; the last two columns are `unexplained` and `no_significant_gap`.
     pub matrix: Vec<Vec<usize>>,
     pub columns: Vec<String>,
+    /// Cases whose verdict is right.
     pub passed: usize,
     pub total: usize,
+    /// Clean cases and those whose verdict names an effect (false alarms).
+    pub clean: usize,
+    pub false_alarms: usize,
     pub seconds: f64,
 }
 
@@ -254,7 +260,7 @@ pub fn run(
         let pass = if truth == "none" {
             verdict == "no_significant_gap"
         } else {
-            truth_rank == Some(1)
+            &verdict == truth
         };
         let case = Case {
             model: label.clone(),
@@ -296,10 +302,16 @@ fn summarize(model: String, cases: Vec<Case>, names: &[String], clock: Instant) 
             .unwrap_or(columns.len() - 2);
         matrix[r][col] += 1;
     }
+    let clean: Vec<&Case> = cases.iter().filter(|c| c.truth == "none").collect();
     SelfCheck {
         model,
         passed: cases.iter().filter(|c| c.pass).count(),
         total: cases.len(),
+        clean: clean.len(),
+        false_alarms: clean
+            .iter()
+            .filter(|c| c.verdict != "no_significant_gap" && c.verdict != "unexplained")
+            .count(),
         cases,
         labels,
         matrix,
