@@ -1,4 +1,4 @@
-"""Shared pieces of the comparison harness: the default engine (PHYSICS.md section 8), the
+"""Shared pieces of the comparison harness: the default engine (docs/physics.md section 8), the
 `nsection` topology as plain arrays, the fairness state and the tolerance scales.
 
 Everything here mirrors `examples/bench_native.rs` / the generated Rust model; `compare.py`

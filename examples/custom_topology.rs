@@ -1,10 +1,10 @@
 //! A free-piston engine that is not in the seed's family, declared in user code with the
 //! public `stirling_model!` DSL only, and run through every analysis.
 //!
-//! The engine is the default B-10B-like engine (PHYSICS.md section 8) with two changes:
+//! The engine is the default B-10B-like engine (docs/physics.md section 8) with two changes:
 //! - **closed bounce space**: the gas under the piston is a control volume `bounce` with its
 //!   own state `P_bounce` and a heat port to a wall at `Tb` (a gas spring with hysteresis
-//!   loss, PHYSICS.md section 9), instead of a space held at the fixed pressure `Pb`;
+//!   loss, docs/physics.md section 9), instead of a space held at the fixed pressure `Pb`;
 //! - **linear alternator** on the power piston: an extra force `-c_alt w`; its power
 //!   `c_alt w^2` is the electric output. The piston's own damping `bp` is friction only.
 //!

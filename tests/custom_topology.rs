@@ -169,7 +169,7 @@ fn power_terms_hold_the_bounce_and_alternator_terms() {
     }
 }
 
-/// PHYSICS.md section 10 with the closed bounce space: `E(t) - E(0)` equals the integral of
+/// docs/physics.md section 10 with the closed bounce space: `E(t) - E(0)` equals the integral of
 /// `heat + mechanical` (the boundary term is zero), carried as a quadrature state of the same
 /// run and, independently, by the trapezoid rule on dense samples.
 #[test]

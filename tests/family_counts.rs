@@ -1,4 +1,4 @@
-//! State counts of the family (PHYSICS.md section 5): `nsection` n+6 frozen / 2n+8 full,
+//! State counts of the family (docs/physics.md section 5): `nsection` n+6 frozen / 2n+8 full,
 //! `cv1` 5 with both closures (no links: its mass is a constant), `cv2` 6 / 8, `schmidt` 4;
 //! and the state layout `[x, v, y, w, P_1..P_ncv, m_1..m_ncv]`.
 

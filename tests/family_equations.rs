@@ -1,6 +1,6 @@
-//! The generated right-hand sides are the equations of PHYSICS.md: every family member is
+//! The generated right-hand sides are the equations of docs/physics.md: every family member is
 //! checked at a fixed non-equilibrium state against a plain-Rust reference written out by
-//! hand below from PHYSICS.md sections 1-6 (geometry, mechanics, Schmidt pressure, control
+//! hand below from docs/physics.md sections 1-6 (geometry, mechanics, Schmidt pressure, control
 //! volumes, the family table, the equilibrium). Nothing here is taken from generated code;
 //! the default engine of section 8 is typed in by hand and checked against the declared
 //! defaults.
@@ -14,7 +14,7 @@ use std::f64::consts::PI;
 use stirling::dsl::Closure;
 use stirling::models::build;
 
-/// PHYSICS.md section 8, by hand.
+/// docs/physics.md section 8, by hand.
 #[derive(Clone, Copy, Debug)]
 struct Engine {
     r: f64,
@@ -491,7 +491,7 @@ fn defaults_are_the_engine_of_physics_md_section_8() {
             assert_eq!(dn, hn, "{name}: parameter order");
             assert!(
                 (dv - hv).abs() <= 1e-15 * hv.abs(),
-                "{name}: {dn} = {dv}, PHYSICS.md says {hv}"
+                "{name}: {dn} = {dv}, docs/physics.md says {hv}"
             );
         }
     }

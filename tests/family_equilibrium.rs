@@ -1,4 +1,4 @@
-//! The equilibrium of PHYSICS.md section 6 and the analytic Jacobian (section 10):
+//! The equilibrium of docs/physics.md section 6 and the analytic Jacobian (section 10):
 //! the right-hand side vanishes at `equilibrium_guess` for every member and closure,
 //! and the generated Jacobian matches central finite differences, at rest and away from it.
 

@@ -1,5 +1,5 @@
 //! The generated Jacobian and parameter Jacobian match central finite differences
-//! (PHYSICS.md section 10) at seeded random states near equilibrium, for small
+//! (docs/physics.md section 10) at seeded random states near equilibrium, for small
 //! topologies that each exercise one feature, both inventory closures, and chains
 //! of n = 1, 2, 3, 10, 50 sections.
 

@@ -1,4 +1,4 @@
-//! Mass conservation (PHYSICS.md sections 6 and 10): in a closed topology with the `full`
+//! Mass conservation (docs/physics.md sections 6 and 10): in a closed topology with the `full`
 //! closure the mass rows of the right-hand side sum to zero to round-off, and so do the
 //! mass rows of the Jacobian (`c J = 0`, the inventory mode).
 

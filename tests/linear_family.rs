@@ -1,6 +1,6 @@
 //! Every family member on the default engine: the right-half-plane pair near 85 rad/s with the
 //! `full` closure, stable `frozen` models, the inventory mode, and the loop broken at the piston
-//! and displacer forces (reference numbers: the independent Python check of PHYSICS.md).
+//! and displacer forces (reference numbers: the independent Python check of docs/physics.md).
 
 use stirling::dsl::{Closure, Model};
 use stirling::models::linear::{

@@ -1,4 +1,4 @@
-//! `schmidt` on the default engine reproduces PHYSICS.md section 8 (the seed's Figure 8), and
+//! `schmidt` on the default engine reproduces docs/physics.md section 8 (the seed's Figure 8), and
 //! its margins agree with an independent computation written here.
 
 use stirling::dsl::{Closure, Model};

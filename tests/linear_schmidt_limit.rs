@@ -1,4 +1,4 @@
-//! PHYSICS.md section 10: with large heat transfer and small flow resistance, `nsection` tends to
+//! docs/physics.md section 10: with large heat transfer and small flow resistance, `nsection` tends to
 //! `schmidt`. At finite n the limit is the Schmidt model whose regenerator temperature is the
 //! harmonic mean of the n section wall temperatures; the log-mean (section 3) is reached as
 //! O(1/n^2). Reference values: 40-digit eigenvalues of the independent Python check.

@@ -1,5 +1,5 @@
 //! Along trajectories (`full` closure) the gas inventory is conserved to round-off
-//! and the energy budget of PHYSICS.md section 10 closes to the solver tolerance:
+//! and the energy budget of docs/physics.md section 10 closes to the solver tolerance:
 //! `E(t) - E(0) = integral (heat + boundary + mechanical) dt`, the integral carried
 //! as a quadrature state of the same BDF run.
 

@@ -1,5 +1,5 @@
 //! `stirling linearize`: equilibrium, closed-loop poles, the loop broken at a pressure-force
-//! channel and its margins (PHYSICS.md sections 6-7); `--json` prints the `LinearReport`,
+//! channel and its margins (docs/physics.md sections 6-7); `--json` prints the `LinearReport`,
 //! `--plot DIR` writes the pole map and the Bode diagram as SVG.
 
 use std::io::{self, Write};

@@ -1,4 +1,4 @@
-//! Inventory closure of the gas model (PHYSICS.md section 4).
+//! Inventory closure of the gas model (docs/physics.md section 4).
 
 use serde::{Deserialize, Serialize};
 

@@ -2,7 +2,7 @@
 //!
 //! A free-piston Stirling engine is declared as a topology of bodies, gas control
 //! volumes (CVs), faces, heat ports and mass-flow links. This crate turns such a
-//! declaration into equations by the energetic rules of PHYSICS.md, differentiates
+//! declaration into equations by the energetic rules of docs/physics.md, differentiates
 //! them symbolically and emits Rust: the right-hand side, the analytic Jacobian and
 //! the parameter Jacobian, for any number `n` of array sections chosen at run time.
 //!
@@ -12,7 +12,7 @@
 //!   substitution, [`Arena::eval`], text/LaTeX [`expr::Printer`], Rust emission with CSE).
 //! - [`topology`]: the declaration ([`Topology`]) and its assembly ([`assemble`]) into
 //!   equations: faces give both `dV/dt` and the pressure forces, ports the heat, links the
-//!   mass and enthalpy flows (PHYSICS.md sections 1, 2, 4).
+//!   mass and enthalpy flows (docs/physics.md sections 1, 2, 4).
 //! - [`codegen`]: emission of a whole model ([`codegen::generate`]), used by the
 //!   `stirling_model!` macro at compile time.
 //! - The run-time interface every generated model implements: [`Model`], with
@@ -35,7 +35,7 @@
 //! |---|---|
 //! | `rhs`, `jacobian`, `param_jacobian` | `f(x, p)`, `df/dx`, `df/dp` (analytic) |
 //! | `states`, `params`, `bodies`, `vessel_names` | the layout `[x, v, y, w, P_1.., m_1..]` and its meaning |
-//! | `equilibrium_guess` | the rest state of PHYSICS.md section 6 |
+//! | `equilibrium_guess` | the rest state of docs/physics.md section 6 |
 //! | `pv`, `temperatures`, `gas_mass` | derived quantities per vessel |
 //! | `energy`, `power` | `E` and `dE/dt = heat + boundary + mechanical` (section 10) |
 //! | `pressure_forces`, `pressure_force_gradient`, `body_masses` | where the loop is broken |
@@ -46,7 +46,7 @@
 //! The expression arena is usable on its own. Expressions are hash-consed (equal
 //! subexpressions share one node), constructors fold constants, and [`Arena::diff`]
 //! differentiates with respect to any symbol. Here the heat flow of a port,
-//! `Q = h Aw (Tw - T)` with the gas temperature `T = P V / (m R)` (PHYSICS.md section 4),
+//! `Q = h Aw (Tw - T)` with the gas temperature `T = P V / (m R)` (docs/physics.md section 4),
 //! and its derivative with respect to the pressure, which is what the generated Jacobian
 //! holds in the row of `P'`:
 //!

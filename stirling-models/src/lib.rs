@@ -5,7 +5,7 @@
 //! same equilibrium, poles, margins, limit cycle and plots as the seed's family.
 //!
 //! - [`family`]: `schmidt`, `cv1`, `cv2`, `nsection` declared with `stirling_model!`
-//!   on the default engine of PHYSICS.md section 8.
+//!   on the default engine of docs/physics.md section 8.
 //! - [`linear`]: equilibrium by Newton ([`linear::equilibrium::solve`]), the dynamic poles
 //!   with the inventory mode removed ([`linear::dynamic_poles`]), the loop broken at a
 //!   pressure force with gain and phase margins and Bode/Nyquist data
@@ -59,7 +59,7 @@
 //! let m0 = model.gas_mass(&p, &x0);
 //! assert!(tr.x.iter().all(|x| (model.gas_mass(&p, x) - m0).abs() < 1e-12 * m0));
 //!
-//! // the energy budget (PHYSICS.md section 10) as a quadrature state of the same run:
+//! // the energy budget (docs/physics.md section 10) as a quadrature state of the same run:
 //! // E(t) - E(0) = integral of heat + boundary + mechanical power
 //! let n = model.n_states();
 //! let mut z0 = x0.clone();

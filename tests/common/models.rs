@@ -28,7 +28,7 @@ stirling_model! {
     }
 }
 
-/// The engine frame shared by the two-CV and chain models (PHYSICS.md section 8).
+/// The engine frame shared by the two-CV and chain models (docs/physics.md section 8).
 macro_rules! test_engine {
     ($(#[$meta:meta])* model $name:ident { $($body:tt)* }) => {
         stirling_model! {

@@ -205,7 +205,7 @@ fn diff_of_functions() {
 
 #[test]
 fn diff_of_the_upwind_enthalpy() {
-    // H = mdot (y + (1 + tanh(mdot / 0.01)) / 2 (1 - y)), the link law of PHYSICS.md 4
+    // H = mdot (y + (1 + tanh(mdot / 0.01)) / 2 (1 - y)), the link law of docs/physics.md 4
     check_diff(
         "enthalpy",
         |a, x, y| {

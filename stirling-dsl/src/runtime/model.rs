@@ -42,7 +42,7 @@ pub struct BodyInfo {
     pub vel: &'static str,
 }
 
-/// Energy-rate terms of the budget (PHYSICS.md section 10):
+/// Energy-rate terms of the budget (docs/physics.md section 10):
 /// `dE/dt = heat + boundary + mechanical`.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct PowerTerms {
@@ -108,7 +108,7 @@ pub trait Model: Send + Sync {
     /// The declared mass of every body, in body order: `out[k] = m_k`, so that an extra
     /// force `u` on body `k` enters the velocity row as `u / m_k`.
     fn body_masses(&self, p: &[f64], out: &mut [f64]);
-    /// The equilibrium of PHYSICS.md section 6 (exact for the declared charge at rest).
+    /// The equilibrium of docs/physics.md section 6 (exact for the declared charge at rest).
     fn equilibrium_guess(&self, p: &[f64], out: &mut [f64]);
     /// Pressure and volume of every vessel (CV elements, then spaces).
     fn pv(&self, p: &[f64], x: &[f64], pressure: &mut [f64], volume: &mut [f64]);

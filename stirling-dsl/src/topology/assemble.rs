@@ -1,4 +1,4 @@
-//! The energetic assembly rules (PHYSICS.md sections 1, 2, 4 and 6).
+//! The energetic assembly rules (docs/physics.md sections 1, 2, 4 and 6).
 //!
 //! Per control volume `i` (ideal gas, `cv = R/(gamma-1)`):
 //!

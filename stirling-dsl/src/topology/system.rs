@@ -102,7 +102,7 @@ pub struct System {
     pub blocks: Vec<BlockInfo>,
     /// Right-hand side per block.
     pub rows: Vec<Row>,
-    /// Equilibrium guess per block (PHYSICS.md section 6).
+    /// Equilibrium guess per block (docs/physics.md section 6).
     pub init: Vec<Row>,
     /// Pressure force on each body.
     pub forces: Vec<Id>,

@@ -1,4 +1,4 @@
-//! The sim-to-real gap diagnosis (DESIGN.md, "The gap diagnosis, in outline"):
+//! The sim-to-real gap diagnosis (method and results: docs/diagnosis.md):
 //! calibrate the nominal model on a training block with the two driven subsystems
 //! ([`crate::fit`]), then
 //! - **where** ([`localize`]): residuals per channel, per harmonic of the cycle, per phase of

@@ -1,4 +1,4 @@
-//! Effects the nominal models leave out (PHYSICS.md section 9), as model augmentations
+//! Effects the nominal models leave out (docs/physics.md section 9), as model augmentations
 //! declared through the DSL ([`models`]), and the registry that names them.
 //!
 //! Each model effect is a set of extra parameters of an augmented family member

@@ -1,4 +1,4 @@
-//! The augmented family members: every DSL-expressible effect of PHYSICS.md section 9 as an
+//! The augmented family members: every DSL-expressible effect of docs/physics.md section 9 as an
 //! extra parameter whose null value (0) makes the effect absent.
 //!
 //! - seal leak cold space -> bounce space: `mdot = Gleak (Pc - Pb)` (a `conductance:` link, so

@@ -1,4 +1,4 @@
-//! The default engine (PHYSICS.md section 8) as the common frame of the family:
+//! The default engine (docs/physics.md section 8) as the common frame of the family:
 //! parameters, the two bodies, their coupling damper and the bounce space.
 //! Each member adds its gas spaces and links.
 

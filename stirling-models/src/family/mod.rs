@@ -1,4 +1,4 @@
-//! The seed's model family (PHYSICS.md sections 3-5), declared with `stirling_model!`.
+//! The seed's model family (docs/physics.md sections 3-5), declared with `stirling_model!`.
 
 mod cv1;
 mod cv2;

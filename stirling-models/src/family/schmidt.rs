@@ -1,4 +1,4 @@
-//! `schmidt`: the 4th-order isothermal model (PHYSICS.md section 3, seed eqs. S12-S15).
+//! `schmidt`: the 4th-order isothermal model (docs/physics.md section 3, seed eqs. S12-S15).
 //!
 //! `P = M R / (Vh/Th + Vc/Tk + Vr/Tr)`, `Tr = (Th - Tk)/ln(Th/Tk)`, `M R = Pmean S0`.
 

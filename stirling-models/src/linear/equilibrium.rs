@@ -1,6 +1,6 @@
 //! The equilibrium `f(x*) = 0` by Newton's method with the analytic Jacobian.
 //!
-//! The iteration starts from [`Model::equilibrium_guess`] (PHYSICS.md section 6, exact for the
+//! The iteration starts from [`Model::equilibrium_guess`] (docs/physics.md section 6, exact for the
 //! family) and solves `J dx = -f`, halving the step while the scaled residual grows. With the
 //! `full` closure the total gas mass is conserved (`c J = 0`, `c` = ones on the mass states),
 //! so `J` is singular: the last mass equation is replaced by the inventory constraint

@@ -1,4 +1,4 @@
-//! Breaking the feedback loop at a pressure-force input (PHYSICS.md section 7).
+//! Breaking the feedback loop at a pressure-force input (docs/physics.md section 7).
 //!
 //! The linearized engine `x' = J x` is read as a plant driven by a scalar input `u` that is fed
 //! back from the states: `x' = A0 x + B u`, `u = -K x`, with `A0 - B K = J`. The open loop is

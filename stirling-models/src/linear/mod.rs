@@ -1,4 +1,4 @@
-//! Linear analysis of any generated model (PHYSICS.md sections 6-7).
+//! Linear analysis of any generated model (docs/physics.md sections 6-7).
 //!
 //! The pipeline of [`linearize`]:
 //! 1. [`equilibrium`]: `f(x*) = 0` by Newton with the analytic Jacobian (mass constraint with `full`);

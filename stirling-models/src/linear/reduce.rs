@@ -1,4 +1,4 @@
-//! Inventory reduction (PHYSICS.md section 6).
+//! Inventory reduction (docs/physics.md section 6).
 //!
 //! With the `full` closure the total gas mass is conserved: `c J = 0` for `c` = ones on the
 //! mass states, so `J` has an exact zero eigenvalue, the inventory mode. The dynamic poles are

@@ -93,7 +93,7 @@ impl OdeSystem for ModelSystem<'_> {
 }
 
 /// A model plus one quadrature state `z' = heat + boundary + mechanical`
-/// (PHYSICS.md section 10), so `z(t)` must equal `E(t) - E(0)`.
+/// (docs/physics.md section 10), so `z(t)` must equal `E(t) - E(0)`.
 ///
 /// The quadrature row of the iteration matrix is left zero: `z` never feeds back,
 /// so Newton still converges; accuracy is set by the error control, not the matrix.
