@@ -2,7 +2,7 @@
 
 use nalgebra::{DMatrix, DVector};
 use stirling::models::diagnose::score::{bandwidth, long_run_cov, robust_score};
-use stirling::models::diagnose::{chi2_sf, erfc, high_pass};
+use stirling::models::signal::{chi2_sf, erfc, high_pass};
 
 #[test]
 fn chi_square_tails() {

@@ -125,13 +125,16 @@ pub mod diagnose;
 pub mod effects;
 /// Identification: driven subsystems, forward sensitivities, Levenberg-Marquardt, report.
 pub mod fit;
+/// Which state of a model is what (positions, velocities, pressures, masses).
+pub mod layout;
 /// Linear analysis: equilibrium, poles, the loop broken at a pressure force, margins, locus.
 pub mod linear;
 pub mod registry;
-/// Which state of a model is what (positions, velocities, pressures, masses).
-pub mod layout;
 /// The virtual test rig: truth model plus effects, noise, offsets, sample rate.
 pub mod rig;
+/// Signal processing shared by fit, diagnose and rig: smoothing, noise level, cycles,
+/// harmonics, filters, statistical tails.
+pub mod signal;
 /// Nonlinear simulation, limit cycles, Floquet multipliers and cycle work.
 pub mod sim;
 

@@ -13,6 +13,7 @@ use stirling_dsl::{Closure, Model, StateKind};
 
 use crate::data::{write_csv, Measured};
 use crate::effects::{augmented, EffectSettings};
+use crate::signal::first_order_lag;
 use crate::sim::{simulate, SimOptions};
 
 /// What the rig runs.
@@ -144,20 +145,6 @@ pub fn pressure_states(model: &dyn Model) -> (usize, usize) {
     (*ps.last().expect("a CV model"), ps[0])
 }
 
-/// Exact first-order-hold discretization of `tau y' = u - y` on a uniform grid.
-pub fn first_order_lag(u: &[f64], dt: f64, tau: f64) -> Vec<f64> {
-    if tau <= 0.0 || u.is_empty() {
-        return u.to_vec();
-    }
-    let a = (-dt / tau).exp();
-    let c = 1.0 - tau / dt * (1.0 - a);
-    let mut y = vec![u[0]; u.len()];
-    for k in 1..u.len() {
-        y[k] = a * y[k - 1] + (1.0 - a) * u[k - 1] + c * (u[k] - u[k - 1]);
-    }
-    y
-}
-
 /// Lowest sample rate the rig accepts (Hz): the family runs near 13 Hz, and the fit's
 /// smoothing derivatives need several samples per millisecond-scale feature.
 pub const MIN_RATE: f64 = 200.0;
@@ -166,7 +153,10 @@ pub const MIN_RATE: f64 = 200.0;
 fn validate(cfg: &RigConfig) -> Result<(), RigError> {
     let bad = |what: String| Err(RigError::Bad(what));
     if !(cfg.t_end > 0.0 && cfg.t_end.is_finite()) {
-        return bad(format!("--t-end must be a positive number of seconds (got {})", cfg.t_end));
+        return bad(format!(
+            "--t-end must be a positive number of seconds (got {})",
+            cfg.t_end
+        ));
     }
     if !(cfg.settle >= 0.0 && cfg.settle.is_finite()) {
         return bad(format!("--settle must be >= 0 s (got {})", cfg.settle));
@@ -359,9 +349,33 @@ pub fn write(out: &RigOutput, path: &Path, force: bool) -> Result<PathBuf, RigEr
     }
     let tr = &out.truth;
     let comments = vec![
-        format!("stirling rig: truth model {} (n = {}), effects: {}", tr.model, tr.n, if tr.active_effects.is_empty() { "none".to_string() } else { tr.active_effects.join(", ") }),
-        format!("rate {} Hz, noise p {} Pa, x {} m, seed {}; truth in {}", tr.rate, tr.noise.p, tr.noise.x, tr.seed, side.display()),
-        format!("columns: t [s], {}", out.data.channels().iter().map(|c| describe(c)).collect::<Vec<_>>().join(", ")),
+        format!(
+            "stirling rig: truth model {} (n = {}), effects: {}",
+            tr.model,
+            tr.n,
+            if tr.active_effects.is_empty() {
+                "none".to_string()
+            } else {
+                tr.active_effects.join(", ")
+            }
+        ),
+        format!(
+            "rate {} Hz, noise p {} Pa, x {} m, seed {}; truth in {}",
+            tr.rate,
+            tr.noise.p,
+            tr.noise.x,
+            tr.seed,
+            side.display()
+        ),
+        format!(
+            "columns: t [s], {}",
+            out.data
+                .channels()
+                .iter()
+                .map(|c| describe(c))
+                .collect::<Vec<_>>()
+                .join(", ")
+        ),
     ];
     write_csv(path, &out.data, &comments).map_err(|e| RigError::Io(path.to_path_buf(), e))?;
     let json = serde_json::to_string_pretty(&out.truth).expect("serializable");

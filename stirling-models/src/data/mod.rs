@@ -10,8 +10,8 @@ mod sampling;
 mod text;
 
 pub use csv::{parse_csv, parse_csv_bytes, read_csv, read_csv_lines, write_csv};
-pub use sampling::{check_uniform, UNIFORM_TOLERANCE};
 pub use offsets::{cycle_mean, remove_position_offsets, PositionOffsets};
+pub use sampling::{check_uniform, UNIFORM_TOLERANCE};
 
 use std::fmt;
 

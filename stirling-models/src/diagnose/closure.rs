@@ -8,7 +8,8 @@ use rand::{rngs::StdRng, Rng, SeedableRng};
 use serde::Serialize;
 
 use super::{Context, Eval};
-use crate::data::{cycle_mean, Measured};
+use crate::data::Measured;
+use crate::signal::cycle_starts;
 
 /// The closure fraction with its interval.
 #[derive(Clone, Debug, Serialize)]
@@ -19,32 +20,6 @@ pub struct Closure {
     pub err_before: f64,
     pub err_after: f64,
     pub cycles: usize,
-}
-
-/// Sample indices of upward crossings of the displacer position through its mean in `range`.
-pub fn cycle_starts(data: &Measured, range: (usize, usize)) -> Vec<usize> {
-    let Some(x) = data.x.as_ref().or(data.p.as_ref()) else {
-        return vec![range.0, range.1];
-    };
-    let m = cycle_mean(x);
-    // smooth a little so noise does not make spurious crossings
-    let h = 3usize;
-    let sm: Vec<f64> = (0..x.len())
-        .map(|i| {
-            let a = i.saturating_sub(h);
-            let b = (i + h + 1).min(x.len());
-            x[a..b].iter().sum::<f64>() / (b - a) as f64 - m
-        })
-        .collect();
-    let mut out = Vec::new();
-    let mut last: Option<usize> = None;
-    for i in range.0.max(1)..range.1 {
-        if sm[i - 1] < 0.0 && sm[i] >= 0.0 && last.is_none_or(|l| i - l > 10) {
-            out.push(i);
-            last = Some(i);
-        }
-    }
-    out
 }
 
 /// Per-sample channel-averaged normalized squared residual.

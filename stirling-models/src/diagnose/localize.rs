@@ -9,10 +9,11 @@
 use serde::Serialize;
 use stirling_dsl::{Model, StateKind};
 
-use super::closure::cycle_starts;
 use super::{Context, Eval};
 use crate::data::{cycle_mean, Measured};
-use crate::fit::driven::savitzky_golay;
+use crate::signal::cycle_starts;
+use crate::signal::dft;
+use crate::signal::savitzky_golay;
 use crate::sim::{simulate, SimOptions};
 
 /// Number of harmonics reported (0 = mean, 1 = fundamental, ...).
@@ -75,18 +76,6 @@ pub struct Localization {
     pub period: f64,
     pub cycles: usize,
     pub features: Features,
-}
-
-fn dft(r: &[f64], period_samples: f64, k: usize) -> (f64, f64) {
-    let n = r.len() as f64;
-    let (mut re, mut im) = (0.0, 0.0);
-    for (i, v) in r.iter().enumerate() {
-        let ph = 2.0 * std::f64::consts::PI * k as f64 * i as f64 / period_samples;
-        re += v * ph.cos();
-        im -= v * ph.sin();
-    }
-    let s = if k == 0 { 1.0 / n } else { 2.0 / n };
-    (s * re, s * im)
 }
 
 /// Features of `x`, `y`, `p` (already on a common grid) between cycle starts.

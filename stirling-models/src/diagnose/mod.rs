@@ -28,8 +28,9 @@ use stirling_dsl::{Closure, Model};
 
 use crate::data::{cycle_mean, Measured};
 use crate::effects::{self, EffectInfo};
-use crate::fit::driven::{noise_sigma, project_drift};
+
 use crate::fit::{self, FitOptions, FittedStage};
+use crate::signal::{high_pass, noise_sigma, project_drift};
 use joint::Joint;
 
 /// Why a diagnosis failed.
@@ -261,31 +262,6 @@ pub struct Context<'a> {
     pub fits: std::sync::atomic::AtomicUsize,
 }
 
-/// Remove the centered moving average of half-width `h` (over the finite samples), scaled so
-/// that white noise keeps its variance.
-pub fn high_pass(r: &[f64], h: usize) -> Vec<f64> {
-    let n = r.len();
-    let mut cs = vec![0.0; n + 1];
-    let mut cn = vec![0usize; n + 1];
-    for i in 0..n {
-        let ok = r[i].is_finite();
-        cs[i + 1] = cs[i] + if ok { r[i] } else { 0.0 };
-        cn[i + 1] = cn[i] + ok as usize;
-    }
-    let w = (2 * h + 1) as f64;
-    let gain = 1.0 / (1.0 - 1.0 / w).sqrt();
-    (0..n)
-        .map(|i| {
-            if !r[i].is_finite() || h == 0 {
-                return r[i];
-            }
-            let (a, b) = (i.saturating_sub(h), (i + h + 1).min(n));
-            let m = (cs[b] - cs[a]) / (cn[b] - cn[a]).max(1) as f64;
-            gain * (r[i] - m)
-        })
-        .collect()
-}
-
 impl Context<'_> {
     /// The noise level of a channel (1 if unknown).
     pub fn noise_of(&self, ch: &str) -> f64 {
@@ -509,7 +485,7 @@ pub fn diagnose(
             p_nom[i] = *v;
         }
     }
-    let starts = closure::cycle_starts(data, (b.train_idx.0, b.hold_idx.1));
+    let starts = crate::signal::cycle_starts(data, (b.train_idx.0, b.hold_idx.1));
     let period = if starts.len() >= 2 {
         (starts[starts.len() - 1] - starts[0]) / (starts.len() - 1)
     } else {
@@ -687,42 +663,4 @@ pub fn nominal_model(
         .map_err(|e| DiagnoseError::Bad(e.to_string()))?;
     let p = effects::nominal_params(m.as_ref());
     Ok((m, p))
-}
-
-/// Upper tail of the chi-square distribution with `k` degrees of freedom (k = 1, 2; larger
-/// `k` by the Wilson-Hilferty approximation).
-pub fn chi2_sf(x: f64, k: usize) -> f64 {
-    if !(x > 0.0) {
-        return 1.0;
-    }
-    match k {
-        1 => erfc((x / 2.0).sqrt()),
-        2 => (-x / 2.0).exp(),
-        _ => {
-            let k = k as f64;
-            let z = ((x / k).powf(1.0 / 3.0) - (1.0 - 2.0 / (9.0 * k))) / (2.0 / (9.0 * k)).sqrt();
-            0.5 * erfc(z / std::f64::consts::SQRT_2)
-        }
-    }
-}
-
-/// Complementary error function (Numerical Recipes' Chebyshev fit, relative error < 1.2e-7).
-pub fn erfc(x: f64) -> f64 {
-    let z = x.abs();
-    let t = 1.0 / (1.0 + 0.5 * z);
-    let ans = t
-        * (-z * z - 1.26551223
-            + t * (1.00002368
-                + t * (0.37409196
-                    + t * (0.09678418
-                        + t * (-0.18628806
-                            + t * (0.27886807
-                                + t * (-1.13520398
-                                    + t * (1.48851587 + t * (-0.82215223 + t * 0.17087277)))))))))
-            .exp();
-    if x >= 0.0 {
-        ans
-    } else {
-        2.0 - ans
-    }
 }

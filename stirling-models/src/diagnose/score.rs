@@ -22,7 +22,7 @@
 use nalgebra::{DMatrix, DVector};
 use serde::Serialize;
 
-use super::chi2_sf;
+use crate::signal::chi2_sf;
 
 /// The result of a score test.
 #[derive(Clone, Debug, Serialize)]

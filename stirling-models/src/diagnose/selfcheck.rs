@@ -173,7 +173,10 @@ pub fn run(
     }
     let (model, p_nom) = nominal_model(&opts.model, opts.n)?;
     // `p_hot` only where the model has a hot side (more than one CV)
-    let multi_cv = crate::layout::StateLayout::of(model.as_ref()).pressures.len() > 1;
+    let multi_cv = crate::layout::StateLayout::of(model.as_ref())
+        .pressures
+        .len()
+        > 1;
     let channels: Vec<String> = opts
         .channels
         .iter()

@@ -17,66 +17,8 @@ use stirling_dsl::{Model, StateKind};
 
 use super::sensitivity::{Column, Driven, Given, Signal};
 use super::FitError;
+use crate::signal::{derivative, noise_sigma, project_drift, savitzky_golay};
 use crate::sim::{integrate, state_scale, Hooks, SimOptions};
-
-/// Savitzky-Golay smoothing (local polynomial of `degree` over `2h+1` samples): value and
-/// first derivative at every sample (windows shifted inside the record at the ends).
-pub fn savitzky_golay(y: &[f64], dt: f64, h: usize, degree: usize) -> (Vec<f64>, Vec<f64>) {
-    let n = y.len();
-    let h = h.min((n - 1) / 2).max(1);
-    let w = 2 * h + 1;
-    let deg = degree.min(w - 1);
-    // weights for evaluation point at offset `c` from the window start
-    let a = DMatrix::from_fn(w, deg + 1, |i, k| {
-        ((i as f64 - h as f64) / h as f64).powi(k as i32)
-    });
-    let pinv = (a.transpose() * &a)
-        .try_inverse()
-        .expect("Vandermonde of distinct points")
-        * a.transpose();
-    let weights = |c: usize| -> (DVector<f64>, DVector<f64>) {
-        let s = (c as f64 - h as f64) / h as f64;
-        let v = DVector::from_fn(deg + 1, |k, _| s.powi(k as i32));
-        let d = DVector::from_fn(deg + 1, |k, _| {
-            if k == 0 {
-                0.0
-            } else {
-                k as f64 * s.powi(k as i32 - 1) / (h as f64 * dt)
-            }
-        });
-        (pinv.transpose() * v, pinv.transpose() * d)
-    };
-    let mid = weights(h);
-    let mut val = vec![0.0; n];
-    let mut der = vec![0.0; n];
-    for i in 0..n {
-        let start = i.saturating_sub(h).min(n - w);
-        let c = i - start;
-        let owned;
-        let (wv, wd) = if c == h {
-            (&mid.0, &mid.1)
-        } else {
-            owned = weights(c);
-            (&owned.0, &owned.1)
-        };
-        let seg = &y[start..start + w];
-        val[i] = seg.iter().zip(wv.iter()).map(|(a, b)| a * b).sum();
-        der[i] = seg.iter().zip(wd.iter()).map(|(a, b)| a * b).sum();
-    }
-    (val, der)
-}
-
-/// Noise standard deviation from third differences (the smooth signal cancels).
-pub fn noise_sigma(y: &[f64]) -> f64 {
-    if y.len() < 5 {
-        return 0.0;
-    }
-    let mut d: Vec<f64> = (0..y.len() - 3)
-        .map(|i| (y[i + 3] - 3.0 * y[i + 2] + 3.0 * y[i + 1] - y[i]).abs())
-        .collect();
-    d.sort_by(f64::total_cmp);
-    d[d.len() / 2] / 0.6745 / 20f64.sqrt()
-}
 
 /// Lowest ratio of a positive model parameter to its starting value that a stage simulates.
 pub const MIN_RATIO: f64 = 0.02;
@@ -222,52 +164,6 @@ pub struct Stage<'a> {
     /// Noise on the prescribed inputs: `(signal, standard deviation of the raw samples,
     /// Savitzky-Golay half-width the signal was smoothed with)`; see [`Stage::input_noise_cov`].
     pub input_noise: Vec<(usize, f64, usize)>,
-}
-
-/// Remove the cosines `k = 1..=m` (DCT-II, orthogonal on the uniform grid) from `v`.
-pub fn project_drift(v: &mut [f64], m: usize) {
-    let n = v.len();
-    if n < 2 {
-        return;
-    }
-    for k in 1..=m.min(n - 1) {
-        let b: Vec<f64> = (0..n)
-            .map(|i| (std::f64::consts::PI * k as f64 * (i as f64 + 0.5) / n as f64).cos())
-            .collect();
-        let c = v.iter().zip(&b).map(|(a, b)| a * b).sum::<f64>() / (n as f64 / 2.0);
-        v.iter_mut().zip(&b).for_each(|(a, b)| *a -= c * b);
-    }
-}
-
-/// Number of cosines of [`project_drift`] below `f_cut` (Hz) on `n` samples of interval `dt`.
-pub fn drift_count(n: usize, dt: f64, f_cut: f64) -> usize {
-    if !(f_cut > 0.0) || n < 2 {
-        return 0;
-    }
-    ((2.0 * n as f64 * dt * f_cut).floor() as usize).min(n / 4)
-}
-
-/// Cycle frequency (Hz) from the upward crossings of the mean, with a hysteresis of half the
-/// standard deviation so that noise cannot add crossings (`None`: fewer than 2 cycles).
-pub fn cycle_frequency(y: &[f64], dt: f64) -> Option<f64> {
-    let n = y.len().max(1) as f64;
-    let m = y.iter().sum::<f64>() / n;
-    let sd = (y.iter().map(|v| (v - m) * (v - m)).sum::<f64>() / n).sqrt();
-    let (lo, hi) = (m - 0.5 * sd, m + 0.5 * sd);
-    let mut armed = false;
-    let mut ups = Vec::new();
-    for (i, &v) in y.iter().enumerate() {
-        if v < lo {
-            armed = true;
-        } else if armed && v > hi {
-            armed = false;
-            ups.push(i);
-        }
-    }
-    if ups.len() < 3 {
-        return None;
-    }
-    Some((ups.len() - 1) as f64 / ((ups[ups.len() - 1] - ups[0]) as f64 * dt))
 }
 
 /// Simulated outputs (rows: samples of the window) and their derivatives.
@@ -418,7 +314,7 @@ impl Stage<'_> {
         }
         for (o, &tau) in lag.iter().enumerate() {
             if tau > 0.0 {
-                yhat[o] = crate::rig::first_order_lag(&yhat[o], self.dt, tau);
+                yhat[o] = crate::signal::first_order_lag(&yhat[o], self.dt, tau);
                 lag_columns(&mut dyhat[o], self.dt, tau);
             }
         }
@@ -608,7 +504,10 @@ impl Stage<'_> {
         let mut r = Vec::with_capacity(keep.len() * self.outputs.len());
         for (o, out) in self.outputs.iter().enumerate() {
             let start = r.len();
-            r.extend(keep.iter().map(|&i| (run.yhat[o][i - first] - out.data[i]) / out.sigma));
+            r.extend(
+                keep.iter()
+                    .map(|&i| (run.yhat[o][i - first] - out.data[i]) / out.sigma),
+            );
             if self.drift > 0 {
                 project_drift(&mut r[start..], self.drift);
             }
@@ -662,27 +561,12 @@ impl Stage<'_> {
     }
 }
 
-/// Central-difference derivative of uniform samples (one-sided at the ends).
-pub fn derivative(y: &[f64], dt: f64) -> Vec<f64> {
-    let n = y.len();
-    (0..n)
-        .map(|i| {
-            let (a, b) = (i.saturating_sub(1), (i + 1).min(n - 1));
-            if b > a {
-                (y[b] - y[a]) / ((b - a) as f64 * dt)
-            } else {
-                0.0
-            }
-        })
-        .collect()
-}
-
 /// Lag every sensitivity column (`rows[sample][var]`) by the first-order filter.
 fn lag_columns(rows: &mut [Vec<f64>], dt: f64, tau: f64) {
     let nv = rows.first().map_or(0, |r| r.len());
     for v in 0..nv {
         let col: Vec<f64> = rows.iter().map(|r| r[v]).collect();
-        let f = crate::rig::first_order_lag(&col, dt, tau);
+        let f = crate::signal::first_order_lag(&col, dt, tau);
         rows.iter_mut().zip(f).for_each(|(r, c)| r[v] = c);
     }
 }

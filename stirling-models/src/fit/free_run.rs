@@ -23,10 +23,11 @@ use std::time::Instant;
 use serde::Serialize;
 use stirling_dsl::{Model, StateKind};
 
-use super::driven::{self, cold_weight, pressure_states, savitzky_golay};
+use super::driven::{cold_weight, pressure_states};
 use super::report::{fit_percent, ChannelFit};
 use super::{FitError, Series};
 use crate::data::Measured;
+use crate::signal::{crossing_frequency, fundamental, savitzky_golay, wrap};
 use crate::sim::{simulate, SimOptions};
 
 /// Additive sensor offsets: measured = model + offset.
@@ -192,63 +193,6 @@ pub struct CycleFeatures {
     pub phase: Vec<(String, f64)>,
 }
 
-/// Least-squares `c + a cos(wt) + b sin(wt)`: returns `(amplitude, phase)`.
-fn fundamental(y: &[f64], dt: f64, f: f64) -> (f64, f64) {
-    let w = 2.0 * std::f64::consts::PI * f;
-    let mut a = nalgebra::Matrix3::<f64>::zeros();
-    let mut g = nalgebra::Vector3::<f64>::zeros();
-    for (i, &v) in y.iter().enumerate() {
-        let t = i as f64 * dt;
-        let r = nalgebra::Vector3::new(1.0, (w * t).cos(), (w * t).sin());
-        a += r * r.transpose();
-        g += r * v;
-    }
-    let c = a.lu().solve(&g).unwrap_or_else(nalgebra::Vector3::zeros);
-    // a cos + b sin = A cos(wt - phi): phase = -phi
-    ((c[1] * c[1] + c[2] * c[2]).sqrt(), -(c[2].atan2(c[1])))
-}
-
-fn wrap(a: f64) -> f64 {
-    let tau = 2.0 * std::f64::consts::PI;
-    let mut v = a % tau;
-    if v <= -std::f64::consts::PI {
-        v += tau;
-    } else if v > std::f64::consts::PI {
-        v -= tau;
-    }
-    v
-}
-
-/// Cycle frequency from the upward mean crossings, located by linear interpolation between
-/// samples (with the hysteresis of [`driven::cycle_frequency`]); `None`: fewer than 2 cycles.
-pub fn crossing_frequency(y: &[f64], dt: f64) -> Option<f64> {
-    driven::cycle_frequency(y, dt)?;
-    let n = y.len() as f64;
-    let m = y.iter().sum::<f64>() / n;
-    let sd = (y.iter().map(|v| (v - m) * (v - m)).sum::<f64>() / n).sqrt();
-    let (lo, hi) = (m - 0.5 * sd, m + 0.5 * sd);
-    let mut armed = false;
-    let mut last_below = 0;
-    let mut ups: Vec<f64> = Vec::new();
-    for (i, &v) in y.iter().enumerate() {
-        if v < m {
-            last_below = i;
-        }
-        if v < lo {
-            armed = true;
-        } else if armed && v > hi {
-            armed = false;
-            // the mean crossing between last_below and last_below + 1
-            let (a, b) = (y[last_below], y[last_below + 1]);
-            ups.push(last_below as f64 + (m - a) / (b - a));
-        }
-    }
-    if ups.len() < 3 {
-        return None;
-    }
-    Some((ups.len() - 1) as f64 / ((ups[ups.len() - 1] - ups[0]) * dt))
-}
-
 /// Features of channels `(name, samples)` (the first must be `x`); `None` when `x` holds
 /// fewer than two cycles.
 pub fn cycle_features(series: &[(String, Vec<f64>)], dt: f64) -> Option<CycleFeatures> {
@@ -382,7 +326,7 @@ pub fn free_run(
     let f_meas = measured
         .as_ref()
         .map(|m| m.frequency)
-        .or_else(|| driven::cycle_frequency(&data.x.as_ref().expect("checked")[..], dt));
+        .or_else(|| crate::signal::cycle_frequency(&data.x.as_ref().expect("checked")[..], dt));
     let short = f_meas
         .map(|f| opts.cycles / f)
         .unwrap_or(block.1 - block.0)

@@ -8,11 +8,12 @@
 
 use stirling_dsl::Model;
 
-use super::driven::{cold_weight, noise_sigma, static_shift, Output, Stage, Var};
+use super::driven::{cold_weight, static_shift, Output, Stage, Var};
 use super::record::Record;
 use super::sensitivity::Given;
 use super::{FitError, FitOptions};
 use crate::layout::StateLayout;
+use crate::signal::noise_sigma;
 
 /// Stage 2 with the bookkeeping that turns its pressure offsets back into position offsets.
 pub struct GasStage<'a> {
@@ -45,8 +46,7 @@ pub fn stage<'a>(
     opts: &FitOptions,
 ) -> Result<GasStage<'a>, FitError> {
     let data = rec.data;
-    let (Some(xm), Some(ym), Some(pm)) = (data.x.as_ref(), data.y.as_ref(), data.p.as_ref())
-    else {
+    let (Some(xm), Some(ym), Some(pm)) = (data.x.as_ref(), data.y.as_ref(), data.p.as_ref()) else {
         return Err(FitError::MissingColumns {
             file: data.source.clone(),
             stage: "stage 2 (gas)",

@@ -72,7 +72,15 @@ impl<'a> Run<'a, '_> {
         free: &[usize],
         x_off: [f64; 2],
     ) -> Result<(GasStage<'a>, Solved), FitError> {
-        let gs = gas::stage(self.model, &self.layout, &self.rec, p, free, x_off, self.opts)?;
+        let gs = gas::stage(
+            self.model,
+            &self.layout,
+            &self.rec,
+            p,
+            free,
+            x_off,
+            self.opts,
+        )?;
         let solved = fit_stage(&gs.stage, self.rec.tr, self.rec.ho, gs.burn, self.opts)?;
         Ok((gs, solved))
     }
@@ -143,7 +151,11 @@ pub fn identify_stages<'a>(
     }
     let mut gas_fit = None;
     if run2 {
-        let free2 = if opts.stage2 { gas_free.clone() } else { Vec::new() };
+        let free2 = if opts.stage2 {
+            gas_free.clone()
+        } else {
+            Vec::new()
+        };
         let (gs, solved) = run.gas(&p, &free2, x_off)?;
         for (out, v) in apply(&gs.stage, &solved.values, &mut p) {
             if out == 0 {

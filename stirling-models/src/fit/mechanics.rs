@@ -9,11 +9,12 @@
 
 use stirling_dsl::Model;
 
-use super::driven::{cold_weight, cycle_frequency, drift_count, noise_sigma, Output, Stage, Var};
+use super::driven::{cold_weight, Output, Stage, Var};
 use super::record::Record;
 use super::sensitivity::{Given, Signal};
 use super::{FitError, FitOptions};
 use crate::layout::StateLayout;
+use crate::signal::{cycle_frequency, drift_count, noise_sigma};
 
 /// What stage 1 is built from besides the record.
 pub struct MechInputs<'s> {
@@ -86,7 +87,11 @@ pub fn stage<'a>(
                 if have_hot {
                     terms.push((1, 1.0 - wc, false));
                 }
-                let hot = if have_hot { (1.0 - wc) * inp.ph_off } else { 0.0 };
+                let hot = if have_hot {
+                    (1.0 - wc) * inp.ph_off
+                } else {
+                    0.0
+                };
                 Given {
                     state: s,
                     terms,
@@ -106,7 +111,12 @@ pub fn stage<'a>(
     ];
     let mut vars = Var::params(model, inp.p, inp.free, opts.prior);
     for (k, nm) in ["x(0)", "v(0)", "y(0)", "w(0)"].iter().enumerate() {
-        vars.push(Var::initial(nm, z0[k], if k % 2 == 0 { 1e-3 } else { 0.05 }, k));
+        vars.push(Var::initial(
+            nm,
+            z0[k],
+            if k % 2 == 0 { 1e-3 } else { 0.05 },
+            k,
+        ));
     }
     vars.push(Var::offset("x_offset", x_off[0], 1e-3, 0, vec![]));
     vars.push(Var::offset("y_offset", x_off[1], 1e-3, 1, vec![]));

@@ -43,7 +43,9 @@ pub enum FitError {
     Start(String),
     #[error("unknown parameter `{name}` of model `{model}`: see `stirling info {model}`")]
     UnknownParameter { name: String, model: String },
-    #[error("parameter `{name}` does not enter the equations of `{model}`: it cannot be identified")]
+    #[error(
+        "parameter `{name}` does not enter the equations of `{model}`: it cannot be identified"
+    )]
     NotInEquations { name: String, model: String },
     #[error("{file}: {samples} samples are too few to fit")]
     TooFewSamples { file: String, samples: usize },
@@ -54,7 +56,11 @@ pub enum FitError {
     #[error("{file}: {stage} needs the columns p, x and y")]
     MissingColumns { file: String, stage: &'static str },
     #[error("parameter `{name}` = {value:.4e} fell below {floor:.4e} (2 % of its start): the data push it out of the physical range")]
-    ParamRange { name: String, value: f64, floor: f64 },
+    ParamRange {
+        name: String,
+        value: f64,
+        floor: f64,
+    },
     #[error("stage 1 expects two bodies (displacer x, piston y); `{model}` has {found}")]
     Bodies { model: String, found: usize },
 }
@@ -184,4 +190,3 @@ pub struct Identification {
     /// Why an optional step (refinement, free run) did not run.
     pub notes: Vec<String>,
 }
-

@@ -24,12 +24,12 @@ use nalgebra::DMatrix;
 use serde::Serialize;
 use stirling_dsl::{Model, StateKind};
 
-use super::driven::{self, noise_sigma};
 use super::free_run::{channels, measured_state, SensorOffsets};
 use super::report::{self, fit_percent, ChannelFit, FitStats};
 use super::sensitivity::{Column, Driven};
 use super::{lm, FitError};
 use crate::data::Measured;
+use crate::signal::noise_sigma;
 use crate::sim::{integrate, state_scale, Hooks, SimOptions};
 
 /// Options of the refinement.
@@ -259,8 +259,8 @@ pub fn multiple_shooting(
             block.0, block.1
         )));
     }
-    let f = driven::cycle_frequency(&ch[0].data[a..=b], dt)
-        .or_else(|| driven::cycle_frequency(&ch[1].data[a..=b], dt))
+    let f = crate::signal::cycle_frequency(&ch[0].data[a..=b], dt)
+        .or_else(|| crate::signal::cycle_frequency(&ch[1].data[a..=b], dt))
         .ok_or_else(|| {
             FitError::Bad("multiple shooting: fewer than two cycles in the block".into())
         })?;

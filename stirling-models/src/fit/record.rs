@@ -4,11 +4,11 @@
 
 use stirling_dsl::Model;
 
-use super::driven::savitzky_golay;
 use super::sensitivity::Signal;
 use super::{FitError, FitOptions};
 use crate::data::{cycle_mean, Measured};
 use crate::layout::StateLayout;
+use crate::signal::savitzky_golay;
 
 /// A record prepared for the two stages.
 pub struct Record<'a> {

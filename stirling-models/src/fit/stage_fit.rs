@@ -6,10 +6,11 @@ use std::time::Instant;
 
 use nalgebra::DMatrix;
 
-use super::driven::{project_drift, Stage, VarKind};
+use super::driven::{Stage, VarKind};
 use super::lm::{self, LmResult};
 use super::report::{self, fit_percent, ChannelFit};
 use super::{FitError, FitOptions, Series, StageFit};
+use crate::signal::project_drift;
 
 /// A fitted stage with its optimum, for analyses that extend it (the gap diagnosis).
 #[derive(Clone)]
@@ -141,7 +142,10 @@ fn evaluate(
             let range = run.first..run.first + run.yhat[o].len();
             Series {
                 channel: out.channel.clone(),
-                t: range.clone().map(|i| stage.t0 + i as f64 * stage.dt).collect(),
+                t: range
+                    .clone()
+                    .map(|i| stage.t0 + i as f64 * stage.dt)
+                    .collect(),
                 measured: range.map(|i| out.data[i]).collect(),
                 model: run.yhat[o].clone(),
             }
@@ -176,7 +180,11 @@ fn block_fits(
             project_drift(&mut e, m);
             yh = y.iter().zip(&e).map(|(a, b)| a + b).collect();
         }
-        let rms = (y.iter().zip(&yh).map(|(a, b)| (a - b) * (a - b)).sum::<f64>()
+        let rms = (y
+            .iter()
+            .zip(&yh)
+            .map(|(a, b)| (a - b) * (a - b))
+            .sum::<f64>()
             / y.len().max(1) as f64)
             .sqrt();
         fits.push(ChannelFit {

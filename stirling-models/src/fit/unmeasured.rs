@@ -58,7 +58,7 @@ pub fn pressure_differences(
                 let j = k.saturating_sub(first);
                 *v = run.yhat[i][j] - run.yhat[cold][j];
             }
-            let der = super::driven::derivative(&val, rec.dt);
+            let der = crate::signal::derivative(&val, rec.dt);
             Signal {
                 t0: rec.t0,
                 dt: rec.dt,
@@ -110,11 +110,17 @@ pub fn carried_covariance(
         ua[k] -= h;
         ub[k] += h;
         let (ra, rb) = (residuals_at(&ua)?, residuals_at(&ub)?);
-        let d = DVector::from_iterator(ra.len(), ra.iter().zip(&rb).map(|(a, b)| (b - a) / (2.0 * h)));
+        let d = DVector::from_iterator(
+            ra.len(),
+            ra.iter().zip(&rb).map(|(a, b)| (b - a) / (2.0 * h)),
+        );
         let col = -(&inv * (j1.transpose() * d));
         g.set_column(k, &col);
     }
-    let c2 = scaled_covariance(stats2, &gas.vars.iter().map(|v| v.scale).collect::<Vec<_>>());
+    let c2 = scaled_covariance(
+        stats2,
+        &gas.vars.iter().map(|v| v.scale).collect::<Vec<_>>(),
+    );
     Ok(Some(&g * c2 * g.transpose()))
 }
 
@@ -129,7 +135,11 @@ fn scaled_covariance(stats: &FitStats, scale: &[f64]) -> DMatrix<f64> {
         .collect();
     DMatrix::from_fn(k, k, |a, b| {
         let c = stats.correlation[a][b];
-        let c = if c.is_finite() { c } else { f64::from(u8::from(a == b)) };
+        let c = if c.is_finite() {
+            c
+        } else {
+            f64::from(u8::from(a == b))
+        };
         c * se[a] * se[b]
     })
 }
