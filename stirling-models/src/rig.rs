@@ -9,9 +9,10 @@ use std::path::{Path, PathBuf};
 
 use rand::{rngs::StdRng, Rng, SeedableRng};
 use serde::Serialize;
-use stirling_dsl::{Closure, Model, StateKind};
+use stirling_dsl::Closure;
 
 use crate::data::{write_csv, Measured};
+use crate::layout::StateLayout;
 use crate::effects::{augmented, EffectSettings};
 use crate::signal::first_order_lag;
 use crate::sim::{simulate, SimOptions};
@@ -133,17 +134,6 @@ impl Gauss {
     }
 }
 
-/// Indices of the cold-side and hot-side pressure states (last and first CV).
-pub fn pressure_states(model: &dyn Model) -> (usize, usize) {
-    let ps: Vec<usize> = model
-        .states()
-        .iter()
-        .enumerate()
-        .filter(|(_, s)| matches!(s.kind, StateKind::Pressure(_)))
-        .map(|(i, _)| i)
-        .collect();
-    (*ps.last().expect("a CV model"), ps[0])
-}
 
 /// Lowest sample rate the rig accepts (Hz): the family runs near 13 Hz, and the fit's
 /// smoothing derivatives need several samples per millisecond-scale feature.
@@ -234,12 +224,11 @@ pub fn run(cfg: &RigConfig) -> Result<RigOutput, RigError> {
         &samples,
         &opts,
     )?;
-    let (ic, ih) = pressure_states(model.as_ref());
-    let ncv = model
-        .states()
-        .iter()
-        .filter(|s| matches!(s.kind, StateKind::Pressure(_)))
-        .count();
+    let ps = StateLayout::of(model.as_ref()).pressures;
+    let (Some(&ic), Some(&ih)) = (ps.last(), ps.first()) else {
+        return Err(RigError::Bad(format!("`{}` has no gas volume to measure", cfg.model)));
+    };
+    let ncv = ps.len();
     let col = |i: usize| traj.x.iter().map(|r| r[i]).collect::<Vec<f64>>();
     let tau = fx.sensor_value("tau_p");
     let (gx, gy) = (fx.sensor_value("gain_x"), fx.sensor_value("gain_y"));

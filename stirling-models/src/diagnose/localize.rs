@@ -190,13 +190,7 @@ fn free_run(
         &SimOptions::default(),
     )
     .map_err(|e| e.to_string())?;
-    let ps: Vec<usize> = model
-        .states()
-        .iter()
-        .enumerate()
-        .filter(|(_, s)| matches!(s.kind, StateKind::Pressure(_)))
-        .map(|(i, _)| i)
-        .collect();
+    let ps = crate::layout::StateLayout::of(model).pressures;
     let ic = *ps.last().ok_or("no pressure state")?;
     let col = |i: usize| tr.x.iter().map(|r| r[i]).collect::<Vec<f64>>();
     let (x, y, pc) = (col(0), col(2), col(ic));

@@ -13,7 +13,7 @@
 //! Gradients are forward sensitivities ([`super::sensitivity`]) on the generated Jacobians.
 
 use nalgebra::{DMatrix, DVector};
-use stirling_dsl::{Model, StateKind};
+use stirling_dsl::Model;
 
 use super::sensitivity::{Column, Driven, Given, Signal};
 use super::FitError;
@@ -571,30 +571,6 @@ fn lag_columns(rows: &mut [Vec<f64>], dt: f64, tau: f64) {
     }
 }
 
-/// Indices of the body states (positions and velocities) and of the gas states.
-pub fn split_states(model: &dyn Model) -> (Vec<usize>, Vec<usize>) {
-    let mut bodies = Vec::new();
-    let mut gas = Vec::new();
-    for (i, s) in model.states().iter().enumerate() {
-        match s.kind {
-            StateKind::Position(_) | StateKind::Velocity(_) => bodies.push(i),
-            _ => gas.push(i),
-        }
-    }
-    (bodies, gas)
-}
-
-/// Indices of the pressure states, in CV order.
-pub fn pressure_states(model: &dyn Model) -> Vec<usize> {
-    model
-        .states()
-        .iter()
-        .enumerate()
-        .filter(|(_, s)| matches!(s.kind, StateKind::Pressure(_)))
-        .map(|(i, _)| i)
-        .collect()
-}
-
 /// Weight of the cold-side channel in the prescribed pressure of CV `i` of `ncv` (hot = 0).
 pub fn cold_weight(i: usize, ncv: usize, have_hot: bool) -> f64 {
     if !have_hot || ncv < 2 {
@@ -615,20 +591,8 @@ pub fn static_shift(
     let mut eq = vec![0.0; n];
     model.equilibrium_guess(p, &mut eq);
     let j = model.jacobian_dense(p, &eq, 0.0);
-    let st = model.states();
-    let pos: Vec<usize> = st
-        .iter()
-        .enumerate()
-        .filter(|(_, s)| matches!(s.kind, StateKind::Position(_)))
-        .map(|(i, _)| i)
-        .collect();
-    let vel: Vec<usize> = st
-        .iter()
-        .enumerate()
-        .filter(|(_, s)| matches!(s.kind, StateKind::Velocity(_)))
-        .map(|(i, _)| i)
-        .collect();
-    let ps = pressure_states(model);
+    let layout = crate::layout::StateLayout::of(model);
+    let (pos, vel, ps) = (&layout.positions, &layout.velocities, &layout.pressures);
     let jaq = DMatrix::from_fn(vel.len(), pos.len(), |r, c| j[vel[r] + n * pos[c]]);
     let lu = jaq.lu();
     let mut out = [Vec::new(), Vec::new()];

@@ -23,7 +23,8 @@ use std::time::Instant;
 use serde::Serialize;
 use stirling_dsl::{Model, StateKind};
 
-use super::driven::{cold_weight, pressure_states};
+use super::driven::cold_weight;
+use crate::layout::StateLayout;
 use super::report::{fit_percent, ChannelFit};
 use super::{FitError, Series};
 use crate::data::Measured;
@@ -64,14 +65,8 @@ pub struct Channel {
 /// The observed channels: `x`, `y` (body positions), `p` (cold pressure), `p_hot` (hot
 /// pressure, when measured and the model has more than one control volume).
 pub fn channels(model: &dyn Model, data: &Measured) -> Result<Vec<Channel>, FitError> {
-    let pos: Vec<usize> = model
-        .states()
-        .iter()
-        .enumerate()
-        .filter(|(_, s)| matches!(s.kind, StateKind::Position(_)))
-        .map(|(i, _)| i)
-        .collect();
-    let ps = pressure_states(model);
+    let layout = StateLayout::of(model);
+    let (pos, ps) = (&layout.positions, &layout.pressures);
     let (Some(x), Some(y), Some(p)) = (&data.x, &data.y, &data.p) else {
         return Err(FitError::Bad(format!(
             "{}: the free run needs the columns p, x and y",
@@ -149,7 +144,8 @@ pub fn measured_state(
             .ok_or_else(|| FitError::Bad("a body without a velocity state".into()))?;
         x[vel] = d;
     }
-    let ps = pressure_states(model);
+    let layout = StateLayout::of(model);
+    let ps = &layout.pressures;
     let have_hot = ch.len() > 3;
     let pc = smooth(&ch[2].data, (h / 2).max(3)).0 - off.p;
     let ph = if have_hot {
@@ -161,9 +157,7 @@ pub fn measured_state(
         let wc = cold_weight(i, ps.len(), have_hot);
         x[s] = wc * pc + (1.0 - wc) * ph;
     }
-    let masses: Vec<usize> = (0..n)
-        .filter(|&i| matches!(states[i].kind, StateKind::Mass(_)))
-        .collect();
+    let masses = &layout.masses;
     if !masses.is_empty() {
         let nv = model.vessel_names().len();
         let (mut pr, mut vol) = (vec![0.0; nv], vec![0.0; nv]);

@@ -66,13 +66,7 @@ pub fn state_scales(model: &dyn Model, x: &[f64]) -> Vec<f64> {
 
 /// Indices of the mass states (empty unless the closure is `full`).
 pub fn mass_states(model: &dyn Model) -> Vec<usize> {
-    model
-        .states()
-        .iter()
-        .enumerate()
-        .filter(|(_, s)| matches!(s.kind, StateKind::Mass(_)))
-        .map(|(i, _)| i)
-        .collect()
+    crate::layout::StateLayout::of(model).masses
 }
 
 /// Solve from the model's own guess.

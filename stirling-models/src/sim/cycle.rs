@@ -54,9 +54,7 @@ pub fn figures(model: &dyn Model, p: &[f64], period: f64, states: &[Vec<f64>]) -
     let xs = pos(0).map(col).unwrap_or_default();
     let ys = pos(1).map(col).unwrap_or_default();
     let pressures: Vec<Vec<f64>> = {
-        let pk: Vec<usize> = (0..kinds.len())
-            .filter(|&i| matches!(kinds[i].kind, StateKind::Pressure(_)))
-            .collect();
+        let pk = crate::layout::StateLayout::of(model).pressures;
         if pk.is_empty() {
             // algebraic pressure (schmidt): the first vessel of `pv`
             let nv = model.vessel_names().len();

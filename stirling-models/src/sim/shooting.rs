@@ -179,9 +179,7 @@ pub fn shoot(
                 "shooting needs a second body (the power piston) for its section".into(),
             )
         })?;
-    let masses: Vec<usize> = (0..n)
-        .filter(|&i| matches!(kinds[i].kind, StateKind::Mass(_)))
-        .collect();
+    let masses = crate::layout::StateLayout::of(model).masses;
     let s = state_scale(model, p);
     let m_total: f64 = masses.iter().map(|&i| x0[i]).sum();
     let (mut x, mut t_per) = (x0.to_vec(), period);
