@@ -7,7 +7,7 @@
 use rand::{rngs::StdRng, Rng, SeedableRng};
 use serde::Serialize;
 
-use super::{Context, Eval};
+use super::context::{Context, Eval};
 use crate::data::Measured;
 use crate::signal::cycle_starts;
 

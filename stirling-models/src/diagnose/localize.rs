@@ -9,7 +9,7 @@
 use serde::Serialize;
 use stirling_dsl::{Model, StateKind};
 
-use super::{Context, Eval};
+use super::context::{Context, Eval};
 use crate::data::{cycle_mean, Measured};
 use crate::signal::cycle_starts;
 use crate::signal::dft;

@@ -17,7 +17,8 @@ use nalgebra::DVector;
 
 use super::joint::{EffectVar, Joint};
 use super::score::{robust_score, Score};
-use super::{Context, EffectEstimate, Eval, RankEntry};
+use super::context::{Context, Eval};
+use super::types::{EffectEstimate, RankEntry};
 use crate::effects::{EffectInfo, EffectTarget};
 use crate::fit::lm::{self, LmOptions};
 use crate::fit::FittedStage;

@@ -7,7 +7,7 @@ use std::path::Path;
 use plotters::prelude::*;
 
 use super::localize::{HARMONICS, PHASE_BINS};
-use super::Diagnosis;
+use super::types::Diagnosis;
 use crate::data::Measured;
 
 fn bars(
@@ -122,8 +122,8 @@ fn overlay(path: &Path, d: &Diagnosis, data: &Measured, ch: &str) -> Result<(), 
         .build_cartesian_2d(data.t[i0]..data.t[i1 - 1], (lo - pad)..(hi + pad))
         .map_err(|e| err(&e))?;
     c.configure_mesh()
-        .x_desc("t (s)")
-        .y_desc(ch)
+        .x_desc(crate::plot::axes::label("t", "s"))
+        .y_desc(crate::plot::axes::channel_label(ch))
         .draw()
         .map_err(|e| err(&e))?;
     c.draw_series(m.iter().map(|&p| Circle::new(p, 1, BLACK.filled())))
@@ -160,8 +160,8 @@ pub fn write(d: &Diagnosis, data: &Measured, dir: &Path) -> Result<std::path::Pa
     bars(
         &dir.join("residual_phase.svg"),
         "residual RMS / noise by phase of the cycle",
-        &format!("phase bin ({PHASE_BINS} per cycle)"),
-        "RMS / noise",
+        &format!("phase of the cycle [bin of 1/{PHASE_BINS} cycle]"),
+        "residual RMS / noise [-]",
         &phase,
         Some(1.0),
     )?;
@@ -178,8 +178,8 @@ pub fn write(d: &Diagnosis, data: &Measured, dir: &Path) -> Result<std::path::Pa
     bars(
         &dir.join("residual_harmonics.svg"),
         "residual amplitude / noise level by harmonic",
-        &format!("harmonic 0..{}", HARMONICS - 1),
-        "amplitude / (2 sigma / sqrt N)",
+        &format!("harmonic 0..{} [multiple of the cycle frequency]", HARMONICS - 1),
+        "amplitude / (2 sigma / sqrt N) [-]",
         &harm,
         Some(1.0),
     )?;

@@ -8,7 +8,10 @@ use std::time::Instant;
 
 use serde::Serialize;
 
-use super::{diagnose, nominal_model, DiagnoseError, DiagnoseOptions, Diagnosis};
+use super::candidates::nominal_model;
+use super::run::diagnose;
+use super::types::Diagnosis;
+use super::{DiagnoseError, DiagnoseOptions};
 use crate::data::{read_csv, write_csv};
 use crate::effects::{effect, effects_for};
 use crate::rig::{self, RigConfig};

@@ -15,7 +15,8 @@
 
 use serde::Serialize;
 
-use super::{Eval, ParamShift, RankEntry};
+use super::context::Eval;
+use super::types::{ParamShift, RankEntry};
 
 /// The lower closure bound a winner must clear.
 pub const MIN_CLOSURE: f64 = 0.2;

@@ -1,0 +1,49 @@
+//! The training and held-out blocks of a record.
+
+use super::{DiagnoseError, DiagnoseOptions};
+use crate::data::Measured;
+
+/// Training and held-out blocks (times and sample ranges) of a record.
+pub(super) struct Blocks {
+    pub train: (f64, f64),
+    pub holdout: (f64, f64),
+    pub train_idx: (usize, usize),
+    pub hold_idx: (usize, usize),
+}
+
+pub(super) fn blocks(data: &Measured, opts: &DiagnoseOptions) -> Result<Blocks, DiagnoseError> {
+    if data.t.len() < 100 {
+        return Err(DiagnoseError::Bad(format!(
+            "{}: {} samples are too few to diagnose",
+            data.source,
+            data.t.len()
+        )));
+    }
+    let t0 = data.t[0];
+    let t1 = data.t[data.t.len() - 1];
+    let train = opts.train.unwrap_or((t0, t0 + 0.6 * (t1 - t0)));
+    let holdout = opts.holdout.unwrap_or((train.1, t1));
+    if holdout.0 < train.1 - 1e-12 {
+        return Err(DiagnoseError::Bad(format!(
+            "the held-out block {}:{} must start after the training block {}:{}",
+            holdout.0, holdout.1, train.0, train.1
+        )));
+    }
+    let dt = data.dt();
+    let idx = |t: f64| (((t - t0) / dt).round().max(0.0) as usize).min(data.t.len() - 1);
+    let burn = (opts.fit.burn_in / dt).round() as usize;
+    let train_idx = ((idx(train.0) + burn).min(idx(train.1)), idx(train.1));
+    let hold_idx = (idx(holdout.0).max(train_idx.1), idx(holdout.1) + 1);
+    if train_idx.1 < train_idx.0 + 50 || hold_idx.1 < hold_idx.0 + 50 {
+        return Err(DiagnoseError::Bad(
+            "the training and held-out blocks need at least 50 samples each (after the burn-in)"
+                .into(),
+        ));
+    }
+    Ok(Blocks {
+        train,
+        holdout,
+        train_idx,
+        hold_idx,
+    })
+}

@@ -1,0 +1,49 @@
+//! The candidate effects of a diagnosis and the nominal (augmented, at the nulls) model.
+
+use stirling_dsl::{Closure, Model};
+
+use super::DiagnoseError;
+use crate::effects::{self, EffectInfo};
+
+/// The candidate effects of a diagnosis.
+pub(super) fn candidates(
+    model: &dyn Model,
+    names: &Option<Vec<String>>,
+) -> Result<Vec<&'static EffectInfo>, DiagnoseError> {
+    let base = model.name().trim_end_matches("_fx").to_string();
+    let Some(names) = names else {
+        return Ok(effects::effects_for(&base));
+    };
+    let mut v = Vec::new();
+    for n in names {
+        let e = effects::effect(n).ok_or_else(|| {
+            DiagnoseError::Bad(format!(
+                "unknown effect `{n}`: expected one of {}",
+                effects::EFFECTS
+                    .iter()
+                    .map(|e| e.name)
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            ))
+        })?;
+        if !e.applies_to.contains(&base.as_str()) {
+            return Err(DiagnoseError::Bad(format!(
+                "effect `{n}` does not apply to `{base}` (it applies to {})",
+                e.applies_to.join(", ")
+            )));
+        }
+        v.push(e);
+    }
+    Ok(v)
+}
+
+/// The augmented model of a base model name, with its nominal parameters.
+pub fn nominal_model(
+    base: &str,
+    n: Option<usize>,
+) -> Result<(Box<dyn Model>, Vec<f64>), DiagnoseError> {
+    let m = effects::augmented(base, n, Closure::Full)
+        .map_err(|e| DiagnoseError::Bad(e.to_string()))?;
+    let p = effects::nominal_params(m.as_ref());
+    Ok((m, p))
+}

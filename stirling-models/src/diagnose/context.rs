@@ -1,0 +1,194 @@
+//! The evaluation context of one diagnosis: the record, its blocks and noise levels, the
+//! nominal predictions, and the residuals of a model (nominal or with an effect) on them.
+
+use stirling_dsl::Model;
+
+use super::joint::Joint;
+use crate::data::{cycle_mean, Measured};
+use crate::fit::FittedStage;
+use crate::signal::{high_pass, project_drift};
+
+/// The residuals of one model (nominal or with an effect) on the record.
+#[derive(Clone, Debug)]
+pub struct Eval {
+    /// Effect values (empty for the nominal model).
+    pub theta: Vec<f64>,
+    /// Held-out mean of the per-sample, channel-averaged (residual / noise)^2.
+    pub holdout_error: f64,
+    pub train_error: f64,
+    /// Channel names and, per channel, the residual (measured minus model) on the whole
+    /// evaluated range (`NaN` outside it) and the model prediction in measured space.
+    pub channels: Vec<String>,
+    pub resid: Vec<Vec<f64>>,
+    /// The residuals with their slow part (a centered moving average over one cycle) removed:
+    /// what the costs and errors use.
+    pub hp: Vec<Vec<f64>>,
+    pub pred: Vec<Vec<f64>>,
+    /// All model parameters (effect values applied).
+    pub p: Vec<f64>,
+}
+
+/// A model prediction of one channel in measured space, from sample `first` on.
+#[derive(Clone, Debug)]
+pub struct Prediction {
+    pub channel: String,
+    pub first: usize,
+    pub values: Vec<f64>,
+    /// Drift cosines per sample that the stage's fit ignores ([`crate::fit::driven::Stage::drift`]):
+    /// the same band is projected out of this channel's residuals on every block.
+    pub drift_rate: f64,
+}
+
+/// The prediction of a fitted stage at variables `u`, from its training start to `last`.
+pub fn predict(st: &FittedStage, u: &[f64], last: usize) -> Result<Vec<Prediction>, String> {
+    let run = st
+        .stage
+        .run(u, st.first, last, false)
+        .map_err(|e| e.to_string())?;
+    Ok(st
+        .stage
+        .outputs
+        .iter()
+        .zip(run.yhat)
+        .map(|(o, values)| Prediction {
+            channel: o.channel.clone(),
+            first: run.first,
+            values,
+            drift_rate: st.stage.drift as f64 / st.keep.len().max(1) as f64,
+        })
+        .collect())
+}
+
+/// What every evaluation of a diagnosis shares.
+pub struct Context<'a> {
+    pub model: &'a dyn Model,
+    pub data: &'a Measured,
+    /// Per-channel noise from the original record.
+    pub noise: Vec<(String, f64)>,
+    /// Training sample range (after the burn-in) and held-out range, inclusive-exclusive.
+    pub train_idx: (usize, usize),
+    pub hold_idx: (usize, usize),
+    /// Half-width (samples) of the moving average removed from the residuals (half a cycle).
+    pub half_period: usize,
+    /// Bartlett bandwidth of the robust score test (samples).
+    pub lag: usize,
+    /// The calibrated nominal parameters.
+    pub p_nom: Vec<f64>,
+    /// The nominal stages' predictions (per stage), reused for stages an effect leaves alone.
+    pub nominal_preds: Vec<Vec<Prediction>>,
+    /// Per nominal stage: Monte Carlo draws of how input noise moves its weighted residuals.
+    pub input_noise: Vec<Vec<Vec<f64>>>,
+    /// Joint fits run.
+    pub fits: std::sync::atomic::AtomicUsize,
+}
+
+impl Context<'_> {
+    /// The noise level of a channel (1 if unknown).
+    pub fn noise_of(&self, ch: &str) -> f64 {
+        self.noise
+            .iter()
+            .find(|(c, _)| c == ch)
+            .map(|(_, s)| *s)
+            .unwrap_or(1.0)
+    }
+
+    /// The recorded excursion of a position channel about its mean (99.5th percentile).
+    pub fn excursion(&self, ch: &str) -> Option<f64> {
+        let v = self.data.channel(ch)?;
+        let m = cycle_mean(v);
+        let mut a: Vec<f64> = v.iter().map(|s| (s - m).abs()).collect();
+        a.sort_by(f64::total_cmp);
+        a.get((a.len() as f64 * 0.995) as usize).copied()
+    }
+
+    /// Residual samples (all channels) on the held-out block.
+    pub fn holdout_points(&self, ev: &Eval) -> usize {
+        (self.hold_idx.1 - self.hold_idx.0) * ev.channels.len()
+    }
+
+    /// The evaluation of a set of predictions (effect values `theta`, parameters `p`).
+    pub fn eval(&self, preds: &[Prediction], theta: Vec<f64>, p: Vec<f64>) -> Result<Eval, String> {
+        let nt = self.data.t.len();
+        let (mut channels, mut resid, mut pred) = (Vec::new(), Vec::new(), Vec::new());
+        for pr in preds {
+            let meas = self
+                .data
+                .channel(&pr.channel)
+                .ok_or_else(|| format!("channel `{}` missing", pr.channel))?;
+            let mut r = vec![f64::NAN; nt];
+            let mut pv = vec![f64::NAN; nt];
+            for (k, v) in pr.values.iter().enumerate() {
+                let i = pr.first + k;
+                if i < nt {
+                    r[i] = meas[i] - v;
+                    pv[i] = *v;
+                }
+            }
+            channels.push(pr.channel.clone());
+            resid.push(r);
+            pred.push(pv);
+        }
+        if channels.is_empty() {
+            return Err("the calibration produced no output series".into());
+        }
+        let hp: Vec<Vec<f64>> = resid
+            .iter()
+            .zip(preds)
+            .map(|(r, pr)| {
+                let mut h = high_pass(r, self.half_period);
+                for (a, b) in [self.train_idx, self.hold_idx] {
+                    let m = (pr.drift_rate * (b - a) as f64).round() as usize;
+                    if m > 0 && h[a..b].iter().all(|v| v.is_finite()) {
+                        project_drift(&mut h[a..b], m);
+                    }
+                }
+                h
+            })
+            .collect();
+        let sample_err = |range: (usize, usize)| -> Result<f64, String> {
+            let mut total = 0.0;
+            for i in range.0..range.1 {
+                for (c, r) in channels.iter().zip(&hp) {
+                    let z = r[i] / self.noise_of(c);
+                    if !z.is_finite() {
+                        return Err(format!("no model output for `{c}` at sample {i}"));
+                    }
+                    total += z * z;
+                }
+            }
+            let n = ((range.1 - range.0) * channels.len()).max(1) as f64;
+            Ok(total / n)
+        };
+        let train_error = sample_err(self.train_idx)?;
+        let holdout_error = sample_err(self.hold_idx)?;
+        Ok(Eval {
+            theta,
+            holdout_error,
+            train_error,
+            channels,
+            resid,
+            hp,
+            pred,
+            p,
+        })
+    }
+
+    /// The evaluation of a fitted joint problem: its stages at `u`, the others nominal.
+    pub fn eval_joint(&self, joint: &Joint, u: &[f64], theta: Vec<f64>) -> Result<Eval, String> {
+        let last = self.hold_idx.1 - 1;
+        let mut preds = Vec::new();
+        for (si, nom) in self.nominal_preds.iter().enumerate() {
+            match joint.stages.iter().position(|(s, _)| *s == si) {
+                Some(k) => preds.extend(predict(&joint.stages[k].1, &joint.stage_u(k, u), last)?),
+                None => preds.extend(nom.iter().cloned()),
+            }
+        }
+        let mut p = self.p_nom.clone();
+        for (v, val) in joint.effect.iter().zip(&theta) {
+            if let Some(i) = self.model.param_index(&v.name) {
+                p[i] = *val;
+            }
+        }
+        self.eval(&preds, theta, p)
+    }
+}

@@ -1,0 +1,63 @@
+//! The nominal model's held-out gap per channel, with features and calibrated parameters.
+
+use super::context::{Context, Eval};
+use super::types::{ChannelError, GapBefore, ParamShift};
+use super::localize;
+use crate::fit;
+use crate::fit::FittedStage;
+
+/// The nominal model's held-out gap per channel, with features and calibrated parameters.
+pub(super) fn gap_before(
+    ctx: &Context,
+    nominal: &Eval,
+    stages: &[FittedStage],
+    loc: &localize::Localization,
+) -> GapBefore {
+    let (a, b) = ctx.hold_idx;
+    let channels = nominal
+        .channels
+        .iter()
+        .zip(&nominal.hp)
+        .map(|(c, r)| {
+            let rms = (r[a..b].iter().map(|v| v * v).sum::<f64>() / (b - a) as f64).sqrt();
+            let s = ctx.noise_of(c);
+            ChannelError {
+                channel: c.clone(),
+                rms,
+                noise: s,
+                ratio: rms / s,
+            }
+        })
+        .collect();
+    let fitted: Vec<(&fit::driven::Var, f64)> = stages
+        .iter()
+        .flat_map(|st| st.stage.vars.iter())
+        .filter_map(|v| match v.kind {
+            fit::driven::VarKind::Param(i) => Some((v, ctx.p_nom[i])),
+            _ => None,
+        })
+        .collect();
+    let params = fitted.iter().map(|(v, x)| (v.name.clone(), *x)).collect();
+    let shifts = fitted
+        .iter()
+        .filter(|(v, _)| v.initial != 0.0)
+        .map(|(v, x)| {
+            let factor = x / v.initial;
+            ParamShift {
+                name: v.name.clone(),
+                start: v.initial,
+                calibrated: *x,
+                factor,
+                prior_sd: v.prior.filter(|_| factor > 0.0).map(|s| factor.ln() / s),
+            }
+        })
+        .collect();
+    GapBefore {
+        shifts,
+        channels,
+        holdout_error: nominal.holdout_error,
+        train_error: nominal.train_error,
+        features: loc.features.clone(),
+        params,
+    }
+}

@@ -1,0 +1,163 @@
+//! One diagnosis: calibrate, localize, assess every candidate (in parallel), close, decide.
+
+use std::time::Instant;
+
+use stirling_dsl::Model;
+
+use super::blocks::blocks;
+use super::candidates::candidates;
+use super::context::{predict, Context, Prediction};
+use super::gap::gap_before;
+use super::types::{Diagnosis, RankEntry};
+use super::{closure, joint, localize, rank, score, verdict, DiagnoseError, DiagnoseOptions};
+use crate::data::Measured;
+use crate::fit;
+use crate::signal::noise_sigma;
+
+/// Diagnose `model` (a base model with an augmented member: `cv1`, `nsection`) from starting
+/// parameters `p0` (of the augmented model, effects at their nulls) on a measured record.
+pub fn diagnose(
+    model: &dyn Model,
+    p0: &[f64],
+    data: &Measured,
+    opts: &DiagnoseOptions,
+) -> Result<Diagnosis, DiagnoseError> {
+    let clock = Instant::now();
+    let b = blocks(data, opts)?;
+    let cands = candidates(model, &opts.effects)?;
+    let noise: Vec<(String, f64)> = data
+        .channels()
+        .iter()
+        .filter_map(|c| {
+            data.channel(c)
+                .map(|v| (c.to_string(), noise_sigma(v).max(1e-12)))
+        })
+        .collect();
+    let mut fit_opts = opts.fit.clone();
+    fit_opts.train = Some(b.train);
+    fit_opts.holdout = Some(b.holdout);
+    // the diagnosis needs the stages, not the validation extras
+    fit_opts.free_run = None;
+    fit_opts.multiple_shooting = None;
+    fit_opts.input_noise_draws = 0;
+    fit_opts.prior = opts.prior;
+    let (id, stages) = fit::identify_stages(model, p0, data, &fit_opts)
+        .map_err(|e| DiagnoseError::Nominal(e.to_string()))?;
+    let mut p_nom = p0.to_vec();
+    for (name, v) in &id.params {
+        if let Some(i) = model.param_index(name) {
+            p_nom[i] = *v;
+        }
+    }
+    let starts = crate::signal::cycle_starts(data, (b.train_idx.0, b.hold_idx.1));
+    let period = if starts.len() >= 2 {
+        (starts[starts.len() - 1] - starts[0]) / (starts.len() - 1)
+    } else {
+        0
+    };
+    let last = b.hold_idx.1 - 1;
+    let nominal_preds = stages
+        .iter()
+        .map(|st| predict(st, &st.u, last))
+        .collect::<Result<Vec<_>, String>>()
+        .map_err(DiagnoseError::Nominal)?;
+    let ctx = Context {
+        model,
+        data,
+        noise,
+        train_idx: b.train_idx,
+        hold_idx: b.hold_idx,
+        half_period: period / 2,
+        lag: score::bandwidth(b.train_idx.1 - b.train_idx.0, period),
+        p_nom: p_nom.clone(),
+        nominal_preds,
+        input_noise: stages
+            .iter()
+            .map(|st| {
+                st.stage.input_noise_draws(
+                    &st.u,
+                    st.first,
+                    st.last,
+                    &st.keep,
+                    opts.noise_draws,
+                    opts.seed,
+                )
+            })
+            .collect::<Result<Vec<_>, _>>()
+            .map_err(|e| DiagnoseError::Nominal(e.to_string()))?,
+        fits: std::sync::atomic::AtomicUsize::new(1),
+    };
+    let all: Vec<Prediction> = ctx.nominal_preds.iter().flatten().cloned().collect();
+    let nominal = ctx
+        .eval(&all, vec![], p_nom.clone())
+        .map_err(DiagnoseError::Nominal)?;
+    let s2 = stages
+        .iter()
+        .map(joint::variance_factor)
+        .collect::<Result<Vec<f64>, _>>()
+        .map_err(|e| DiagnoseError::Nominal(e.to_string()))?;
+    let localization = localize::localize(model, &p_nom, data, &nominal, &ctx);
+    if std::env::var_os("STIRLING_DIAGNOSE_DEBUG").is_some() {
+        eprintln!("nominal parameters: {:?}", id.params);
+        for c in &localization.channels {
+            eprintln!(
+                "nominal {}: train {:.3}, held-out {:.3} x noise; s2 {s2:?}",
+                c.channel, c.train_ratio, c.holdout_ratio
+            );
+        }
+    }
+    let mut lm = opts.fit.lm;
+    lm.max_iter = opts.joint_iters;
+    // trial steps of at most one typical strength: far trials (an engine stopped by friction)
+    // are slow to integrate and rejected anyway
+    lm.max_step = 1.0;
+    // the candidates are independent: one per core
+    let mut assessed: Vec<rank::Assessed> = {
+        use rayon::prelude::*;
+        cands
+            .par_iter()
+            .map(|e| rank::assess(&ctx, &stages, &s2, &nominal, e, &lm))
+            .collect()
+    };
+    rank::sort(&mut assessed, opts.alpha / cands.len().max(1) as f64);
+    for a in assessed.iter_mut() {
+        if let Some(ev) = &a.eval {
+            let c = closure::closure(
+                data,
+                &nominal,
+                ev,
+                ctx.hold_idx,
+                &ctx,
+                opts.bootstrap,
+                opts.seed,
+            );
+            a.entry.closure_fraction = Some(c.fraction);
+            a.entry.ci_low = Some(c.ci_low);
+            a.entry.ci_high = Some(c.ci_high);
+        }
+    }
+    let after = assessed.first().and_then(|a| a.eval.clone());
+    let ranking: Vec<RankEntry> = assessed.into_iter().map(|a| a.entry).collect();
+    let gap_before = gap_before(&ctx, &nominal, &stages, &localization);
+    let verdict = verdict::decide(
+        &ranking,
+        &nominal,
+        opts.alpha,
+        cands.len(),
+        &gap_before.shifts,
+    );
+    Ok(Diagnosis {
+        model: model.name().into(),
+        n: model.n(),
+        train: b.train,
+        holdout: b.holdout,
+        gap_before,
+        localization,
+        ranking,
+        verdict,
+        fits: ctx.fits.load(std::sync::atomic::Ordering::Relaxed),
+        seconds: clock.elapsed().as_secs_f64(),
+        before: Some(nominal),
+        after,
+    })
+}
