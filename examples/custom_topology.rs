@@ -293,7 +293,7 @@ fn figures(
         dir.join("pv.svg"),
     ];
     plot::poles::pole_map(&files[0], &title, &lin.dynamics.poles, &lin.open_loop.poles)?;
-    plot::bode::bode_diagram(&files[1], &title, &lin.bode(), &lin.margins)?;
+    plot::bode::loop_bode(&files[1], &plot::bode::model_tag(model), lin)?;
     let tr = &lc.settled.trajectory;
     plot::timeseries::startup_svg(
         &files[2],

@@ -179,8 +179,8 @@ fn write_plots(
         out.join("pv.svg"),
     ];
     plot::poles::pole_map(&files[0], &title, &lin.dynamics.poles, &lin.open_loop.poles)?;
-    let b = lin.bode();
-    plot::bode::bode_diagram(&files[1], &title, &b, &lin.margins)?;
+    // the same figure as `stirling linearize --plot`
+    plot::bode::loop_bode(&files[1], &plot::bode::model_tag(model), lin)?;
     let tr = &lc.settled.trajectory;
     let pressures = pressure_channels(model);
     plot::timeseries::startup_svg(&files[2], &title, &tr.t, &tr.x, 0, 2, &pressures)?;

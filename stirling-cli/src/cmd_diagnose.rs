@@ -163,6 +163,10 @@ pub fn run(a: &DiagnoseArgs) -> anyhow::Result<()> {
     let (Some(model_name), Some(path)) = (a.model.as_ref(), a.data.as_ref()) else {
         bail!("usage: stirling diagnose <model> --data FILE ... (or --self-check)");
     };
+    // Files stamped from here on are this run's: taken before the diagnosis, as the file
+    // system's clock is coarser than SystemTime (a stamp taken just before writing can be later
+    // than the files' times).
+    let start = std::time::SystemTime::now();
     if let Some(dir) = &a.report {
         files::prepare_dir(dir, &REPORT, a.force, "--report")?;
     }
@@ -186,7 +190,6 @@ pub fn run(a: &DiagnoseArgs) -> anyhow::Result<()> {
     };
     let d = diagnose::diagnose(model.as_ref(), &p0, &data, &opts)?;
     if let Some(dir) = &a.report {
-        let start = std::time::SystemTime::now();
         let p = diagnose::report::write(&d, &data, dir).map_err(anyhow::Error::msg)?;
         for f in files::matching(dir, &REPORT, Some(start))? {
             files::wrote(&f);

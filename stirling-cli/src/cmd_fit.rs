@@ -8,7 +8,8 @@ use anyhow::Context;
 use clap::Args;
 use stirling_dsl::Closure;
 use stirling_models::data::{check_uniform, read_csv_lines};
-use stirling_models::fit::{self, report::plot_series, FitOptions, Identification};
+use stirling_models::fit::{self, FitOptions, Identification, Series};
+use stirling_models::plot::series::measured_vs_model;
 
 use crate::common::{self, files, ranges};
 
@@ -88,6 +89,17 @@ pub fn run(a: &FitArgs) -> anyhow::Result<()> {
     Ok(print_text(&mut common::stdout(), &a.data, &res)?)
 }
 
+fn plot_series(path: &Path, title: &str, s: &Series) -> anyhow::Result<()> {
+    Ok(measured_vs_model(
+        path,
+        title,
+        &s.channel,
+        &s.t,
+        &s.measured,
+        &s.model,
+    )?)
+}
+
 fn plots(dir: &Path, res: &Identification) -> anyhow::Result<()> {
     for (k, st) in [&res.stage1, &res.stage2].into_iter().enumerate() {
         for s in st.iter().flat_map(|s| &s.series) {
@@ -96,15 +108,13 @@ fn plots(dir: &Path, res: &Identification) -> anyhow::Result<()> {
                 &f,
                 &format!("stage {}: {} measured vs model", k + 1, s.channel),
                 s,
-            )
-            .map_err(anyhow::Error::msg)?;
+            )?;
             files::wrote(&f);
         }
     }
     for s in res.free_run.iter().flat_map(|f| &f.series) {
         let f = dir.join(format!("free_run_{}.svg", s.channel));
-        plot_series(&f, &format!("free run: {} measured vs model", s.channel), s)
-            .map_err(anyhow::Error::msg)?;
+        plot_series(&f, &format!("free run: {} measured vs model", s.channel), s)?;
         files::wrote(&f);
     }
     Ok(())

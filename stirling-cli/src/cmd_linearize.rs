@@ -10,7 +10,7 @@ use clap::Args;
 use serde::Serialize;
 use stirling_dsl::Model;
 use stirling_models::linear::export::{self, StateSpaceExport};
-use stirling_models::linear::{self, bode, LinearOptions, LinearReport, Linearization, Pole};
+use stirling_models::linear::{self, LinearOptions, LinearReport, Linearization, Pole};
 use stirling_models::plot;
 
 use crate::common::{self, files, ModelArgs};
@@ -84,7 +84,7 @@ pub fn run(a: &LinearizeArgs) -> anyhow::Result<()> {
 }
 
 fn plots(dir: &Path, model: &dyn Model, lin: &Linearization) -> anyhow::Result<()> {
-    let tag = format!("{} (n = {}, {})", model.name(), model.n(), model.closure());
+    let tag = plot::bode::model_tag(model);
     let poles = dir.join(FIGURES[0]);
     plot::poles::pole_map(
         &poles,
@@ -93,30 +93,10 @@ fn plots(dir: &Path, model: &dyn Model, lin: &Linearization) -> anyhow::Result<(
         &lin.open_loop.poles,
     )?;
     files::wrote(&poles);
-    let center = lin
-        .margins
-        .gain_crossover_rad_s
-        .or(lin.margins.phase_crossover_rad_s)
-        .unwrap_or_else(|| dominant_freq(&lin.dynamics.poles));
-    let w = bode::log_grid(center / 30.0, center * 30.0, 400);
-    let data = bode::bode(&|w| lin.open_loop.at(w), &w);
-    let title = format!(
-        "Open loop at the {} input of {tag}",
-        lin.open_loop.full.name
-    );
     let bode_svg = dir.join(FIGURES[1]);
-    plot::bode::bode_diagram(&bode_svg, &title, &data, &lin.margins)?;
+    plot::bode::loop_bode(&bode_svg, &tag, lin)?;
     files::wrote(&bode_svg);
     Ok(())
-}
-
-fn dominant_freq(poles: &[Pole]) -> f64 {
-    poles
-        .iter()
-        .filter(|p| p.im > 0.0)
-        .map(|p| p.im)
-        .fold(f64::INFINITY, f64::min)
-        .clamp(1e-3, 1e6)
 }
 
 fn opt(v: Option<f64>, prec: usize) -> String {

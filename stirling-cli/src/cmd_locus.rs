@@ -55,7 +55,12 @@ pub fn run(a: &LocusArgs) -> anyhow::Result<()> {
     .with_context(|| format!("root locus of `{}` over `{}`", model.name(), a.param))?;
     if let Some(dir) = &a.plot {
         let f = dir.join("locus.svg");
-        plot::locus::root_locus(&f, &l)?;
+        let unit = model
+            .params()
+            .iter()
+            .find(|q| q.name == a.param)
+            .map_or("-", |q| q.unit);
+        plot::locus::root_locus(&f, &l, unit)?;
         files::wrote(&f);
     }
     if a.json {

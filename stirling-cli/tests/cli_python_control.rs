@@ -15,7 +15,8 @@ use serde_json::Value;
 use support::{s, scratch, succeeds};
 
 /// How `.ci/run` sets the Python up, for the failure messages.
-const SETUP: &str = "python3 -m venv target/pyenv && target/pyenv/bin/pip install -q control numpy scipy \
+const SETUP: &str =
+    "python3 -m venv target/pyenv && target/pyenv/bin/pip install -q control numpy scipy \
 && export STIRLING_PYTHON=$PWD/target/pyenv/bin/python (as .ci/run does)";
 
 /// The Python that has python-control, or a failure saying how to get one.
@@ -29,12 +30,20 @@ fn python() -> String {
         Ok(o) if o.status.success() => py,
         Ok(o) => panic!(
             "python-control is not importable by {py}{}: {}\nset it up with: {SETUP}",
-            if from_env { " (STIRLING_PYTHON)" } else { " (STIRLING_PYTHON is unset)" },
+            if from_env {
+                " (STIRLING_PYTHON)"
+            } else {
+                " (STIRLING_PYTHON is unset)"
+            },
             String::from_utf8_lossy(&o.stderr).trim()
         ),
         Err(e) => panic!(
             "cannot run {py}{}: {e}\nset it up with: {SETUP}",
-            if from_env { " (STIRLING_PYTHON)" } else { " (STIRLING_PYTHON is unset)" }
+            if from_env {
+                " (STIRLING_PYTHON)"
+            } else {
+                " (STIRLING_PYTHON is unset)"
+            }
         ),
     }
 }
@@ -54,10 +63,19 @@ fn python_control_reads_the_seed_margins_of_schmidt() {
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(out.status.success(), "{} failed: {err}", script.display());
     let m: Value = serde_json::from_slice(&out.stdout).expect("margins.py prints JSON");
-    let get = |k: &str| m[k].as_f64().unwrap_or_else(|| panic!("{k} missing in {m}"));
+    let get = |k: &str| {
+        m[k].as_f64()
+            .unwrap_or_else(|| panic!("{k} missing in {m}"))
+    };
     let (gm, w_pc, pm, w_gc) = (get("gm_db"), get("w_pc"), get("pm_deg"), get("w_gc"));
     assert!((gm + 6.63).abs() <= 0.05, "Gm = {gm} dB, want -6.63 ({m})");
-    assert!((w_pc - 81.6).abs() <= 0.05, "phase crossover {w_pc} rad/s, want 81.6 ({m})");
+    assert!(
+        (w_pc - 81.6).abs() <= 0.05,
+        "phase crossover {w_pc} rad/s, want 81.6 ({m})"
+    );
     assert!((pm + 79.5).abs() <= 0.5, "Pm = {pm} deg, want -79.5 ({m})");
-    assert!((w_gc - 91.3).abs() <= 0.05, "gain crossover {w_gc} rad/s, want 91.3 ({m})");
+    assert!(
+        (w_gc - 91.3).abs() <= 0.05,
+        "gain crossover {w_gc} rad/s, want 91.3 ({m})"
+    );
 }

@@ -1,5 +1,7 @@
 //! SVG plots (plotters): one file per kind of figure.
 // <plot mods>
+/// Axis labels with units, power-of-ten ticks.
+pub mod axes;
 /// Bode diagram with the margins marked (seed Figure 8).
 pub mod bode;
 /// Root locus over a parameter.
@@ -8,5 +10,7 @@ pub mod locus;
 pub mod poles;
 /// PV diagram per vessel over one cycle.
 pub mod pv;
+/// Measured against model, with the residual below (fit figures).
+pub mod series;
 /// Start-up time response (x, y, pressures against time).
 pub mod timeseries;

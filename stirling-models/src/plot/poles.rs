@@ -25,6 +25,12 @@ impl DrawError {
     }
 }
 
+/// The natural frequency [rad/s] up to which poles count as slow (dominant): five times the
+/// largest oscillation frequency, at least 1000 rad/s; faster ones are the stiff gas poles.
+pub(crate) fn slow_limit<'a>(poles: impl Iterator<Item = &'a Pole>) -> f64 {
+    5.0 * poles.map(|p| p.im.abs()).fold(200.0, f64::max)
+}
+
 /// The frame `(re_min, re_max, im_max)` holding the slow poles, and the poles outside it.
 pub(crate) fn frame<'a>(poles: impl Iterator<Item = &'a Pole> + Clone) -> ((f64, f64, f64), usize) {
     let im_max = poles
@@ -32,7 +38,7 @@ pub(crate) fn frame<'a>(poles: impl Iterator<Item = &'a Pole> + Clone) -> ((f64,
         .map(|p| p.im.abs())
         .fold(0.0, f64::max)
         .max(10.0);
-    let limit = 5.0 * im_max.max(200.0);
+    let limit = slow_limit(poles.clone());
     let inside = |p: &&Pole| p.natural_rad_s <= limit;
     let re_min = poles
         .clone()
@@ -115,8 +121,8 @@ pub(crate) fn splane_chart<'a, 'b>(
         .map_err(|e| err(e.to_string()))?;
     chart
         .configure_mesh()
-        .x_desc("Real axis (1/s)")
-        .y_desc("Imaginary axis (rad/s)")
+        .x_desc("Real axis [1/s]")
+        .y_desc("Imaginary axis [rad/s]")
         .draw()
         .map_err(|e| err(e.to_string()))?;
     let shade = RGBColor(255, 210, 210).filled();

@@ -1,9 +1,12 @@
-//! PV diagram per vessel over one cycle: pressure (kPa) against volume (cm^3);
-//! the enclosed area is the vessel's cycle work.
+//! PV diagram per vessel over one cycle: pressure [kPa] against volume [cm^3]; the enclosed
+//! area is the vessel's cycle work, arrowheads along the loop show the direction of the cycle
+//! (clockwise: work done by the gas), a dot marks its start.
 
 use std::path::Path;
 
 use plotters::prelude::*;
+
+use super::axes;
 
 /// One closed `(V, P)` loop per vessel, in one panel each (a grid).
 pub fn pv_svg(
@@ -17,10 +20,10 @@ pub fn pv_svg(
     let k = vessels.len().max(1);
     let cols = k.min(3);
     let rows = k.div_ceil(cols);
-    let root =
+    let canvas =
         SVGBackend::new(path, (360 * cols as u32, 320 * rows as u32 + 40)).into_drawing_area();
-    root.fill(&WHITE).map_err(|e| err(&e))?;
-    let root = root
+    canvas.fill(&WHITE).map_err(|e| err(&e))?;
+    let root = canvas
         .titled(&format!("{title}: PV diagrams"), ("sans-serif", 20))
         .map_err(|e| err(&e))?;
     for (i, area) in root
@@ -35,7 +38,8 @@ pub fn pv_svg(
                 .iter()
                 .map(f)
                 .fold((f64::MAX, f64::MIN), |(l, h), v| (l.min(v), h.max(v)));
-            let pad = ((h - l) * 0.05).max(1e-9 * h.abs().max(1.0));
+            // A vessel of constant volume or pressure gets a band of 2 % around its value.
+            let pad = ((h - l) * 0.05).max(0.02 * h.abs()).max(1e-9);
             (l - pad)..(h + pad)
         };
         let mut c = ChartBuilder::on(&area)
@@ -49,17 +53,50 @@ pub fn pv_svg(
             )
             .margin(8)
             .x_label_area_size(30)
-            .y_label_area_size(50)
+            .y_label_area_size(60)
             .build_cartesian_2d(span(|p| p.0), span(|p| p.1))
             .map_err(|e| err(&e))?;
         c.configure_mesh()
-            .x_desc("V (cm^3)")
-            .y_desc("P (kPa)")
+            .x_desc(axes::label("V", "cm^3"))
+            .y_desc(axes::label("P", "kPa"))
             .x_labels(5)
             .draw()
             .map_err(|e| err(&e))?;
-        c.draw_series(LineSeries::new(pts, &BLUE))
+        c.draw_series(LineSeries::new(pts.clone(), &BLUE))
             .map_err(|e| err(&e))?;
+        if let Some(&p0) = pts.first() {
+            c.draw_series(std::iter::once(Circle::new(p0, 4, BLUE.filled())))
+                .map_err(|e| err(&e))?;
+        }
+        // Arrowheads in pixels (the axes are scaled differently), drawn on the whole canvas.
+        let m = pts.len();
+        for j in 0..4 {
+            let i = j * m / 4 + m / 8;
+            let (Some(&a), Some(&b)) = (pts.get(i), pts.get((i + 2).min(m.saturating_sub(1))))
+            else {
+                continue;
+            };
+            let (pa, pb) = (c.backend_coord(&a), c.backend_coord(&b));
+            let (dx, dy) = ((pb.0 - pa.0) as f64, (pb.1 - pa.1) as f64);
+            let len = dx.hypot(dy);
+            if len < 1e-9 {
+                continue;
+            }
+            let (ux, uy) = (dx / len, dy / len);
+            let tip = (pa.0 as f64 + 5.0 * ux, pa.1 as f64 + 5.0 * uy);
+            let back = (tip.0 - 11.0 * ux, tip.1 - 11.0 * uy);
+            let px = |x: f64, y: f64| (x.round() as i32, y.round() as i32);
+            canvas
+                .draw(&Polygon::new(
+                    vec![
+                        px(tip.0, tip.1),
+                        px(back.0 - 5.0 * uy, back.1 + 5.0 * ux),
+                        px(back.0 + 5.0 * uy, back.1 - 5.0 * ux),
+                    ],
+                    BLUE.filled(),
+                ))
+                .map_err(|e| err(&e))?;
+        }
     }
     root.present().map_err(|e| err(&e))
 }

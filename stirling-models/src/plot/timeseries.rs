@@ -1,9 +1,39 @@
-//! Start-up time response in the style of the seed's Figure 3: displacer `x`,
-//! piston `y` (mm) and the pressures (kPa) against time, two stacked panels.
+//! Start-up time response in the style of the seed's Figure 3: displacer `x`, piston `y`
+//! [mm] and the pressures [kPa] against time [s], two stacked panels. The legends sit in a
+//! strip right of the panels (they never hide a trace); the pressure traces are drawn from
+//! wide and pale to narrow so that channels lying on top of each other stay visible.
 
 use std::path::Path;
 
+use plotters::coord::Shift;
 use plotters::prelude::*;
+
+use super::axes;
+
+/// The legend strip width [px].
+const STRIP: u32 = 150;
+
+/// One legend entry per `(name, colour, width)`, top to bottom, in `area`.
+fn legend<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    entries: &[(String, RGBAColor, u32)],
+) -> Result<(), String> {
+    for (k, (name, color, width)) in entries.iter().enumerate() {
+        let y = 40 + 22 * k as i32;
+        area.draw(&PathElement::new(
+            vec![(8, y), (36, y)],
+            color.stroke_width(*width),
+        ))
+        .map_err(|e| e.to_string())?;
+        area.draw(&Text::new(
+            name.clone(),
+            (42, y - 7),
+            ("sans-serif", 13).into_font(),
+        ))
+        .map_err(|e| e.to_string())?;
+    }
+    Ok(())
+}
 
 /// Plot `x`, `y` (state columns `ix`, `iy`) and the `pressures` columns of `states` against `t`.
 pub fn startup_svg(
@@ -16,83 +46,81 @@ pub fn startup_svg(
     pressures: &[(String, usize)],
 ) -> Result<(), String> {
     let err = |e: &dyn std::fmt::Display| format!("plot {}: {e}", path.display());
-    let root = SVGBackend::new(path, (900, 700)).into_drawing_area();
+    let root = SVGBackend::new(path, (900 + STRIP, 720)).into_drawing_area();
     root.fill(&WHITE).map_err(|e| err(&e))?;
-    let (top, bottom) = root.split_vertically(350);
+    let root = root
+        .titled(&format!("{title}: start-up"), ("sans-serif", 20))
+        .map_err(|e| err(&e))?;
+    let (top, bottom) = root.split_vertically(340);
+    let (top, top_strip) = top.split_horizontally(900);
+    let (bottom, bottom_strip) = bottom.split_horizontally(900);
     let t1 = t.last().copied().unwrap_or(1.0).max(1e-12);
-    let mm = |k: usize| -> Vec<(f64, f64)> {
+    let col = |k: usize, scale: f64| -> Vec<(f64, f64)> {
         t.iter()
             .zip(states)
-            .map(|(&t, x)| (t, 1e3 * x[k]))
+            .filter_map(|(&t, x)| x.get(k).map(|v| (t, scale * v)))
+            .filter(|p| p.1.is_finite())
             .collect()
     };
-    let (xs, ys) = (mm(ix), mm(iy));
+    let (xs, ys) = (col(ix, 1e3), col(iy, 1e3));
     let lim = xs.iter().chain(&ys).map(|p| p.1.abs()).fold(1e-9, f64::max) * 1.05;
     let mut c = ChartBuilder::on(&top)
-        .caption(format!("{title}: start-up"), ("sans-serif", 20))
         .margin(10)
-        .x_label_area_size(30)
+        .x_label_area_size(35)
         .y_label_area_size(60)
         .build_cartesian_2d(0.0..t1, -lim..lim)
         .map_err(|e| err(&e))?;
     c.configure_mesh()
-        .x_desc("t (s)")
-        .y_desc("position (mm)")
+        .x_desc(axes::label("t", "s"))
+        .y_desc(axes::label("position", "mm"))
         .draw()
         .map_err(|e| err(&e))?;
-    c.draw_series(LineSeries::new(xs, &BLUE))
-        .map_err(|e| err(&e))?
-        .label("displacer x")
-        .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], BLUE));
-    c.draw_series(LineSeries::new(ys, &RED))
-        .map_err(|e| err(&e))?
-        .label("piston y")
-        .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], RED));
-    c.configure_series_labels()
-        .border_style(BLACK)
-        .background_style(WHITE)
-        .draw()
+    c.draw_series(LineSeries::new(xs, BLUE.stroke_width(2)))
         .map_err(|e| err(&e))?;
-    let series: Vec<Vec<(f64, f64)>> = pressures
-        .iter()
-        .map(|(_, k)| {
-            t.iter()
-                .zip(states)
-                .map(|(&t, x)| (t, 1e-3 * x[*k]))
-                .collect()
-        })
-        .collect();
+    c.draw_series(LineSeries::new(ys, RED.stroke_width(1)))
+        .map_err(|e| err(&e))?;
+    legend(
+        &top_strip,
+        &[
+            ("displacer x".into(), BLUE.to_rgba(), 2),
+            ("piston y".into(), RED.to_rgba(), 1),
+        ],
+    )
+    .map_err(|e| err(&e))?;
+    let series: Vec<Vec<(f64, f64)>> = pressures.iter().map(|(_, k)| col(*k, 1e-3)).collect();
     let (lo, hi) = series
         .iter()
         .flatten()
         .fold((f64::MAX, f64::MIN), |(l, h), p| (l.min(p.1), h.max(p.1)));
     let (lo, hi) = if lo < hi {
         (lo - 0.05 * (hi - lo), hi + 0.05 * (hi - lo))
-    } else {
+    } else if lo == hi {
         (lo - 1.0, lo + 1.0)
+    } else {
+        (0.0, 1.0)
     };
     let mut c = ChartBuilder::on(&bottom)
         .margin(10)
-        .x_label_area_size(30)
+        .x_label_area_size(35)
         .y_label_area_size(60)
         .build_cartesian_2d(0.0..t1, lo..hi)
         .map_err(|e| err(&e))?;
     c.configure_mesh()
-        .x_desc("t (s)")
-        .y_desc("pressure (kPa)")
+        .x_desc(axes::label("t", "s"))
+        .y_desc(axes::label("pressure", "kPa"))
         .draw()
         .map_err(|e| err(&e))?;
+    let k = series.len();
+    let mut entries = Vec::new();
     for (i, (s, (name, _))) in series.into_iter().zip(pressures).enumerate() {
         let color = Palette99::pick(i).to_rgba();
-        c.draw_series(LineSeries::new(s, color))
-            .map_err(|e| err(&e))?
-            .label(name.clone())
-            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], color));
+        // The first trace widest and palest, the last one 1 px: overlaps stay visible.
+        let width = 1 + 2 * (k - 1 - i) as u32;
+        let color = color.mix(if i + 1 == k { 1.0 } else { 0.6 });
+        c.draw_series(LineSeries::new(s, color.stroke_width(width)))
+            .map_err(|e| err(&e))?;
+        entries.push((name.clone(), color, width));
     }
-    c.configure_series_labels()
-        .border_style(BLACK)
-        .background_style(WHITE)
-        .draw()
-        .map_err(|e| err(&e))?;
+    legend(&bottom_strip, &entries).map_err(|e| err(&e))?;
     root.present().map_err(|e| err(&e))
 }
