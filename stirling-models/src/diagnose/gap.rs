@@ -29,11 +29,11 @@ pub(super) fn gap_before(
             }
         })
         .collect();
-    let fitted: Vec<(&fit::driven::Var, f64)> = stages
+    let fitted: Vec<(&fit::vars::Var, f64)> = stages
         .iter()
         .flat_map(|st| st.stage.vars.iter())
         .filter_map(|v| match v.kind {
-            fit::driven::VarKind::Param(i) => Some((v, ctx.p_nom[i])),
+            fit::vars::VarKind::Param(i) => Some((v, ctx.p_nom[i])),
             _ => None,
         })
         .collect();

@@ -17,7 +17,7 @@ use nalgebra::DMatrix;
 use stirling_dsl::Model;
 
 use crate::effects::{EffectInfo, EffectTarget};
-use crate::fit::driven::{Sensor, Var, VarKind};
+use crate::fit::vars::{Sensor, Var, VarKind};
 use crate::fit::prior::prior_rows;
 use crate::fit::{classify, FitError, FittedStage};
 

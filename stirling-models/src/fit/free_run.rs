@@ -23,7 +23,7 @@ use std::time::Instant;
 use serde::Serialize;
 use stirling_dsl::{Model, StateKind};
 
-use super::driven::cold_weight;
+use super::static_shift::cold_weight;
 use crate::layout::StateLayout;
 use super::report::{fit_percent, ChannelFit};
 use super::{FitError, Series};

@@ -8,7 +8,9 @@
 
 use stirling_dsl::Model;
 
-use super::driven::{cold_weight, static_shift, Output, Stage, Var};
+use super::driven::Stage;
+use super::vars::{Output, Var};
+use super::static_shift::{cold_weight, static_shift};
 use super::record::Record;
 use super::sensitivity::Given;
 use super::{FitError, FitOptions};

@@ -12,7 +12,8 @@ use std::time::Instant;
 use stirling_dsl::Model;
 
 use super::classify::{classify, default_free};
-use super::driven::{Stage, VarKind};
+use super::driven::Stage;
+use super::vars::VarKind;
 use super::gas::{self, GasStage};
 use super::mechanics::{self, MechInputs};
 use super::record::Record;

@@ -9,7 +9,9 @@
 
 use stirling_dsl::Model;
 
-use super::driven::{cold_weight, Output, Stage, Var};
+use super::driven::Stage;
+use super::vars::{Output, Var};
+use super::static_shift::cold_weight;
 use super::record::Record;
 use super::sensitivity::{Given, Signal};
 use super::{FitError, FitOptions};

@@ -12,6 +12,7 @@ pub mod driven;
 pub mod free_run;
 pub mod gas;
 pub mod identify;
+pub mod input_noise;
 pub mod lm;
 pub mod mechanics;
 pub mod multiple_shooting;
@@ -19,8 +20,11 @@ pub mod prior;
 pub mod record;
 pub mod report;
 pub mod sensitivity;
+pub mod sensors;
 pub mod stage_fit;
+pub mod static_shift;
 pub mod unmeasured;
+pub mod vars;
 
 use serde::Serialize;
 

@@ -6,7 +6,7 @@
 //! fit). Below `θ / θ0 = FLOOR` the logarithm continues linearly, so a trial step through
 //! zero stays finite.
 
-use super::driven::Var;
+use super::vars::Var;
 
 /// Ratio below which the log residual continues linearly.
 const FLOOR: f64 = 0.05;

@@ -6,7 +6,8 @@ use std::time::Instant;
 
 use nalgebra::DMatrix;
 
-use super::driven::{Stage, VarKind};
+use super::driven::Stage;
+use super::vars::VarKind;
 use super::lm::{self, LmResult};
 use super::report::{self, fit_percent, ChannelFit};
 use super::{FitError, FitOptions, Series, StageFit};

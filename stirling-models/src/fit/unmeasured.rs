@@ -13,7 +13,8 @@
 
 use nalgebra::{DMatrix, DVector};
 
-use super::driven::{Output, Stage, VarKind};
+use super::driven::Stage;
+use super::vars::{Output, VarKind};
 use super::record::Record;
 use super::report::FitStats;
 use super::sensitivity::Signal;
