@@ -2,7 +2,6 @@
 
 mod cmd_models;
 mod common;
-// <mods>
 mod cmd_diagnose;
 mod cmd_fit;
 mod cmd_info;
@@ -29,7 +28,6 @@ enum Command {
         #[arg(long)]
         json: bool,
     },
-    // <commands>
     /// Sim-to-real gap diagnosis: where the gap lies, which omitted effect, how far it closes
     Diagnose(cmd_diagnose::DiagnoseArgs),
     /// Virtual test rig: truth model plus effects, noise and offsets -> measured CSV + truth sidecar
@@ -50,7 +48,6 @@ fn main() {
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Models { json } => cmd_models::run(json),
-        // <dispatch>
         Command::Diagnose(a) => cmd_diagnose::run(&a),
         Command::Rig(a) => cmd_rig::run(&a),
         Command::Fit(a) => cmd_fit::run(&a),

@@ -17,6 +17,13 @@
 //! - [`plot`]: SVG figures (pole map, Bode, root locus, start-up response, PV diagrams).
 //! - [`params`]: parameter files, overrides and validation; [`registry`]: the family by
 //!   name, as the command line uses it.
+//! - [`data`]: measured records (CSV) with row and column errors; [`rig`]: the virtual test
+//!   rig that writes them from a truth model with effects, noise and offsets.
+//! - [`fit`]: the two-stage identification (mechanics driven by pressure, gas driven by
+//!   positions), on the seed's sensors too; [`diagnose`]: the sim-to-real gap diagnosis;
+//!   [`effects`]: the effects the nominal models leave out.
+//! - [`layout`]: which state is what; [`signal`]: smoothing, noise level, cycles, harmonics,
+//!   filters and statistical tails shared by the analyses.
 //!
 //! ## Linear analysis
 //!
@@ -113,10 +120,6 @@
 //! println!("{}", model.equations(stirling_models::dsl::Style::Text));
 //! ```
 
-pub mod family;
-pub mod params;
-pub mod plot;
-// <analysis mods>
 /// Measured data: CSV input with row/column errors, sensor offsets.
 pub mod data;
 /// The sim-to-real gap diagnosis: where, which effect, how far.
@@ -125,10 +128,17 @@ pub mod diagnose;
 pub mod effects;
 /// Identification: driven subsystems, forward sensitivities, Levenberg-Marquardt, report.
 pub mod fit;
+/// The seed's model family (`schmidt`, `cv1`, `cv2`, `nsection`) on the default engine.
+pub mod family;
 /// Which state of a model is what (positions, velocities, pressures, masses).
 pub mod layout;
 /// Linear analysis: equilibrium, poles, the loop broken at a pressure force, margins, locus.
 pub mod linear;
+/// Parameter files, overrides and validation.
+pub mod params;
+/// SVG figures: pole map, Bode, root locus, start-up, PV diagrams, measured vs model.
+pub mod plot;
+/// The family by name, as the command line uses it.
 pub mod registry;
 /// The virtual test rig: truth model plus effects, noise, offsets, sample rate.
 pub mod rig;

@@ -1,5 +1,4 @@
 //! SVG plots (plotters): one file per kind of figure.
-// <plot mods>
 /// Axis labels with units, power-of-ten ticks.
 pub mod axes;
 /// Bode diagram with the margins marked (seed Figure 8).

@@ -1,0 +1,53 @@
+//! The gap diagnosis on the seed's sensor set (`p`, `x`, `y`; the hot-side pressure
+//! unmeasured) of `nsection` n = 2: the verdict a user reads is `no_significant_gap` on a
+//! clean record and `coulomb` on a record whose Coulomb friction is withheld. The wider
+//! self-check (every effect) is in docs/diagnosis.md, "The seed's sensor set".
+
+use stirling::models::diagnose::selfcheck::{self, SelfCheckOptions};
+use stirling::models::diagnose::DiagnoseOptions;
+
+fn pxy(effects: &[&str], clean: bool) -> SelfCheckOptions {
+    SelfCheckOptions {
+        model: "nsection".into(),
+        n: Some(2),
+        effects: Some(effects.iter().map(|s| s.to_string()).collect()),
+        strengths: vec![1.0],
+        t_end: 2.0,
+        rate: 1000.0,
+        clean,
+        channels: ["p", "x", "y"].map(String::from).to_vec(),
+        diagnose: DiagnoseOptions {
+            effects: Some(["coulomb", "sensor_lag", "sensor_gain"].map(String::from).to_vec()),
+            bootstrap: 200,
+            ..Default::default()
+        },
+        ..Default::default()
+    }
+}
+
+fn log(c: &selfcheck::Case) {
+    eprintln!(
+        "{} -> {} (rank {:?}, closure {:?} [{:?}, {:?}], {:.1} s)",
+        c.truth, c.verdict, c.truth_rank, c.closure_fraction, c.ci_low, c.ci_high, c.seconds
+    );
+}
+
+#[test]
+fn clean_pxy_record_has_no_significant_gap() {
+    let sc = selfcheck::run(&pxy(&[], true), log).unwrap();
+    assert_eq!(sc.cases[0].verdict, "no_significant_gap");
+    assert_eq!(sc.false_alarms, 0);
+}
+
+#[test]
+fn withheld_coulomb_friction_is_the_verdict_on_pxy() {
+    let sc = selfcheck::run(&pxy(&["coulomb"], false), log).unwrap();
+    let c = &sc.cases[0];
+    assert_eq!(c.verdict, "coulomb", "top {:?}", c.top);
+    let (f, lo, hi) = (
+        c.closure_fraction.unwrap(),
+        c.ci_low.unwrap(),
+        c.ci_high.unwrap(),
+    );
+    assert!(lo <= f && f <= hi && lo > 0.5, "closure {f} [{lo}, {hi}]");
+}
