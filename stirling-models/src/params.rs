@@ -172,3 +172,13 @@ pub fn validate(model: &dyn Model, p: &[f64]) -> Result<(), ParamError> {
     }
     Ok(())
 }
+
+/// The parameter vector `p` of `model` as `(name, value)` pairs, in declaration order.
+pub fn named(model: &dyn Model, p: &[f64]) -> Vec<(String, f64)> {
+    model
+        .params()
+        .iter()
+        .zip(p)
+        .map(|(i, v)| (i.name.to_string(), *v))
+        .collect()
+}

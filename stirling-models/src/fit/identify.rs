@@ -238,12 +238,7 @@ pub fn identify_stages<'a>(
     let id = Identification {
         model: model.name().into(),
         n: model.n(),
-        params: model
-            .params()
-            .iter()
-            .zip(&p)
-            .map(|(i, v)| (i.name.to_string(), *v))
-            .collect(),
+        params: crate::params::named(model, &p),
         stage1,
         stage2,
         train: rec.train,

@@ -426,12 +426,7 @@ pub fn multiple_shooting(
         .collect();
     Ok(MultipleShooting {
         stats,
-        params: model
-            .params()
-            .iter()
-            .zip(&p)
-            .map(|(i, v)| (i.name.to_string(), *v))
-            .collect(),
+        params: crate::params::named(model, &p),
         offsets,
         segments,
         fits,
