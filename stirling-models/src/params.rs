@@ -69,33 +69,78 @@ pub fn apply_file(model: &dyn Model, path: &Path, p: &mut [f64]) -> Result<(), P
         path: shown.clone(),
         why: e.to_string(),
     })?;
-    let table: serde_json::Map<String, serde_json::Value> =
-        if path.extension().is_some_and(|e| e == "toml") {
-            let v: toml::Table = toml::from_str(&text).map_err(|e| ParamError::Parse {
-                path: shown.clone(),
-                why: e.to_string(),
-            })?;
-            serde_json::to_value(v)
-                .ok()
-                .and_then(|v| v.as_object().cloned())
-                .unwrap_or_default()
-        } else {
-            serde_json::from_str(&text).map_err(|e| ParamError::Parse {
-                path: shown.clone(),
-                why: e.to_string(),
-            })?
-        };
-    for (name, value) in table {
+    let toml_ext = path.extension().is_some_and(|e| e == "toml");
+    let pairs = if toml_ext {
+        toml_pairs(&text)
+    } else {
+        json_pairs(&text)
+    }
+    .map_err(|why| ParamError::Parse {
+        path: shown.clone(),
+        why: format!("{why}\n{}", format_note(toml_ext, &text)),
+    })?;
+    for (name, value) in pairs {
         let k = model
             .param_index(&name)
             .ok_or_else(|| unknown(model, &shown, &name))?;
-        p[k] = value.as_f64().ok_or_else(|| ParamError::NotANumber {
+        p[k] = value.map_err(|found| ParamError::NotANumber {
             origin: shown.clone(),
             name: name.clone(),
-            found: value.to_string(),
+            found,
         })?;
     }
     Ok(())
+}
+
+/// A value as a finite number, else what was found.
+type Number = Result<f64, String>;
+
+fn finite(v: f64) -> Number {
+    if v.is_finite() {
+        Ok(v)
+    } else {
+        Err(format!("{v} (not a finite number)"))
+    }
+}
+
+/// `name = value` pairs of a TOML table (NaN and infinities reported as such).
+fn toml_pairs(text: &str) -> Result<Vec<(String, Number)>, String> {
+    let table: toml::Table = toml::from_str(text).map_err(|e| e.to_string())?;
+    Ok(table
+        .into_iter()
+        .map(|(k, v)| {
+            let n = match &v {
+                toml::Value::Float(f) => finite(*f),
+                toml::Value::Integer(i) => Ok(*i as f64),
+                other => Err(format!("{other} ({})", other.type_str())),
+            };
+            (k, n)
+        })
+        .collect())
+}
+
+/// `name: value` pairs of a JSON object.
+fn json_pairs(text: &str) -> Result<Vec<(String, Number)>, String> {
+    let map: serde_json::Map<String, serde_json::Value> =
+        serde_json::from_str(text).map_err(|e| e.to_string())?;
+    Ok(map
+        .into_iter()
+        .map(|(k, v)| {
+            let n = v.as_f64().ok_or_else(|| v.to_string());
+            (k, n)
+        })
+        .collect())
+}
+
+/// Which format a parameter file was read as, and a hint when its text looks like the other.
+fn format_note(toml_ext: bool, text: &str) -> String {
+    let looks_json = text.trim_start().starts_with('{');
+    match (toml_ext, looks_json) {
+        (true, true) => "read as TOML (the file name ends in .toml), but the text looks like JSON: rename it to .json".into(),
+        (true, false) => "read as TOML (the file name ends in .toml)".into(),
+        (false, false) => "read as JSON (the file name does not end in .toml); if it is TOML, rename it to .toml".into(),
+        (false, true) => "read as JSON (the file name does not end in .toml)".into(),
+    }
 }
 
 /// Apply one `name=value` override.
