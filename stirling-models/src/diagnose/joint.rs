@@ -19,7 +19,8 @@ use stirling_dsl::Model;
 use crate::effects::{EffectInfo, EffectTarget};
 use crate::fit::vars::{Sensor, Var, VarKind};
 use crate::fit::prior::prior_rows;
-use crate::fit::{classify, FitError, FittedStage};
+use crate::fit::sensitivity::Signal;
+use crate::fit::{classify, unmeasured, FitError, FittedStage};
 
 /// One effect variable of the joint problem.
 #[derive(Clone, Debug)]
@@ -82,6 +83,8 @@ impl<'a> Joint<'a> {
         let n_nom: usize = nominal.iter().map(|s| s.stage.vars.len()).sum();
         // which stages each effect variable goes to, with its variable kind there
         let mut adds: Vec<(usize, Var)> = Vec::new();
+        // signals the linked variables of the mechanics stage read (see [`link`])
+        let mut linked: Vec<(usize, Vec<Signal>)> = Vec::new();
         for q in e.params {
             let shape_value = shapes.iter().find(|(n, _)| *n == q.name).map(|s| s.1);
             if q.null.is_none() && !(free_shapes && shape_value.is_some()) {
@@ -117,6 +120,10 @@ impl<'a> Joint<'a> {
                     ));
                 }
             }
+            if let Some((si, var, sigs)) = link(nominal, &adds, &linked, q.name)? {
+                adds.push((si, var));
+                linked.push((si, sigs));
+            }
             if !adds.iter().any(|(_, v)| v.name == q.name) {
                 return Err(format!(
                     "`{}` enters neither driven subsystem of `{}`",
@@ -133,6 +140,11 @@ impl<'a> Joint<'a> {
                 continue;
             }
             let mut ext = st.clone();
+            for (_, sigs) in linked.iter().filter(|(s, _)| *s == si) {
+                let n0 = ext.stage.signals.len();
+                ext.stage.signals.extend(sigs.iter().cloned());
+                ext.stage.derived.extend(n0..ext.stage.signals.len());
+            }
             for (name, v) in shapes {
                 if let Some(j) = model.param_index(name) {
                     ext.stage.p[j] = *v;
@@ -266,6 +278,55 @@ impl<'a> Joint<'a> {
     }
 }
 
+/// On records without `p_hot` the mechanics stage reads the gas stage's pressure differences
+/// ([`crate::fit::unmeasured`]); a gas-stage effect (quadratic regenerator friction, a leak)
+/// changes them, so the mechanics stage gets the effect too, linked to first order: its
+/// prescribed pressures move by `(value - null) dP/dvalue`, the derivative from the gas
+/// stage's forward sensitivities at the nominal optimum. Returns the mechanics stage, its
+/// variable and the derivative signals (appended after those already queued in `linked`).
+fn link(
+    nominal: &[FittedStage],
+    adds: &[(usize, Var)],
+    linked: &[(usize, Vec<Signal>)],
+    name: &str,
+) -> Result<Option<(usize, Var, Vec<Signal>)>, String> {
+    let Some(mech) = nominal
+        .iter()
+        .position(|s| is_mechanics(s) && !s.stage.derived.is_empty())
+    else {
+        return Ok(None);
+    };
+    if adds.iter().any(|(s, v)| *s == mech && v.name == name) {
+        return Ok(None);
+    }
+    let Some((gi, gvar)) = adds
+        .iter()
+        .find(|(s, v)| *s != mech && v.name == name && matches!(v.kind, VarKind::Param(_)))
+    else {
+        return Ok(None);
+    };
+    let gas = &nominal[*gi];
+    let mut st = gas.stage.clone();
+    st.vars.push(gvar.clone());
+    let mut u = gas.u.clone();
+    u.push(0.0);
+    let d = unmeasured::difference_sensitivity(&st, &u, st.vars.len() - 1, gas.first)
+        .map_err(|e| e.to_string())?;
+    let cold = d.len() - 1;
+    let queued: usize = linked
+        .iter()
+        .filter(|(s, _)| *s == mech)
+        .map(|(_, v)| v.len())
+        .sum();
+    let base = nominal[mech].stage.signals.len() + queued;
+    let var = Var {
+        kind: VarKind::Linked((0..cold).map(|i| (i, base + i)).collect()),
+        prior: None,
+        ..gvar.clone()
+    };
+    Ok(Some((mech, var, d.into_iter().take(cold).collect())))
+}
+
 /// The kind of an effect variable in a stage, if it enters it.
 fn kind_in(
     model: &dyn Model,
@@ -323,7 +384,10 @@ fn kind_in(
         }
         (EffectTarget::Sensor, "tau_p") => Some(if mech {
             VarKind::Sensor(Sensor::Lag {
-                signals: (0..st.stage.signals.len()).collect(),
+                // the measured pressures only, not the model's pressure differences
+                signals: (0..st.stage.signals.len())
+                    .filter(|s| !st.stage.derived.contains(s))
+                    .collect(),
                 outputs: vec![],
             })
         } else {

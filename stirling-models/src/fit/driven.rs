@@ -55,6 +55,9 @@ pub struct Stage<'a> {
     /// Noise on the prescribed inputs: `(signal, standard deviation of the raw samples,
     /// Savitzky-Golay half-width the signal was smoothed with)`; see [`Stage::input_noise_cov`].
     pub input_noise: Vec<(usize, f64, usize)>,
+    /// Signals the model computed (the pressure differences of [`super::unmeasured`]), not
+    /// measured: a sensor effect does not act on them.
+    pub derived: Vec<usize>,
 }
 
 /// Simulated outputs (rows: samples of the window) and their derivatives.
@@ -132,6 +135,16 @@ impl Stage<'_> {
                     }
                 }
                 VarKind::Sensor(_) => {}
+                VarKind::Linked(pairs) => {
+                    for &(g, s) in pairs {
+                        given[g].terms.push((s, val - v.initial, false));
+                    }
+                    col_of[k] = Some(columns.len());
+                    columns.push(Column::Signals {
+                        pairs: pairs.clone(),
+                        scale: v.scale,
+                    });
+                }
             }
         }
         if !sens {

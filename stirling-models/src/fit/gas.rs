@@ -88,6 +88,7 @@ pub fn stage<'a>(
     let stage = Stage {
         drift: 0,
         input_noise: vec![(0, noise_sigma(xm), rec.h), (1, noise_sigma(ym), rec.h)],
+        derived: Vec::new(),
         name: "stage 2 (gas driven by measured displacements)",
         model,
         p: p.to_vec(),

@@ -134,9 +134,11 @@ pub fn stage<'a>(
     }
     let mut base = vec![0.0; model.n_states()];
     model.equilibrium_guess(inp.p, &mut base);
+    let measured = if have_hot { 2 } else { 1 };
     Ok(Stage {
         drift: drift_count(tr.1 - tr.0 + 1, dt, opts.drift_cut * f0),
         input_noise,
+        derived: (measured..signals.len()).collect(),
         name: "stage 1 (mechanics driven by measured pressure)",
         model,
         p: inp.p.to_vec(),

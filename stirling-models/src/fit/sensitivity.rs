@@ -77,6 +77,8 @@ pub enum Column {
     Initial { pos: usize, scale: f64 },
     /// Prescribed inputs move by `du[g] * scale` per unit (one entry per [`Given`]).
     Input { du: Vec<f64>, scale: f64 },
+    /// Prescribed input `g` moves by `signal_s(t) * scale` per unit, for each `(g, s)`.
+    Signals { pairs: Vec<(usize, usize)>, scale: f64 },
 }
 
 /// A driven subsystem with its sensitivities, as an [`OdeSystem`]: state `[z, vec(S)]`.
@@ -191,6 +193,15 @@ impl OdeSystem for Driven<'_> {
                 acc += match c {
                     Column::Param { index, scale } => jp[ir + n * index] * scale,
                     Column::Initial { .. } => 0.0,
+                    Column::Signals { pairs, scale } => {
+                        pairs
+                            .iter()
+                            .map(|&(g, s)| {
+                                j[ir + n * self.given[g].state] * self.signals[s].eval(t).0
+                            })
+                            .sum::<f64>()
+                            * scale
+                    }
                     Column::Input { du, scale } => {
                         self.given
                             .iter()

@@ -32,6 +32,41 @@ pub fn pressure_differences(
     layout: &StateLayout,
     rec: &Record,
 ) -> Result<Vec<Signal>, FitError> {
+    let (first, last) = (rec.tr.0, rec.data.t.len() - 1);
+    let run = pressure_run(gas, u, layout, first, last, false)?;
+    let cold = run.yhat.len() - 1;
+    Ok(signals(gas, run.yhat.len(), first, last, |i, k| {
+        run.yhat[i][k] - run.yhat[cold][k]
+    }))
+}
+
+/// The derivative of [`pressure_differences`] with respect to the value of the gas stage's
+/// variable `var` (at `u`, from the training start `first` to the record's end).
+pub fn difference_sensitivity(
+    gas: &Stage,
+    u: &[f64],
+    var: usize,
+    first: usize,
+) -> Result<Vec<Signal>, FitError> {
+    let layout = StateLayout::of(gas.model);
+    let last = gas.outputs[0].data.len() - 1;
+    let run = pressure_run(gas, u, &layout, first, last, true)?;
+    let cold = run.yhat.len() - 1;
+    let scale = gas.vars[var].scale;
+    Ok(signals(gas, run.yhat.len(), first, last, |i, k| {
+        (run.dyhat[i][k][var] - run.dyhat[cold][k][var]) / scale
+    }))
+}
+
+/// A run of the gas stage whose outputs are every CV's pressure (no offsets).
+fn pressure_run(
+    gas: &Stage,
+    u: &[f64],
+    layout: &StateLayout,
+    first: usize,
+    last: usize,
+    sens: bool,
+) -> Result<super::driven::StageRun, FitError> {
     let mut st = gas.clone();
     st.outputs = layout
         .pressures
@@ -49,26 +84,32 @@ pub fn pressure_differences(
             *out = usize::MAX;
         }
     }
-    let (first, last) = (rec.tr.0, rec.data.t.len() - 1);
-    let run = st.run(u, first, last, false)?;
-    let cold = run.yhat.len() - 1;
-    let signals = (0..run.yhat.len())
+    st.run(u, first, last, sens)
+}
+
+/// One signal per CV over samples `0..=last` from `value(cv, sample - first)`, held at the
+/// first value before `first`.
+fn signals(
+    gas: &Stage,
+    n_cv: usize,
+    first: usize,
+    last: usize,
+    value: impl Fn(usize, usize) -> f64,
+) -> Vec<Signal> {
+    (0..n_cv)
         .map(|i| {
-            let mut val = vec![0.0; last + 1];
-            for (k, v) in val.iter_mut().enumerate() {
-                let j = k.saturating_sub(first);
-                *v = run.yhat[i][j] - run.yhat[cold][j];
-            }
-            let der = crate::signal::derivative(&val, rec.dt);
+            let val: Vec<f64> = (0..=last)
+                .map(|k| value(i, k.saturating_sub(first)))
+                .collect();
+            let der = crate::signal::derivative(&val, gas.dt);
             Signal {
-                t0: rec.t0,
-                dt: rec.dt,
+                t0: gas.t0,
+                dt: gas.dt,
                 val,
                 der,
             }
         })
-        .collect();
-    Ok(signals)
+        .collect()
 }
 
 /// Covariance of stage 1's scaled variables carried in from stage 2's: stage 1 (`mech`, at

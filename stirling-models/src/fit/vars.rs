@@ -70,6 +70,11 @@ pub enum VarKind {
     Offset { out: usize, du: Vec<f64> },
     /// A sensor distortion (see [`Sensor`]); its column is a central difference of two runs.
     Sensor(Sensor),
+    /// A parameter of the gas stage seen by the mechanics stage through the pressure
+    /// differences it supplies (records without `p_hot`): prescribed state `g` gains
+    /// `(value - initial) s(t)` for each `(g, s)`, `s` the signal of `dP_g / dvalue` (the
+    /// first-order link; see `diagnose::joint`).
+    Linked(Vec<(usize, usize)>),
 }
 
 /// A sensor distortion fitted as a variable: the data the stage reads through the sensor as
