@@ -96,7 +96,7 @@ pub fn root_locus(path: &Path, locus: &Locus, unit: &str) -> Result<(), DrawErro
         .disable_y_mesh()
         .y_labels(6)
         .y_label_style(("sans-serif", 13))
-        .y_label_formatter(&|v| format!("{}", fmt(*v)))
+        .y_label_formatter(&|v| fmt(*v))
         .axis_desc_style(("sans-serif", 14))
         .y_desc(axes::label(&locus.param, unit))
         .draw()
