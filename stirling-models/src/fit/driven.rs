@@ -20,7 +20,7 @@ use super::FitError;
 use super::sensors::lag_columns;
 use super::vars::{Output, Var, VarKind, MIN_RATIO};
 use crate::signal::project_drift;
-use crate::sim::{integrate, state_scale, Hooks, SimOptions};
+use crate::sim::{integrate, state_scale, Hooks, LinearSolverKind, SimOptions};
 
 
 /// A driven-subsystem fitting problem on a uniform record.
@@ -60,6 +60,15 @@ pub struct Stage<'a> {
     pub derived: Vec<usize>,
 }
 
+/// What a run is built from at given variable values.
+struct Prepared {
+    p: Vec<f64>,
+    z0: Vec<f64>,
+    given: Vec<super::sensitivity::Given>,
+    columns: Vec<Column>,
+    col_of: Vec<Option<usize>>,
+}
+
 /// Simulated outputs (rows: samples of the window) and their derivatives.
 pub struct StageRun {
     /// Sample indices of the window.
@@ -88,12 +97,72 @@ impl Stage<'_> {
         sens: bool,
     ) -> Result<StageRun, FitError> {
         let th = self.values(u);
+        let Prepared {
+            p,
+            z0,
+            mut given,
+            mut columns,
+            col_of,
+        } = self.prepare(&th, sens)?;
+        if !sens {
+            columns.clear();
+        }
+        let t_start = self.t0 + first as f64 * self.dt;
+        let mut signals: Vec<Signal> = self
+            .signals
+            .iter()
+            .map(|s| Signal {
+                t0: s.t0 - t_start,
+                ..s.clone()
+            })
+            .collect();
+        let (gain, lag) = self.apply_sensors(&th, &mut given, &mut signals);
+        let zscale: Vec<f64> = {
+            let s = state_scale(self.model, &p);
+            self.free.iter().map(|&i| s[i]).collect()
+        };
+        let sys = Driven {
+            model: self.model,
+            p,
+            base: self.base.clone(),
+            free: self.free.clone(),
+            given,
+            signals,
+            columns,
+            zscale,
+        };
+        let x0 = sys.initial(&z0);
+        let samples: Vec<f64> = (0..=last - first).map(|k| k as f64 * self.dt).collect();
+        let t_end = samples[samples.len() - 1].max(self.dt);
+        let mut sim = self.sim;
+        if sim.linear_solver == LinearSolverKind::Auto && sys.columns.len() >= 2 {
+            // block-diagonal Newton matrix: the sparse LU factors the blocks one by one
+            sim.linear_solver = LinearSolverKind::Sparse;
+        }
+        let traj = integrate(&sys, &x0, t_end, &samples, &sim, Hooks::default())
+            .map_err(|e| FitError::Sim(self.name.to_string(), e.to_string()))?;
+        let (mut yhat, mut dyhat) = self.outputs_of(&traj.x, &th, &gain, &col_of, sens);
+        for (o, &tau) in lag.iter().enumerate() {
+            if tau > 0.0 {
+                yhat[o] = crate::signal::first_order_lag(&yhat[o], self.dt, tau);
+                lag_columns(&mut dyhat[o], self.dt, tau);
+            }
+        }
+        if sens {
+            self.sensor_columns(u, first, last, &mut dyhat)?;
+        }
+        Ok(StageRun { first, yhat, dyhat })
+    }
+
+    /// The model parameters, initial free states, prescribed states and sensitivity columns
+    /// at the variable values `th` (with the column of each variable, if it has one).
+    fn prepare(&self, th: &[f64], sens: bool) -> Result<Prepared, FitError> {
         let mut p = self.p.clone();
         let mut z0 = self.z0.clone();
         let mut given = self.given.clone();
         let mut columns = Vec::new();
         let mut col_of = vec![None; self.vars.len()];
-        for (k, (v, &val)) in self.vars.iter().zip(&th).enumerate() {
+        for (k, (v, &val)) in self.vars.iter().zip(th).enumerate() {
             match &v.kind {
                 VarKind::Param(i) => {
                     if sens && v.initial > 0.0 && val < MIN_RATIO * v.initial {
@@ -147,51 +216,28 @@ impl Stage<'_> {
                 }
             }
         }
-        if !sens {
-            columns.clear();
-        }
-        let t_start = self.t0 + first as f64 * self.dt;
-        let mut signals: Vec<Signal> = self
-            .signals
-            .iter()
-            .map(|s| Signal {
-                t0: s.t0 - t_start,
-                ..s.clone()
-            })
-            .collect();
-        let (gain, lag) = self.apply_sensors(&th, &mut given, &mut signals);
-        let zscale: Vec<f64> = {
-            let s = state_scale(self.model, &p);
-            self.free.iter().map(|&i| s[i]).collect()
-        };
-        let sys = Driven {
-            model: self.model,
+        Ok(Prepared {
             p,
-            base: self.base.clone(),
-            free: self.free.clone(),
+            z0,
             given,
-            signals,
             columns,
-            zscale,
-        };
-        let x0 = sys.initial(&z0);
-        let samples: Vec<f64> = (0..=last - first).map(|k| k as f64 * self.dt).collect();
-        let t_end = samples[samples.len() - 1].max(self.dt);
-        let sim = if std::env::var_os("STIRLING_DENSE_SENS").is_none() && sys.columns.len() >= 2 {
-            // block-diagonal Newton matrix: the sparse LU factors the blocks one by one
-            SimOptions {
-                linear_solver: crate::sim::LinearSolverKind::Sparse,
-                ..self.sim
-            }
-        } else {
-            self.sim
-        };
-        let traj = integrate(&sys, &x0, t_end, &samples, &sim, Hooks::default())
-            .map_err(|e| FitError::Sim(self.name.to_string(), e.to_string()))?;
+            col_of,
+        })
+    }
+
+    /// Outputs (gain and offsets applied) and their sensitivities from the rows of a run.
+    fn outputs_of(
+        &self,
+        rows: &[Vec<f64>],
+        th: &[f64],
+        gain: &[f64],
+        col_of: &[Option<usize>],
+        sens: bool,
+    ) -> (Vec<Vec<f64>>, Vec<Vec<Vec<f64>>>) {
         let nz = self.free.len();
         let mut yhat = vec![Vec::new(); self.outputs.len()];
         let mut dyhat = vec![Vec::new(); self.outputs.len()];
-        for row in &traj.x {
+        for row in rows {
             for (o, out) in self.outputs.iter().enumerate() {
                 let mut y = gain[o] * row[out.pos];
                 let mut d = vec![0.0; if sens { self.vars.len() } else { 0 }];
@@ -216,16 +262,7 @@ impl Stage<'_> {
                 }
             }
         }
-        for (o, &tau) in lag.iter().enumerate() {
-            if tau > 0.0 {
-                yhat[o] = crate::signal::first_order_lag(&yhat[o], self.dt, tau);
-                lag_columns(&mut dyhat[o], self.dt, tau);
-            }
-        }
-        if sens {
-            self.sensor_columns(u, first, last, &mut dyhat)?;
-        }
-        Ok(StageRun { first, yhat, dyhat })
+        (yhat, dyhat)
     }
 
     /// Weighted residuals on the sample indices `keep` (within `first..=last`), drift
