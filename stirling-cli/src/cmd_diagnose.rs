@@ -186,6 +186,7 @@ pub fn run(a: &DiagnoseArgs) -> anyhow::Result<()> {
         prior: prior_arg(a.prior)?,
         train,
         holdout,
+        progress: Some(|line: &str| common::note(line)),
         ..Default::default()
     };
     let d = diagnose::diagnose(model.as_ref(), &p0, &data, &opts)?;

@@ -80,6 +80,8 @@ pub struct Context<'a> {
     pub input_noise: Vec<Vec<Vec<f64>>>,
     /// Joint fits run.
     pub fits: std::sync::atomic::AtomicUsize,
+    /// Where progress lines go (see [`super::DiagnoseOptions::progress`]).
+    pub progress: Option<fn(&str)>,
 }
 
 impl Context<'_> {

@@ -78,6 +78,9 @@ pub struct DiagnoseOptions {
     /// parameters far from their estimates (a leak by the heat-transfer coefficients); the
     /// prior makes such a move cost, so the effect shows in the score.
     pub prior: Option<f64>,
+    /// Called with a line of progress after the calibration and after each candidate
+    /// (`None`: silent).
+    pub progress: Option<fn(&str)>,
 }
 
 /// The default prior spread of the nominal parameters: log standard deviation 0.5 (a factor
@@ -97,6 +100,7 @@ impl Default for DiagnoseOptions {
             bootstrap: 400,
             alpha: 0.01,
             seed: 7,
+            progress: None,
             prior: Some(DEFAULT_PRIOR),
         }
     }

@@ -195,25 +195,21 @@ pub fn assess(
         ci_high: None,
         params: Vec::new(),
         note: None,
+        seconds: 0.0,
     };
     let clock = std::time::Instant::now();
     let out = assess_inner(ctx, nominal, s2, nominal_eval, e, opts, &mut entry);
-    if std::env::var_os("STIRLING_DIAGNOSE_DEBUG").is_some() {
-        eprintln!(
-            "{}: score {:.2} (dof {}, p {:.2e}), params {:?}, held-out {:?} ({:.1} s) {:?}",
+    entry.seconds = clock.elapsed().as_secs_f64();
+    if let Some(progress) = ctx.progress {
+        progress(&format!(
+            "candidate {}: score p {:.1e}, held-out error {}, {:.1} s",
             e.name,
-            entry.score,
-            entry.dof,
             entry.p_value,
             entry
-                .params
-                .iter()
-                .map(|q| (q.name.clone(), q.value, q.std_error))
-                .collect::<Vec<_>>(),
-            entry.holdout_error,
-            clock.elapsed().as_secs_f64(),
-            entry.note
-        );
+                .holdout_error
+                .map_or("-".into(), |v| format!("{v:.3}")),
+            entry.seconds
+        ));
     }
     match out {
         Ok(eval) => Assessed { entry, eval },

@@ -86,6 +86,7 @@ pub fn diagnose(
             .collect::<Result<Vec<_>, _>>()
             .map_err(|e| DiagnoseError::Nominal(e.to_string()))?,
         fits: std::sync::atomic::AtomicUsize::new(1),
+        progress: opts.progress,
     };
     let all: Vec<Prediction> = ctx.nominal_preds.iter().flatten().cloned().collect();
     let nominal = ctx
@@ -97,14 +98,12 @@ pub fn diagnose(
         .collect::<Result<Vec<f64>, _>>()
         .map_err(|e| DiagnoseError::Nominal(e.to_string()))?;
     let localization = localize::localize(model, &p_nom, data, &nominal, &ctx);
-    if std::env::var_os("STIRLING_DIAGNOSE_DEBUG").is_some() {
-        eprintln!("nominal parameters: {:?}", id.params);
-        for c in &localization.channels {
-            eprintln!(
-                "nominal {}: train {:.3}, held-out {:.3} x noise; s2 {s2:?}",
-                c.channel, c.train_ratio, c.holdout_ratio
-            );
-        }
+    if let Some(progress) = opts.progress {
+        progress(&format!(
+            "nominal calibration done ({:.1} s); assessing {} candidate effects",
+            clock.elapsed().as_secs_f64(),
+            cands.len()
+        ));
     }
     let mut lm = opts.fit.lm;
     lm.max_iter = opts.joint_iters;

@@ -68,6 +68,8 @@ pub struct RankEntry {
     pub params: Vec<EffectEstimate>,
     /// Why it could not be screened or fitted, if so.
     pub note: Option<String>,
+    /// Time spent screening and fitting this candidate (s).
+    pub seconds: f64,
 }
 
 /// A fitted effect parameter.
