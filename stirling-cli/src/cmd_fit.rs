@@ -84,9 +84,21 @@ pub fn run(a: &FitArgs) -> anyhow::Result<()> {
         plots(dir, &res)?;
     }
     if a.json {
-        return common::print_json(&res);
+        common::print_json(&res)?;
+    } else {
+        print_text(&mut common::stdout(), &a.data, &res)?;
     }
-    Ok(print_text(&mut common::stdout(), &a.data, &res)?)
+    // a result that is not an optimum does not stand: say so with a non-zero exit
+    for st in [&res.stage1, &res.stage2].into_iter().flatten() {
+        if !st.converged {
+            anyhow::bail!(
+                "{} did not converge in {} iterations: the estimates above are not an optimum (a longer record, more excitation or better starting values may help)",
+                st.stage,
+                st.iterations
+            );
+        }
+    }
+    Ok(())
 }
 
 fn plot_series(path: &Path, title: &str, s: &Series) -> anyhow::Result<()> {

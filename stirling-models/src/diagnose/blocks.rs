@@ -2,6 +2,7 @@
 
 use super::{DiagnoseError, DiagnoseOptions};
 use crate::data::Measured;
+use crate::signal::cycle_frequency;
 
 /// Training and held-out blocks (times and sample ranges) of a record.
 pub(super) struct Blocks {
@@ -35,10 +36,21 @@ pub(super) fn blocks(data: &Measured, opts: &DiagnoseOptions) -> Result<Blocks, 
     let train_idx = ((idx(train.0) + burn).min(idx(train.1)), idx(train.1));
     let hold_idx = (idx(holdout.0).max(train_idx.1), idx(holdout.1) + 1);
     if train_idx.1 < train_idx.0 + 50 || hold_idx.1 < hold_idx.0 + 50 {
-        return Err(DiagnoseError::Bad(
-            "the training and held-out blocks need at least 50 samples each (after the burn-in)"
-                .into(),
-        ));
+        return Err(DiagnoseError::Bad(format!(
+            "{}: the record ({:.3} s) is too short to diagnose: the training block (after a {} s burn-in) and the held-out block need at least 50 samples each; a diagnosis needs a few cycles to fit and a few more to hold out",
+            data.source,
+            t1 - t0,
+            opts.fit.burn_in
+        )));
+    }
+    let motion = data.x.as_ref().or(data.p.as_ref());
+    if let Some(v) = motion {
+        if cycle_frequency(&v[hold_idx.0..hold_idx.1], dt).is_none() {
+            return Err(DiagnoseError::Bad(format!(
+                "{}: the held-out block {:.3}:{:.3} s holds fewer than two cycles: too few to hold out (a longer record, or --train/--holdout)",
+                data.source, holdout.0, holdout.1
+            )));
+        }
     }
     Ok(Blocks {
         train,

@@ -9,6 +9,7 @@
 
 pub mod classify;
 pub mod driven;
+pub mod excitation;
 pub mod free_run;
 pub mod gas;
 pub mod identify;
@@ -55,6 +56,15 @@ pub enum FitError {
     TooFewSamples { file: String, samples: usize },
     #[error(transparent)]
     Sampling(crate::data::DataError),
+    #[error("{file}: channel `{channel}` does not move enough to fit: its standard deviation on the training block is {sd:.3e}, its noise level {noise:.3e} (needs more than {} times the noise); is the engine running in this record?", excitation::MIN_SIGNAL_TO_NOISE)]
+    NoExcitation {
+        file: String,
+        channel: String,
+        sd: f64,
+        noise: f64,
+    },
+    #[error("{file}: the training block ({seconds:.3} s) holds fewer than two cycles of the motion: the record is too short (or does not oscillate) to identify the dynamics")]
+    TooFewCycles { file: String, seconds: f64 },
     #[error("the training block {from}:{to} holds {samples} samples, fewer than 11")]
     ShortTraining { from: f64, to: f64, samples: usize },
     #[error("{file}: {stage} needs the columns p, x and y")]

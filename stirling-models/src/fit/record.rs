@@ -62,6 +62,7 @@ impl<'a> Record<'a> {
                 samples: tr.1.saturating_sub(tr.0) + 1,
             });
         }
+        super::excitation::check(data, tr, dt)?;
         let h = ((opts.smooth / dt).round() as usize).max(3);
         let ps = &layout.pressures;
         let have_hot = data.p_hot.is_some() && ps.len() > 1;
