@@ -4,7 +4,7 @@
 use std::io::{self, Write};
 use std::path::{Path, PathBuf};
 
-use anyhow::{bail, Context};
+use anyhow::bail;
 use clap::Args;
 use stirling_models::data::{check_uniform, read_csv_lines};
 use stirling_models::diagnose::{self, selfcheck, DiagnoseOptions, Diagnosis};
@@ -19,18 +19,12 @@ const REPORT: [&str; 2] = ["report.md", "*.svg"];
 pub struct DiagnoseArgs {
     /// Model with an augmented member: cv1 or nsection (aliases order5, order7, order8)
     pub model: Option<String>,
-    /// Number of regenerator sections (nsection)
-    #[arg(long, allow_negative_numbers = true, value_parser = ranges::at_least_one)]
-    pub n: Option<usize>,
+    /// Starting parameters: sections, file, overrides
+    #[command(flatten)]
+    pub with: common::ParamArgs,
     /// Measured data (CSV: t and p, x, y; p_hot optional)
     #[arg(long)]
     pub data: Option<PathBuf>,
-    /// Starting parameters (TOML or JSON by name)
-    #[arg(long)]
-    pub params: Option<PathBuf>,
-    /// Override a starting parameter (repeatable)
-    #[arg(long = "set", value_name = "NAME=VALUE")]
-    pub set: Vec<String>,
     /// Candidate effects: all, or a comma-separated list
     #[arg(long, default_value = "all")]
     pub effects: String,
@@ -101,7 +95,7 @@ pub fn run(a: &DiagnoseArgs) -> anyhow::Result<()> {
     if a.self_check {
         let opts = selfcheck::SelfCheckOptions {
             model: a.model.clone().unwrap_or_else(|| "cv1".into()),
-            n: a.n,
+            n: a.with.n,
             effects: effects_arg(&a.effects),
             strengths: a.strengths.clone(),
             t_end: a.t_end,
@@ -173,14 +167,8 @@ pub fn run(a: &DiagnoseArgs) -> anyhow::Result<()> {
     let (data, lines) = read_csv_lines(path)?;
     check_uniform(&data, Some(&lines))?;
     let (train, holdout) = common::blocks(a.train.as_deref(), a.holdout.as_deref(), &data, 0.6)?;
-    let (model, mut p0) = diagnose::nominal_model(model_name, a.n)?;
-    if let Some(f) = &a.params {
-        stirling_models::params::apply_file(model.as_ref(), f, &mut p0)
-            .with_context(|| format!("parameters from {}", f.display()))?;
-    }
-    for s in &a.set {
-        stirling_models::params::apply_override(model.as_ref(), s, &mut p0)?;
-    }
+    let (model, mut p0) = diagnose::nominal_model(model_name, a.with.n)?;
+    a.with.apply(model.as_ref(), &mut p0)?;
     let opts = DiagnoseOptions {
         effects: effects_arg(&a.effects),
         prior: prior_arg(a.prior)?,

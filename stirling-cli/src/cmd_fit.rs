@@ -4,7 +4,6 @@
 use std::io::{self, Write};
 use std::path::{Path, PathBuf};
 
-use anyhow::Context;
 use clap::Args;
 use stirling_dsl::Closure;
 use stirling_models::data::{check_uniform, read_csv_lines};
@@ -21,18 +20,12 @@ const FIGURES: [&str; 3] = ["stage1_*.svg", "stage2_*.svg", "free_run_*.svg"];
 pub struct FitArgs {
     /// Model: cv1, cv2, nsection (aliases order5..order8)
     pub model: String,
-    /// Number of regenerator sections (nsection)
-    #[arg(long, allow_negative_numbers = true, value_parser = ranges::at_least_one)]
-    pub n: Option<usize>,
+    /// Starting parameters: sections, file, overrides
+    #[command(flatten)]
+    pub with: common::ParamArgs,
     /// Measured data (CSV: t and p, x, y; p_hot optional)
     #[arg(long)]
     pub data: PathBuf,
-    /// Starting parameters (TOML or JSON by name)
-    #[arg(long)]
-    pub params: Option<PathBuf>,
-    /// Override a starting parameter (repeatable)
-    #[arg(long = "set", value_name = "NAME=VALUE")]
-    pub set: Vec<String>,
     /// Free parameters, comma-separated (default kd,kp,bd,bp,hh,hk,Rf where used)
     #[arg(long, value_delimiter = ',')]
     pub free: Option<Vec<String>>,
@@ -64,9 +57,8 @@ pub fn run(a: &FitArgs) -> anyhow::Result<()> {
     let (data, lines) = read_csv_lines(&a.data)?;
     check_uniform(&data, Some(&lines))?;
     let (train, holdout) = common::blocks(a.train.as_deref(), a.holdout.as_deref(), &data, 0.7)?;
-    let model = stirling_models::build(&a.model, a.n, Closure::Full)?;
-    let p0 = stirling_models::params::load(model.as_ref(), a.params.as_deref(), &a.set)
-        .with_context(|| format!("parameters of model `{}`", model.name()))?;
+    let model = stirling_models::build(&a.model, a.with.n, Closure::Full)?;
+    let p0 = a.with.load(model.as_ref())?;
     let opts = FitOptions {
         free: a.free.clone(),
         multiple_shooting: a

@@ -14,16 +14,13 @@ use crate::common::ranges;
 pub struct RigArgs {
     /// Base model: cv1 or nsection (aliases order5, order7, order8)
     pub model: String,
-    /// Number of regenerator sections (nsection)
-    #[arg(long, allow_negative_numbers = true, value_parser = ranges::at_least_one)]
-    pub n: Option<usize>,
     /// Effect or effect parameter, e.g. --effect leak=2e-8 --effect xmax=0.004 (repeatable);
     /// effects: leak, coulomb, regen_quadratic, end_stops, sensor_lag, sensor_gain
     #[arg(long = "effect", value_name = "NAME=VALUE")]
     pub effect: Vec<String>,
-    /// Override a model parameter of the truth, e.g. --set kd=700 (repeatable)
-    #[arg(long = "set", value_name = "NAME=VALUE")]
-    pub set: Vec<String>,
+    /// The truth's parameters: sections, file, overrides
+    #[command(flatten)]
+    pub with: crate::common::ParamArgs,
     /// Record length (s)
     #[arg(long, default_value_t = 1.0, allow_negative_numbers = true, value_parser = ranges::finite)]
     pub t_end: f64,
@@ -72,8 +69,9 @@ pub struct RigArgs {
 pub fn run(a: &RigArgs) -> anyhow::Result<()> {
     let cfg = RigConfig {
         model: a.model.clone(),
-        n: a.n,
-        set: a.set.clone(),
+        n: a.with.n,
+        params: a.with.params.clone(),
+        set: a.with.set.clone(),
         effects: a.effect.clone(),
         t_end: a.t_end,
         settle: a.settle,

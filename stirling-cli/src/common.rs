@@ -16,17 +16,13 @@ use anyhow::Context;
 use clap::Args;
 use stirling_dsl::{Closure, Model};
 
-/// Selects a model and its parameters.
+/// The regenerator sections and the parameter sources of a model: every command that builds
+/// one takes them (declared once here).
 #[derive(Args, Debug, Clone)]
-pub struct ModelArgs {
-    /// Model: schmidt, cv1, cv2, nsection (aliases order4..order8)
-    pub model: String,
+pub struct ParamArgs {
     /// Number of regenerator sections (nsection only; default 1)
     #[arg(long, allow_negative_numbers = true, value_parser = ranges::at_least_one)]
     pub n: Option<usize>,
-    /// Inventory closure: full (mass states, default) or frozen (seed's order count)
-    #[arg(long, default_value = "full")]
-    pub closure: Closure,
     /// Parameter file (TOML or JSON, parameters by name)
     #[arg(long)]
     pub params: Option<PathBuf>,
@@ -35,12 +31,43 @@ pub struct ModelArgs {
     pub set: Vec<String>,
 }
 
+impl ParamArgs {
+    /// `p` with the file's values and then the overrides applied (not validated).
+    pub fn apply(&self, model: &dyn Model, p: &mut [f64]) -> anyhow::Result<()> {
+        if let Some(f) = &self.params {
+            stirling_models::params::apply_file(model, f, p)
+                .with_context(|| format!("parameters from {}", f.display()))?;
+        }
+        for s in &self.set {
+            stirling_models::params::apply_override(model, s, p)?;
+        }
+        Ok(())
+    }
+
+    /// The defaults of `model` with the file and the overrides, validated.
+    pub fn load(&self, model: &dyn Model) -> anyhow::Result<Vec<f64>> {
+        stirling_models::params::load(model, self.params.as_deref(), &self.set)
+            .with_context(|| format!("parameters of model `{}`", model.name()))
+    }
+}
+
+/// Selects a model and its parameters.
+#[derive(Args, Debug, Clone)]
+pub struct ModelArgs {
+    /// Model: schmidt, cv1, cv2, nsection (aliases order4..order8)
+    pub model: String,
+    /// Inventory closure: full (mass states, default) or frozen (seed's order count)
+    #[arg(long, default_value = "full")]
+    pub closure: Closure,
+    #[command(flatten)]
+    pub with: ParamArgs,
+}
+
 impl ModelArgs {
     /// The model and its validated parameter vector.
     pub fn load(&self) -> anyhow::Result<(Box<dyn Model>, Vec<f64>)> {
-        let model = stirling_models::build(&self.model, self.n, self.closure)?;
-        let p = stirling_models::params::load(model.as_ref(), self.params.as_deref(), &self.set)
-            .with_context(|| format!("parameters of model `{}`", model.name()))?;
+        let model = stirling_models::build(&self.model, self.with.n, self.closure)?;
+        let p = self.with.load(model.as_ref())?;
         Ok((model, p))
     }
 }

@@ -23,6 +23,8 @@ pub struct RigConfig {
     /// Base model (`cv1`, `nsection`, or an alias).
     pub model: String,
     pub n: Option<usize>,
+    /// Parameter file of the truth (TOML or JSON by name), applied before `set`.
+    pub params: Option<PathBuf>,
     /// Parameter overrides `NAME=VALUE` (model parameters).
     pub set: Vec<String>,
     /// Effect settings `NAME=VALUE` (an effect name sets its strength, or an effect parameter).
@@ -54,6 +56,7 @@ impl Default for RigConfig {
         Self {
             model: "cv1".into(),
             n: None,
+            params: None,
             set: Vec::new(),
             effects: Vec::new(),
             t_end: 1.0,
@@ -203,7 +206,7 @@ pub fn run(cfg: &RigConfig) -> Result<RigOutput, RigError> {
     validate(cfg)?;
     let model = augmented(&cfg.model, cfg.n, Closure::Full)?;
     let fx = EffectSettings::parse(&cfg.model, &cfg.effects)?;
-    let mut p = crate::params::load(model.as_ref(), None, &cfg.set)?;
+    let mut p = crate::params::load(model.as_ref(), cfg.params.as_deref(), &cfg.set)?;
     fx.apply(model.as_ref(), &mut p)?;
     let mut x0 = vec![0.0; model.n_states()];
     model.equilibrium_guess(&p, &mut x0);
