@@ -9,10 +9,10 @@
 use stirling_dsl::Model;
 
 use super::driven::Stage;
-use super::vars::{Output, Var};
-use super::static_shift::{cold_weight, static_shift};
 use super::record::Record;
 use super::sensitivity::Given;
+use super::static_shift::{cold_weight, static_shift};
+use super::vars::{Output, Var};
 use super::{FitError, FitOptions};
 use crate::layout::StateLayout;
 use crate::signal::noise_sigma;
@@ -59,7 +59,7 @@ pub fn stage<'a>(
     let mut eq = vec![0.0; model.n_states()];
     model.equilibrium_guess(p, &mut eq);
     let shift = static_shift(model, p, have_hot)?;
-    let (sx, sy) = rec.positions().expect("checked");
+    let (sx, sy) = rec.pos.clone().expect("checked");
     let used = [0, 1].map(|k| shift[0][k] * p_off0 + shift[1][k] * ph_off0);
     let (pos, vel) = (&layout.positions, &layout.velocities);
     let given = vec![
@@ -121,7 +121,7 @@ fn initial_state(
     eq: &[f64],
     x_off: [f64; 2],
 ) -> Vec<f64> {
-    let (sx, sy) = rec.positions().expect("checked");
+    let (sx, sy) = rec.pos.as_ref().expect("checked");
     let sp = rec.sig_p.as_ref().expect("checked");
     let mut x = eq.to_vec();
     let ta = rec.tr.0;

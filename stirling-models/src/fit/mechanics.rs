@@ -10,10 +10,10 @@
 use stirling_dsl::Model;
 
 use super::driven::Stage;
-use super::vars::{Output, Var};
-use super::static_shift::cold_weight;
 use super::record::Record;
 use super::sensitivity::{Given, Signal};
+use super::static_shift::cold_weight;
+use super::vars::{Output, Var};
 use super::{FitError, FitOptions};
 use crate::layout::StateLayout;
 use crate::signal::{cycle_frequency, drift_count, noise_sigma};
@@ -102,7 +102,7 @@ pub fn stage<'a>(
             })
             .collect(),
     };
-    let (sx, sy) = rec.positions().expect("checked");
+    let (sx, sy) = rec.pos.as_ref().expect("checked");
     let ta = rec.tr.0;
     let x_off = inp.x_off;
     let z0 = vec![

@@ -28,6 +28,8 @@ pub struct Record<'a> {
     /// Smoothed pressure signals.
     pub sig_p: Option<Signal>,
     pub sig_ph: Option<Signal>,
+    /// Smoothed position signals `x`, `y` (value and derivative), when both are measured.
+    pub pos: Option<(Signal, Signal)>,
     /// Whole-cycle means of the positions (first position offsets) and of the pressures
     /// minus the charge pressure (first pressure offsets).
     pub x_off0: [f64; 2],
@@ -83,6 +85,11 @@ impl<'a> Record<'a> {
             have_hot,
             sig_p: data.p.as_ref().map(smooth),
             sig_ph: data.p_hot.as_ref().map(smooth),
+            pos: data
+                .x
+                .as_ref()
+                .zip(data.y.as_ref())
+                .map(|(x, y)| (signal(t0, dt, x, h), signal(t0, dt, y, h))),
             x_off0: [
                 mean_of(data.x.as_ref(), 0.0).unwrap_or(0.0),
                 mean_of(data.y.as_ref(), 0.0).unwrap_or(0.0),
@@ -90,20 +97,6 @@ impl<'a> Record<'a> {
             p_off0: mean_of(data.p.as_ref(), pmean).unwrap_or(0.0),
             ph_off0: mean_of(data.p_hot.as_ref(), pmean).unwrap_or(0.0),
         })
-    }
-
-    /// The smoothed position signals `x`, `y` (value and derivative).
-    pub fn positions(&self) -> Option<(Signal, Signal)> {
-        let (x, y) = (self.data.x.as_ref()?, self.data.y.as_ref()?);
-        Some((
-            signal(self.t0, self.dt, x, self.h),
-            signal(self.t0, self.dt, y, self.h),
-        ))
-    }
-
-    /// The last sample index any block uses.
-    pub fn end(&self) -> usize {
-        self.ho.map_or(self.tr.1, |h| h.1.max(self.tr.1))
     }
 }
 

@@ -78,7 +78,10 @@ pub enum Column {
     /// Prescribed inputs move by `du[g] * scale` per unit (one entry per [`Given`]).
     Input { du: Vec<f64>, scale: f64 },
     /// Prescribed input `g` moves by `signal_s(t) * scale` per unit, for each `(g, s)`.
-    Signals { pairs: Vec<(usize, usize)>, scale: f64 },
+    Signals {
+        pairs: Vec<(usize, usize)>,
+        scale: f64,
+    },
 }
 
 /// A driven subsystem with its sensitivities, as an [`OdeSystem`]: state `[z, vec(S)]`.
@@ -128,6 +131,22 @@ impl Driven<'_> {
 }
 
 impl Driven<'_> {
+    /// The rate of every prescribed state per unit of column `c` at `t` (empty when the
+    /// column moves no prescribed state: parameters and initial states).
+    fn input_rates(&self, c: &Column, t: f64) -> Vec<f64> {
+        match c {
+            Column::Param { .. } | Column::Initial { .. } => Vec::new(),
+            Column::Input { du, scale } => du.iter().map(|d| d * scale).collect(),
+            Column::Signals { pairs, scale } => {
+                let mut du = vec![0.0; self.given.len()];
+                for &(g, s) in pairs {
+                    du[g] += self.signals[s].eval(t).0 * scale;
+                }
+                du
+            }
+        }
+    }
+
     /// Call `f(row, col, value)` for every entry of the augmented Jacobian: the free-state
     /// block of `df/dx` repeated along the diagonal.
     fn for_each_block_entry(&self, t: f64, xa: &[f64], mut f: impl FnMut(usize, usize, f64)) {
@@ -185,6 +204,8 @@ impl OdeSystem for Driven<'_> {
         for (k, c) in self.columns.iter().enumerate() {
             let s = &xa[nz + k * nz..nz + (k + 1) * nz];
             let o = &mut out[nz + k * nz..nz + (k + 1) * nz];
+            // how each prescribed state moves per unit of this column (once per call)
+            let du = self.input_rates(c, t);
             for (r, &ir) in self.free.iter().enumerate() {
                 let mut acc = 0.0;
                 for (cc, &ic) in self.free.iter().enumerate() {
@@ -192,24 +213,12 @@ impl OdeSystem for Driven<'_> {
                 }
                 acc += match c {
                     Column::Param { index, scale } => jp[ir + n * index] * scale,
-                    Column::Initial { .. } => 0.0,
-                    Column::Signals { pairs, scale } => {
-                        pairs
-                            .iter()
-                            .map(|&(g, s)| {
-                                j[ir + n * self.given[g].state] * self.signals[s].eval(t).0
-                            })
-                            .sum::<f64>()
-                            * scale
-                    }
-                    Column::Input { du, scale } => {
-                        self.given
-                            .iter()
-                            .zip(du)
-                            .map(|(g, d)| j[ir + n * g.state] * d)
-                            .sum::<f64>()
-                            * scale
-                    }
+                    _ => self
+                        .given
+                        .iter()
+                        .zip(&du)
+                        .map(|(g, d)| j[ir + n * g.state] * d)
+                        .sum::<f64>(),
                 };
                 o[r] = acc;
             }

@@ -14,10 +14,10 @@
 use nalgebra::{DMatrix, DVector};
 
 use super::driven::Stage;
-use super::vars::{Output, VarKind};
 use super::record::Record;
 use super::report::FitStats;
 use super::sensitivity::Signal;
+use super::vars::{Output, VarKind};
 use super::FitError;
 use crate::layout::StateLayout;
 
@@ -130,7 +130,7 @@ pub fn carried_covariance(
     let Some(inv) = jtj.try_inverse() else {
         return Ok(None);
     };
-    let (first, last) = (keep[0].min(rec.tr.0), rec.tr.1);
+    let (first, last) = rec.tr;
     let residuals_at = |u2: &[f64]| -> Result<Vec<f64>, FitError> {
         let dp = pressure_differences(gas, u2, layout, rec)?;
         let mut st = mech.clone();
