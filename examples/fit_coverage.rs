@@ -71,8 +71,8 @@ fn one(seed: u64, a: &Args) -> Result<Outcome, String> {
         ..Default::default()
     };
     let out = rig::run(&cfg).map_err(|e| e.to_string())?;
-    let model = stirling::models::build("nsection", Some(a.n), Closure::Full)
-        .map_err(|e| e.to_string())?;
+    let model =
+        stirling::models::build("nsection", Some(a.n), Closure::Full).map_err(|e| e.to_string())?;
     let mut p0 = model.default_params();
     let mut rng = StdRng::seed_from_u64(1000 + seed);
     for name in FREE {
@@ -86,7 +86,10 @@ fn one(seed: u64, a: &Args) -> Result<Outcome, String> {
     let id = fit::identify(model.as_ref(), &p0, &out.data, &opts).map_err(|e| e.to_string())?;
     for st in [&id.stage1, &id.stage2].into_iter().flatten() {
         if !st.converged {
-            eprintln!("seed {seed}: {} did not converge in {} iterations", st.stage, st.iterations);
+            eprintln!(
+                "seed {seed}: {} did not converge in {} iterations",
+                st.stage, st.iterations
+            );
         }
     }
     let mut per = Vec::new();
@@ -184,7 +187,10 @@ fn main() {
         );
     }
     let fr: Vec<[f64; 4]> = ok.iter().filter_map(|o| o.1).collect();
-    for (k, what) in ["x amplitude", "y amplitude", "p amplitude", "frequency"].iter().enumerate() {
+    for (k, what) in ["x amplitude", "y amplitude", "p amplitude", "frequency"]
+        .iter()
+        .enumerate()
+    {
         let v: Vec<f64> = fr.iter().map(|f| f[k].abs()).collect();
         let worst = v.iter().copied().fold(0.0, f64::max);
         println!(

@@ -25,7 +25,13 @@ fn pxy_startup_record_recovers_parameters_and_free_run() {
     assert_eq!(out.data.channels(), vec!["p", "x", "y"]);
     let model = stirling::models::build("nsection", Some(2), Closure::Full).unwrap();
     let mut p0 = model.default_params();
-    for (k, v) in [("kd", 683.0), ("hh", 650.0), ("hk", 650.0), ("bp", 7.1), ("Rf", 1.5e5)] {
+    for (k, v) in [
+        ("kd", 683.0),
+        ("hh", 650.0),
+        ("hk", 650.0),
+        ("bp", 7.1),
+        ("Rf", 1.5e5),
+    ] {
         p0[model.param_index(k).unwrap()] = v;
     }
     let free = ["kd", "kp", "bd", "bp", "hh", "hk", "Rf"];
@@ -41,18 +47,44 @@ fn pxy_startup_record_recovers_parameters_and_free_run() {
             .flatten()
             .find_map(|s| s.estimate(name))
             .unwrap();
-        eprintln!("{name}: {:.5e} [{:.5e}, {:.5e}], truth {truth:.5e}", e.value, e.ci_low, e.ci_high);
-        assert!(e.covers(truth), "{name}: truth {truth} outside [{}, {}]", e.ci_low, e.ci_high);
+        eprintln!(
+            "{name}: {:.5e} [{:.5e}, {:.5e}], truth {truth:.5e}",
+            e.value, e.ci_low, e.ci_high
+        );
+        assert!(
+            e.covers(truth),
+            "{name}: truth {truth} outside [{}, {}]",
+            e.ci_low,
+            e.ci_high
+        );
         // an honest interval, not a vacuous one
-        assert!(e.ci_high - e.ci_low < 0.3 * truth, "{name}: interval too wide");
+        assert!(
+            e.ci_high - e.ci_low < 0.3 * truth,
+            "{name}: interval too wide"
+        );
     }
-    let fr = id.free_run.as_ref().expect("free run on the held-out block");
-    let (m, s) = (fr.measured.as_ref().unwrap(), fr.simulated.as_ref().unwrap());
+    let fr = id
+        .free_run
+        .as_ref()
+        .expect("free run on the held-out block");
+    let (m, s) = (
+        fr.measured.as_ref().unwrap(),
+        fr.simulated.as_ref().unwrap(),
+    );
     for ch in ["x", "y", "p"] {
-        let amp = |c: &fit::free_run::CycleFeatures| c.amplitude.iter().find(|a| a.0 == ch).unwrap().1;
+        let amp =
+            |c: &fit::free_run::CycleFeatures| c.amplitude.iter().find(|a| a.0 == ch).unwrap().1;
         let rel = (amp(s) - amp(m)) / amp(m);
-        assert!(rel.abs() < 0.05, "{ch}: free-run amplitude off by {:.2} %", 100.0 * rel);
+        assert!(
+            rel.abs() < 0.05,
+            "{ch}: free-run amplitude off by {:.2} %",
+            100.0 * rel
+        );
     }
     let fe = fr.frequency_error.unwrap();
-    assert!(fe.abs() < 0.005, "free-run frequency off by {:.3} %", 100.0 * fe);
+    assert!(
+        fe.abs() < 0.005,
+        "free-run frequency off by {:.3} %",
+        100.0 * fe
+    );
 }

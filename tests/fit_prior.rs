@@ -2,8 +2,8 @@
 //! differences (also below the floor where the logarithm continues linearly), and which
 //! variables carry one.
 
-use stirling::models::fit::vars::{Var, VarKind};
 use stirling::models::fit::prior::{prior_count, prior_rows};
+use stirling::models::fit::vars::{Var, VarKind};
 
 fn var(initial: f64, scale: f64, prior: Option<f64>) -> Var {
     Var {

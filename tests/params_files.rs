@@ -207,14 +207,29 @@ fn nonfinite_toml_values_and_wrong_formats_say_what_and_how_read() {
     std::fs::create_dir_all(&dir).unwrap();
     let nan = dir.join("nan.toml");
     std::fs::write(&nan, "Th = nan\n").unwrap();
-    let e = load(model.as_ref(), Some(&nan), &[]).unwrap_err().to_string();
-    assert!(e.contains("`Th`") && e.contains("NaN (not a finite number)"), "{e}");
+    let e = load(model.as_ref(), Some(&nan), &[])
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("`Th`") && e.contains("NaN (not a finite number)"),
+        "{e}"
+    );
     let json_in_toml = dir.join("p.toml");
     std::fs::write(&json_in_toml, "{\"Th\": 650}").unwrap();
-    let e = load(model.as_ref(), Some(&json_in_toml), &[]).unwrap_err().to_string();
-    assert!(e.contains("read as TOML") && e.contains("looks like JSON"), "{e}");
+    let e = load(model.as_ref(), Some(&json_in_toml), &[])
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("read as TOML") && e.contains("looks like JSON"),
+        "{e}"
+    );
     let toml_in_json = dir.join("p.json");
     std::fs::write(&toml_in_json, "Th = 650\n").unwrap();
-    let e = load(model.as_ref(), Some(&toml_in_json), &[]).unwrap_err().to_string();
-    assert!(e.contains("read as JSON") && e.contains("rename it to .toml"), "{e}");
+    let e = load(model.as_ref(), Some(&toml_in_json), &[])
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("read as JSON") && e.contains("rename it to .toml"),
+        "{e}"
+    );
 }

@@ -1,14 +1,14 @@
 //! `stirling`: the command line of the framework.
 
-mod cmd_models;
-mod common;
 mod cmd_diagnose;
 mod cmd_fit;
 mod cmd_info;
 mod cmd_linearize;
 mod cmd_locus;
+mod cmd_models;
 mod cmd_rig;
 mod cmd_simulate;
+mod common;
 
 use clap::{Parser, Subcommand};
 

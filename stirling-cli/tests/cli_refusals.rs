@@ -12,8 +12,17 @@ fn write(name: &str, rows: usize, moving: bool) -> std::path::PathBuf {
     let mut text = String::from("t,p,x,y\n");
     for k in 0..rows {
         let t = k as f64 * 5e-4;
-        let w = if moving { (2.0 * std::f64::consts::PI * 13.4 * t).sin() } else { 0.0 };
-        text.push_str(&format!("{t},{},{},{}\n", 101325.0 + 7000.0 * w, 0.131 + 0.01 * w, 0.046 + 0.008 * w));
+        let w = if moving {
+            (2.0 * std::f64::consts::PI * 13.4 * t).sin()
+        } else {
+            0.0
+        };
+        text.push_str(&format!(
+            "{t},{},{},{}\n",
+            101325.0 + 7000.0 * w,
+            0.131 + 0.01 * w,
+            0.046 + 0.008 * w
+        ));
     }
     std::fs::write(&f, text).unwrap();
     f
@@ -44,5 +53,8 @@ fn a_record_shorter_than_two_cycles_is_refused_by_fit() {
 fn a_record_too_short_to_hold_out_is_refused_by_diagnose() {
     // 0.35 s, the length of the seed's start-up records
     let f = write("seedlike", 700, true);
-    fails_with(&["diagnose", "cv1", "--data", s(&f)], &["too short to diagnose"]);
+    fails_with(
+        &["diagnose", "cv1", "--data", s(&f)],
+        &["too short to diagnose"],
+    );
 }

@@ -126,10 +126,10 @@ pub mod data;
 pub mod diagnose;
 /// Effects the nominal models leave out, as DSL-declared model augmentations.
 pub mod effects;
-/// Identification: driven subsystems, forward sensitivities, Levenberg-Marquardt, report.
-pub mod fit;
 /// The seed's model family (`schmidt`, `cv1`, `cv2`, `nsection`) on the default engine.
 pub mod family;
+/// Identification: driven subsystems, forward sensitivities, Levenberg-Marquardt, report.
+pub mod fit;
 /// Which state of a model is what (positions, velocities, pressures, masses).
 pub mod layout;
 /// Linear analysis: equilibrium, poles, the loop broken at a pressure force, margins, locus.

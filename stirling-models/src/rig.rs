@@ -12,8 +12,8 @@ use serde::Serialize;
 use stirling_dsl::Closure;
 
 use crate::data::{write_csv, Measured};
-use crate::layout::StateLayout;
 use crate::effects::{augmented, EffectSettings};
+use crate::layout::StateLayout;
 use crate::signal::first_order_lag;
 use crate::sim::{simulate, SimOptions};
 
@@ -137,7 +137,6 @@ impl Gauss {
     }
 }
 
-
 /// Lowest sample rate the rig accepts (Hz): the family runs near 13 Hz, and the fit's
 /// smoothing derivatives need several samples per millisecond-scale feature.
 pub const MIN_RATE: f64 = 200.0;
@@ -229,7 +228,10 @@ pub fn run(cfg: &RigConfig) -> Result<RigOutput, RigError> {
     )?;
     let ps = StateLayout::of(model.as_ref()).pressures;
     let (Some(&ic), Some(&ih)) = (ps.last(), ps.first()) else {
-        return Err(RigError::Bad(format!("`{}` has no gas volume to measure", cfg.model)));
+        return Err(RigError::Bad(format!(
+            "`{}` has no gas volume to measure",
+            cfg.model
+        )));
     };
     let ncv = ps.len();
     let col = |i: usize| traj.x.iter().map(|r| r[i]).collect::<Vec<f64>>();

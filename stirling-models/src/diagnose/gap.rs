@@ -1,8 +1,8 @@
 //! The nominal model's held-out gap per channel, with features and calibrated parameters.
 
 use super::context::{Context, Eval};
-use super::types::{ChannelError, GapBefore, ParamShift};
 use super::localize;
+use super::types::{ChannelError, GapBefore, ParamShift};
 use crate::fit;
 use crate::fit::FittedStage;
 

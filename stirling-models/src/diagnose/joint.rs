@@ -17,9 +17,9 @@ use nalgebra::DMatrix;
 use stirling_dsl::Model;
 
 use crate::effects::{EffectInfo, EffectTarget};
-use crate::fit::vars::{Sensor, Var, VarKind};
 use crate::fit::prior::prior_rows;
 use crate::fit::sensitivity::Signal;
+use crate::fit::vars::{Sensor, Var, VarKind};
 use crate::fit::{classify, unmeasured, FitError, FittedStage};
 
 /// One effect variable of the joint problem.

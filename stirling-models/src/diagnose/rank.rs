@@ -15,9 +15,9 @@
 
 use nalgebra::DVector;
 
+use super::context::{Context, Eval};
 use super::joint::{EffectVar, Joint};
 use super::score::{robust_score, Score};
-use super::context::{Context, Eval};
 use super::types::{EffectEstimate, RankEntry};
 use crate::effects::{EffectInfo, EffectTarget};
 use crate::fit::lm::{self, LmOptions};

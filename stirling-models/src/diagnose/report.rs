@@ -178,7 +178,10 @@ pub fn write(d: &Diagnosis, data: &Measured, dir: &Path) -> Result<std::path::Pa
     bars(
         &dir.join("residual_harmonics.svg"),
         "residual amplitude / noise level by harmonic",
-        &format!("harmonic 0..{} [multiple of the cycle frequency]", HARMONICS - 1),
+        &format!(
+            "harmonic 0..{} [multiple of the cycle frequency]",
+            HARMONICS - 1
+        ),
         "amplitude / (2 sigma / sqrt N) [-]",
         &harm,
         Some(1.0),

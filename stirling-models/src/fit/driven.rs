@@ -16,12 +16,11 @@ use nalgebra::DMatrix;
 use stirling_dsl::Model;
 
 use super::sensitivity::{Column, Driven, Given, Signal};
-use super::FitError;
 use super::sensors::lag_columns;
 use super::vars::{Output, Var, VarKind, MIN_RATIO};
+use super::FitError;
 use crate::signal::project_drift;
 use crate::sim::{integrate, state_scale, Hooks, LinearSolverKind, SimOptions};
-
 
 /// A driven-subsystem fitting problem on a uniform record.
 #[derive(Clone)]

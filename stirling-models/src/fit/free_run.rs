@@ -23,11 +23,11 @@ use std::time::Instant;
 use serde::Serialize;
 use stirling_dsl::{Model, StateKind};
 
-use super::static_shift::cold_weight;
-use crate::layout::StateLayout;
 use super::report::{fit_percent, ChannelFit};
+use super::static_shift::cold_weight;
 use super::{FitError, Series};
 use crate::data::Measured;
+use crate::layout::StateLayout;
 use crate::signal::{crossing_frequency, fundamental, savitzky_golay, wrap};
 use crate::sim::{simulate, SimOptions};
 

@@ -13,12 +13,12 @@ use stirling_dsl::Model;
 
 use super::classify::{classify, default_free};
 use super::driven::Stage;
-use super::vars::VarKind;
 use super::gas::{self, GasStage};
 use super::mechanics::{self, MechInputs};
 use super::record::Record;
 use super::sensitivity::Signal;
 use super::stage_fit::{fit_stage, stats, FittedStage, Solved};
+use super::vars::VarKind;
 use super::{free_run, multiple_shooting, unmeasured};
 use super::{FitError, FitOptions, Identification};
 use crate::data::Measured;

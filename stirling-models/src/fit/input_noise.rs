@@ -8,7 +8,6 @@ use super::FitError;
 use crate::signal::{project_drift, savitzky_golay};
 
 impl Stage<'_> {
-
     /// How the noise on the prescribed inputs moves the weighted residuals, by Monte Carlo:
     /// `draws` noise records (the estimated standard deviation, white, smoothed like the
     /// signal) are added to the inputs; each gives the change `dr` of the residuals on `keep`

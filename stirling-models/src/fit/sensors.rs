@@ -8,7 +8,6 @@ use super::FitError;
 use crate::signal::{derivative, first_order_lag};
 
 impl Stage<'_> {
-
     /// Apply the sensor variables at values `th`: scale the prescribed states read through a
     /// gain, un-lag the input signals read through a lag; returns each output's gain factor
     /// and lag time constant.
@@ -86,7 +85,6 @@ impl Stage<'_> {
         Ok(())
     }
 }
-
 
 /// Lag every sensitivity column (`rows[sample][var]`) by the first-order filter.
 pub(super) fn lag_columns(rows: &mut [Vec<f64>], dt: f64, tau: f64) {

@@ -7,9 +7,9 @@ use std::time::Instant;
 use nalgebra::DMatrix;
 
 use super::driven::Stage;
-use super::vars::VarKind;
 use super::lm::{self, LmResult};
 use super::report::{self, fit_percent, ChannelFit};
+use super::vars::VarKind;
 use super::{FitError, FitOptions, Series, StageFit};
 use crate::signal::project_drift;
 

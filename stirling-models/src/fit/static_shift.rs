@@ -6,7 +6,6 @@ use stirling_dsl::Model;
 
 use super::FitError;
 
-
 /// Weight of the cold-side channel in the prescribed pressure of CV `i` of `ncv` (hot = 0).
 pub fn cold_weight(i: usize, ncv: usize, have_hot: bool) -> f64 {
     if !have_hot || ncv < 2 {

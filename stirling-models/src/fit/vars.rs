@@ -5,7 +5,6 @@ use stirling_dsl::Model;
 
 use crate::signal::noise_sigma;
 
-
 /// Lowest ratio of a positive model parameter to its starting value that a stage simulates.
 pub const MIN_RATIO: f64 = 0.02;
 
