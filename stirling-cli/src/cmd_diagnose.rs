@@ -38,6 +38,10 @@ pub struct DiagnoseArgs {
     /// standard deviation (0.5: a factor 1.65 at one standard deviation; 0: no prior)
     #[arg(long, default_value_t = diagnose::DEFAULT_PRIOR, allow_negative_numbers = true)]
     pub prior: f64,
+    /// Fit every candidate, not only those whose score is significant (slower; the verdict
+    /// does not change, the ranking of the non-significant candidates is filled in)
+    #[arg(long)]
+    pub fit_all: bool,
     /// Write report.md and SVG figures into this directory (created if missing)
     #[arg(long)]
     pub report: Option<PathBuf>,
@@ -175,6 +179,7 @@ pub fn run(a: &DiagnoseArgs) -> anyhow::Result<()> {
         train,
         holdout,
         progress: Some(|line: &str| common::note(line)),
+        fit_all: a.fit_all,
         ..Default::default()
     };
     let d = diagnose::diagnose(model.as_ref(), &p0, &data, &opts)?;

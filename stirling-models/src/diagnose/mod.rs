@@ -78,6 +78,9 @@ pub struct DiagnoseOptions {
     /// parameters far from their estimates (a leak by the heat-transfer coefficients); the
     /// prior makes such a move cost, so the effect shows in the score.
     pub prior: Option<f64>,
+    /// Fit every candidate, not only those whose score is significant (slower; the verdict
+    /// is the same, the ranking of the non-significant candidates is filled in).
+    pub fit_all: bool,
     /// Called with a line of progress after the calibration and after each candidate
     /// (`None`: silent).
     pub progress: Option<fn(&str)>,
@@ -101,6 +104,7 @@ impl Default for DiagnoseOptions {
             alpha: 0.01,
             seed: 7,
             progress: None,
+            fit_all: false,
             prior: Some(DEFAULT_PRIOR),
         }
     }

@@ -173,16 +173,35 @@ fn estimates(joint: &Joint, res: &lm::LmResult, fixed: &[usize]) -> Vec<EffectEs
         .collect()
 }
 
-/// Screen and fit one candidate.
-pub fn assess(
-    ctx: &Context,
-    nominal: &[FittedStage],
-    s2: &[f64],
-    nominal_eval: &Eval,
-    e: &'static EffectInfo,
-    opts: &LmOptions,
-) -> Assessed {
-    let mut entry = RankEntry {
+/// A candidate after its score screen.
+pub struct Screened {
+    pub effect: &'static EffectInfo,
+    pub score: Option<Score>,
+    /// The shape setting (end-stop travels) with the largest statistic.
+    pub shapes: Vec<(&'static str, f64)>,
+    pub entry: RankEntry,
+}
+
+impl Screened {
+    /// Whether the screen found the effect significant at `level`.
+    pub fn significant(&self, level: f64) -> bool {
+        self.entry.p_value < level
+    }
+
+    /// The candidate left unfitted, with the reason.
+    pub fn unfitted(mut self, why: &str) -> Assessed {
+        if self.entry.note.is_none() {
+            self.entry.note = Some(why.into());
+        }
+        Assessed {
+            entry: self.entry,
+            eval: None,
+        }
+    }
+}
+
+fn empty_entry(e: &EffectInfo) -> RankEntry {
+    RankEntry {
         effect: e.name.into(),
         score: f64::NAN,
         dof: 0,
@@ -196,10 +215,87 @@ pub fn assess(
         params: Vec::new(),
         note: None,
         seconds: 0.0,
+    }
+}
+
+/// The score screen of one candidate (over the travel grid for the end stops).
+pub fn screen_candidate(
+    ctx: &Context,
+    nominal: &[FittedStage],
+    s2: &[f64],
+    e: &'static EffectInfo,
+) -> Screened {
+    let clock = std::time::Instant::now();
+    let mut entry = empty_entry(e);
+    let grid = shape_grid(ctx, e);
+    let mut best: Option<(Score, Vec<(&'static str, f64)>)> = None;
+    for shapes in &grid {
+        let sc = Joint::new(ctx.model, nominal, s2, e, shapes, false)
+            .and_then(|joint| screen(ctx, &joint, &joint.start(nominal)));
+        match sc {
+            Ok(sc) if best.as_ref().is_none_or(|(b, _)| sc.stat > b.stat) => {
+                best = Some((sc, shapes.clone()))
+            }
+            Ok(_) => {}
+            Err(msg) => entry.note = Some(msg),
+        }
+    }
+    let (score, shapes) = match best {
+        Some((sc, shapes)) => (Some(sc), shapes),
+        None => (None, Vec::new()),
+    };
+    if let Some(sc) = &score {
+        entry.score = sc.stat;
+        entry.dof = sc.dof;
+        entry.p_value = (sc.p_value * grid.len() as f64).min(1.0);
+        entry.note = (grid.len() > 1).then(|| {
+            format!(
+                "score: largest over {} end-stop travels (Bonferroni factor {})",
+                grid.len(),
+                grid.len()
+            )
+        });
+    }
+    entry.seconds = clock.elapsed().as_secs_f64();
+    Screened {
+        effect: e,
+        score,
+        shapes,
+        entry,
+    }
+}
+
+/// Fit one screened candidate jointly and evaluate it on the held-out block.
+pub fn assess(
+    ctx: &Context,
+    nominal: &[FittedStage],
+    s2: &[f64],
+    nominal_eval: &Eval,
+    screened: Screened,
+    opts: &LmOptions,
+) -> Assessed {
+    let Screened {
+        effect: e,
+        score,
+        shapes,
+        mut entry,
+    } = screened;
+    let Some(score) = score else {
+        return Assessed { entry, eval: None };
     };
     let clock = std::time::Instant::now();
-    let out = assess_inner(ctx, nominal, s2, nominal_eval, e, opts, &mut entry);
-    entry.seconds = clock.elapsed().as_secs_f64();
+    let out = fit_candidate(
+        ctx,
+        nominal,
+        s2,
+        nominal_eval,
+        e,
+        &score,
+        &shapes,
+        opts,
+        &mut entry,
+    );
+    entry.seconds += clock.elapsed().as_secs_f64();
     if let Some(progress) = ctx.progress {
         progress(&format!(
             "candidate {}: score p {:.1e}, held-out error {}, {:.1} s",
@@ -220,36 +316,19 @@ pub fn assess(
     }
 }
 
-fn assess_inner(
+#[allow(clippy::too_many_arguments)]
+fn fit_candidate(
     ctx: &Context,
     nominal: &[FittedStage],
     s2: &[f64],
     nominal_eval: &Eval,
     e: &'static EffectInfo,
+    score: &Score,
+    shapes: &[(&'static str, f64)],
     opts: &LmOptions,
     entry: &mut RankEntry,
 ) -> Result<Option<Eval>, String> {
-    let grid = shape_grid(ctx, e);
-    let mut best: Option<(Score, Vec<(&'static str, f64)>)> = None;
-    for shapes in &grid {
-        let joint = Joint::new(ctx.model, nominal, s2, e, shapes, false)?;
-        let sc = screen(ctx, &joint, &joint.start(nominal))?;
-        if best.as_ref().is_none_or(|(b, _)| sc.stat > b.stat) {
-            best = Some((sc, shapes.clone()));
-        }
-    }
-    let (score, shapes) = best.expect("the grid is not empty");
-    entry.score = score.stat;
-    entry.dof = score.dof;
-    entry.p_value = (score.p_value * grid.len() as f64).min(1.0);
-    if grid.len() > 1 {
-        entry.note = Some(format!(
-            "score: largest over {} end-stop travels (Bonferroni factor {})",
-            grid.len(),
-            grid.len()
-        ));
-    }
-    let joint = Joint::new(ctx.model, nominal, s2, e, &shapes, !shapes.is_empty())?;
+    let joint = Joint::new(ctx.model, nominal, s2, e, shapes, !shapes.is_empty())?;
     // starts: from the nominal optimum at the one-step estimate; a strength with a shape (end
     // stops) is not smooth in its strength, so also at fixed strengths; and for a model effect
     // the typical strength with the nominal parameters at their estimates (the effect's own
@@ -262,20 +341,30 @@ fn assess_inner(
     if e.target == EffectTarget::Model {
         starts.push((Some(1.0), true));
     }
+    // the starts are independent: in parallel
+    let results: Vec<Result<(lm::LmResult, Vec<usize>), String>> = {
+        use rayon::prelude::*;
+        starts
+            .par_iter()
+            .map(|&(s0, reset)| {
+                let mut sc = score.clone();
+                if let Some(v) = s0 {
+                    sc.step.iter_mut().for_each(|s| *s = v);
+                }
+                ctx.fits.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+                let u0 = if reset {
+                    joint.reset_start(nominal)
+                } else {
+                    joint.start(nominal)
+                };
+                fit(&joint, &u0, &sc, opts)
+            })
+            .collect()
+    };
     let mut best: Option<(lm::LmResult, Vec<usize>)> = None;
     let mut last_err = String::new();
-    for (s0, reset) in starts {
-        let mut sc = score.clone();
-        if let Some(v) = s0 {
-            sc.step.iter_mut().for_each(|s| *s = v);
-        }
-        ctx.fits.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-        let u0 = if reset {
-            joint.reset_start(nominal)
-        } else {
-            joint.start(nominal)
-        };
-        match fit(&joint, &u0, &sc, opts) {
+    for r in results {
+        match r {
             Ok(r) if best.as_ref().is_none_or(|b| r.0.cost < b.0.cost) => best = Some(r),
             Ok(_) => {}
             Err(e) => last_err = e,

@@ -110,15 +110,37 @@ pub fn diagnose(
     // trial steps of at most one typical strength: far trials (an engine stopped by friction)
     // are slow to integrate and rejected anyway
     lm.max_step = 1.0;
-    // the candidates are independent: one per core
+    // the candidates are independent: one per core. First the score screens (one residual
+    // and Jacobian each); then the joint fits, of the significant candidates only (the
+    // verdict names only a significant one), or of all with `fit_all`
+    let level = opts.alpha / cands.len().max(1) as f64;
     let mut assessed: Vec<rank::Assessed> = {
         use rayon::prelude::*;
-        cands
+        let screened: Vec<rank::Screened> = cands
             .par_iter()
-            .map(|e| rank::assess(&ctx, &stages, &s2, &nominal, e, &lm))
+            .map(|e| rank::screen_candidate(&ctx, &stages, &s2, e))
+            .collect();
+        if let Some(progress) = opts.progress {
+            let sig = screened.iter().filter(|s| s.significant(level)).count();
+            progress(&format!(
+                "screened {} candidates ({:.1} s): {sig} significant at {level:.1e}{}",
+                screened.len(),
+                clock.elapsed().as_secs_f64(),
+                if opts.fit_all { "; fitting all" } else { "" }
+            ));
+        }
+        screened
+            .into_par_iter()
+            .map(|s| {
+                if opts.fit_all || s.significant(level) {
+                    rank::assess(&ctx, &stages, &s2, &nominal, s, &lm)
+                } else {
+                    s.unfitted("not fitted: its score is not significant (--fit-all fits it)")
+                }
+            })
             .collect()
     };
-    rank::sort(&mut assessed, opts.alpha / cands.len().max(1) as f64);
+    rank::sort(&mut assessed, level);
     for a in assessed.iter_mut() {
         if let Some(ev) = &a.eval {
             let c = closure::closure(

@@ -12,13 +12,14 @@
 //! (by default; `nsection` at n = 1000, 2008 states, needs it).
 
 use diffsol::{
-    error::OdeSolverError, DiffsolError, FaerSparseLU, NalgebraLU, OdeBuilder, OdeSolverMethod,
+    error::OdeSolverError, DiffsolError, NalgebraLU, OdeBuilder, OdeSolverMethod,
     OdeSolverStopReason,
 };
 use serde::Serialize;
 use stirling_dsl::Model;
 
 use super::adapter::{Backend, DenseM, Eqn, SparseM};
+use super::block_lu::BlockLu;
 use super::system::{ModelSystem, OdeSystem};
 use super::SimError;
 
@@ -215,17 +216,7 @@ pub fn integrate(
         .linear_solver
         .use_sparse(sys.dim(), sys.sparsity().is_some())
     {
-        run!(
-            SparseM,
-            FaerSparseLU<f64>,
-            sys,
-            x0,
-            t_end,
-            samples,
-            opts,
-            atol,
-            hooks
-        )
+        run!(SparseM, BlockLu, sys, x0, t_end, samples, opts, atol, hooks)
     } else {
         run!(
             DenseM,

@@ -2,6 +2,7 @@
 //! cycles by shooting, Floquet multipliers, and cycle work.
 //!
 //! - [`integrate`]: BDF step loop (diffsol), samples, crossings, nonphysical checks.
+//! - [`block_lu`]: the linear solver of repeated-block Newton matrices (sensitivity systems).
 //! - [`system`]: the model, energy-quadrature and variational systems.
 //! - [`cycle`]: periodicity from upward crossings of the piston position; amplitudes, phase.
 //! - [`shooting`]: Newton on the return map, monodromy matrix, Floquet multipliers.
@@ -14,6 +15,7 @@
 //! - [`monodromy`]: the monodromy by Radau IIA along the BDF trajectory.
 
 mod adapter;
+pub mod block_lu;
 pub mod cycle;
 pub mod integrate;
 pub mod monodromy;
