@@ -17,7 +17,7 @@ use diffsol::{
 use diffsol_la::error::LinearSolverError;
 use diffsol_la::{LinearOp, LinearSolver};
 use faer::sparse::SymbolicSparseColMatRef;
-use nalgebra::{DMatrix, DVectorViewMut, LU};
+use nalgebra::{DMatrix, DMatrixViewMut, LU};
 
 /// The block solver (see the module doc).
 #[derive(Default)]
@@ -114,13 +114,21 @@ impl LinearSolver<FaerSparseMat<f64>> for BlockLu {
         }
         let b = self.block;
         let xs = x.inner_mut().col_as_slice_mut(0);
-        for (k, &j) in self.which.iter().enumerate() {
-            let mut seg = DVectorViewMut::from_slice(&mut xs[k * b..(k + 1) * b], b);
-            if !self.lus[j].solve_mut(&mut seg) {
-                return Err(LinearSolverError::LuSolveFailed.into());
-            }
+        let ok = if self.lus.len() == 1 {
+            // every block the same: one solve with the blocks as right-hand-side columns
+            let nb = self.which.len();
+            self.lus[0].solve_mut(&mut DMatrixViewMut::from_slice(xs, b, nb))
+        } else {
+            self.which.iter().enumerate().all(|(k, &j)| {
+                let seg = &mut xs[k * b..(k + 1) * b];
+                self.lus[j].solve_mut(&mut DMatrixViewMut::from_slice(seg, b, 1))
+            })
+        };
+        if ok {
+            Ok(())
+        } else {
+            Err(LinearSolverError::LuSolveFailed.into())
         }
-        Ok(())
     }
 
     fn solve_transpose_in_place(&self, x: &mut FaerVec<f64>) -> Result<(), LaError> {
