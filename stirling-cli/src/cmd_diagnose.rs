@@ -184,7 +184,7 @@ pub fn run(a: &DiagnoseArgs) -> anyhow::Result<()> {
     };
     let d = diagnose::diagnose(model.as_ref(), &p0, &data, &opts)?;
     if let Some(dir) = &a.report {
-        let p = diagnose::report::write(&d, &data, dir).map_err(anyhow::Error::msg)?;
+        let p = diagnose::report::write(&d, &data, dir)?;
         for f in files::matching(dir, &REPORT, Some(start))? {
             files::wrote(&f);
         }
@@ -210,7 +210,17 @@ fn print_text(o: &mut impl Write, path: &Path, d: &Diagnosis) -> io::Result<()> 
         d.holdout.0,
         d.holdout.1
     )?;
-    writeln!(o, "\ngap before (held out):")?;
+    match (&d.simulation_gap, &d.simulation_gap_note) {
+        (Some(g), _) => writeln!(
+            o,
+            "\nthe calibrated model simulated on its own over the held-out block ({} cycles; error = model - measured, 95 % interval over cycles):\n{}",
+            g.cycles,
+            g.markdown()
+        )?,
+        (None, Some(why)) => writeln!(o, "\nsimulated gap: not measured ({why})")?,
+        _ => {}
+    }
+    writeln!(o, "\ngap before (held out, driven subsystems):")?;
     for c in &d.gap_before.channels {
         writeln!(
             o,

@@ -186,6 +186,15 @@ impl Context<'_> {
             }
         }
         let mut p = self.p_nom.clone();
+        // the nominal parameters the joint fit moved, then the effect values
+        for (k, (_, st)) in joint.stages.iter().enumerate() {
+            let vals = st.stage.values(&joint.stage_u(k, u));
+            for (v, val) in st.stage.vars.iter().zip(vals) {
+                if let crate::fit::vars::VarKind::Param(j) = v.kind {
+                    p[j] = val;
+                }
+            }
+        }
         for (v, val) in joint.effect.iter().zip(&theta) {
             if let Some(i) = self.model.param_index(&v.name) {
                 p[i] = *val;

@@ -7,10 +7,13 @@
 //! - **which** ([`score`]): a robust score (Lagrange-multiplier) test of every candidate effect
 //!   at its null, from one Jacobian of the joint problem ([`joint`]: the calibrated stages the
 //!   effect touches, extended by its variables);
-//! - fit every candidate jointly with the nominal variables of those stages and rank them by
-//!   held-out error with a BIC penalty ([`rank`]);
+//! - fit the significant candidates jointly with the nominal variables of those stages and
+//!   rank them by held-out error with a BIC penalty ([`rank`]);
 //! - **how far** ([`closure`]): the fraction of the held-out excess error closed by the winner,
-//!   with a bootstrap interval over whole cycles; the [`verdict`].
+//!   with a bootstrap interval over whole cycles; the [`verdict`];
+//! - **the gap a user sees** ([`sim_gap`]): the calibrated model simulated on its own over the
+//!   held-out block, feature by feature (frequency, amplitudes, phase, work, growth), before
+//!   and after the leading effect, with intervals and one summary closure.
 
 mod blocks;
 mod candidates;
@@ -30,6 +33,8 @@ pub mod report;
 mod run;
 /// The robust score test of an effect at its null.
 pub mod score;
+/// The simulated gap: held-out cycle features of the free run, before and after.
+pub mod sim_gap;
 /// The self-check on rig records whose effect is withheld.
 pub mod selfcheck;
 /// What a diagnosis reports.

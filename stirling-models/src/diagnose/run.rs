@@ -9,7 +9,9 @@ use super::candidates::candidates;
 use super::context::{predict, Context, Prediction};
 use super::gap::gap_before;
 use super::types::{Diagnosis, RankEntry};
-use super::{closure, joint, localize, rank, score, verdict, DiagnoseError, DiagnoseOptions};
+use super::{
+    closure, joint, localize, rank, score, sim_gap, verdict, DiagnoseError, DiagnoseOptions,
+};
 use crate::data::Measured;
 use crate::fit;
 use crate::signal::noise_sigma;
@@ -167,7 +169,14 @@ pub fn diagnose(
         cands.len(),
         &gap_before.shifts,
     );
+    let (simulation_gap, simulation_gap_note) =
+        match simulated_gap(model, data, &id.offsets, &b, &p_nom, &ranking, after.as_ref(), opts) {
+            Ok(g) => (Some(g), None),
+            Err(e) => (None, Some(e.to_string())),
+        };
     Ok(Diagnosis {
+        simulation_gap,
+        simulation_gap_note,
         model: model.name().into(),
         n: model.n(),
         train: b.train,
@@ -181,4 +190,49 @@ pub fn diagnose(
         before: Some(nominal),
         after,
     })
+}
+
+/// The simulated gap before and after the leading fitted candidate (the sensor effects
+/// distort the simulated outputs as they distort the data).
+#[allow(clippy::too_many_arguments)]
+fn simulated_gap(
+    model: &dyn Model,
+    data: &Measured,
+    offsets: &crate::fit::free_run::SensorOffsets,
+    b: &super::blocks::Blocks,
+    p_nom: &[f64],
+    ranking: &[RankEntry],
+    after: Option<&super::context::Eval>,
+    opts: &DiagnoseOptions,
+) -> Result<sim_gap::SimulationGap, sim_gap::SimGapError> {
+    let before = sim_gap::Simulated {
+        p: p_nom,
+        tau_p: 0.0,
+        gain: (0.0, 0.0),
+    };
+    let top = ranking.first().filter(|r| r.fitted);
+    let value = |name: &str| {
+        top.and_then(|r| r.params.iter().find(|q| q.name == name))
+            .map_or(0.0, |q| q.value)
+    };
+    let effect = after.zip(top).map(|(ev, r)| {
+        (
+            r.effect.as_str(),
+            sim_gap::Simulated {
+                p: &ev.p,
+                tau_p: value("tau_p").max(0.0),
+                gain: (value("gain_x"), value("gain_y")),
+            },
+        )
+    });
+    sim_gap::simulation_gap(
+        model,
+        data,
+        offsets,
+        b.holdout,
+        &before,
+        effect.as_ref().map(|(n, m)| (*n, m)),
+        opts.bootstrap,
+        opts.seed,
+    )
 }

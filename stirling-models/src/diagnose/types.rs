@@ -3,7 +3,7 @@
 use serde::Serialize;
 
 use super::context::Eval;
-use super::{localize, verdict};
+use super::{localize, sim_gap, verdict};
 
 /// One channel's error on the held-out block.
 #[derive(Clone, Debug, Serialize)]
@@ -91,6 +91,11 @@ pub struct Diagnosis {
     pub train: (f64, f64),
     pub holdout: (f64, f64),
     pub gap_before: GapBefore,
+    /// The gap where a user sees it: the calibrated model simulated on its own over the
+    /// held-out block, feature by feature, before and after the leading effect.
+    pub simulation_gap: Option<sim_gap::SimulationGap>,
+    /// Why the simulated gap is missing, if it is.
+    pub simulation_gap_note: Option<String>,
     pub localization: localize::Localization,
     pub ranking: Vec<RankEntry>,
     pub verdict: verdict::Verdict,

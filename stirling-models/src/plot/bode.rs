@@ -13,7 +13,8 @@ use std::path::Path;
 use plotters::prelude::*;
 
 use super::axes;
-use super::poles::{slow_limit, DrawError};
+use super::poles::slow_limit;
+use super::DrawError;
 use crate::linear::{bode, Bode, Linearization, Margins};
 
 /// The frequency range `(lo, hi)` [rad/s] of the Bode figure of `lin`: whole decades from a

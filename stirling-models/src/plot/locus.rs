@@ -8,7 +8,8 @@ use std::path::Path;
 use plotters::prelude::*;
 
 use super::axes;
-use super::poles::{frame, splane_chart, DrawError};
+use super::poles::{frame, splane_chart};
+use super::DrawError;
 use crate::linear::Locus;
 
 /// The colour of the fraction `t` in [0, 1] of the range.

@@ -1,4 +1,14 @@
-//! SVG plots (plotters): one file per kind of figure.
+//! SVG plots (plotters): one file per kind of figure. Every figure of the project is drawn
+//! here; the analyses hand over numbers.
+/// Bars per group (the diagnosis's residual by phase and by harmonic).
+pub mod bars;
+/// The error of a figure that could not be drawn.
+mod error;
+pub use error::DrawError;
+/// Measured points against two model lines over time (before and after an effect).
+pub mod overlay;
+/// Mean residual by phase of the cycle, before and after an effect, one panel per channel.
+pub mod phase_residual;
 /// Axis labels with units, power-of-ten ticks.
 pub mod axes;
 /// Bode diagram with the margins marked (seed Figure 8).

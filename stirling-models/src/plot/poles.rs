@@ -6,24 +6,9 @@ use std::path::Path;
 
 use plotters::prelude::*;
 
+use super::DrawError;
+
 use crate::linear::Pole;
-
-/// A plot that could not be drawn.
-#[derive(Debug, thiserror::Error)]
-#[error("cannot draw {path}: {why}")]
-pub struct DrawError {
-    pub path: String,
-    pub why: String,
-}
-
-impl DrawError {
-    pub(crate) fn at(path: &Path) -> impl Fn(String) -> DrawError + '_ {
-        move |why| DrawError {
-            path: path.display().to_string(),
-            why,
-        }
-    }
-}
 
 /// The natural frequency [rad/s] up to which poles count as slow (dominant): five times the
 /// largest oscillation frequency, at least 1000 rad/s; faster ones are the stiff gas poles.

@@ -6,7 +6,7 @@ use std::path::Path;
 
 use plotters::prelude::*;
 
-use super::axes;
+use super::{axes, DrawError};
 
 /// One closed `(V, P)` loop per vessel, in one panel each (a grid).
 pub fn pv_svg(
@@ -15,8 +15,8 @@ pub fn pv_svg(
     vessels: &[String],
     loops: &[Vec<(f64, f64)>],
     work: &[f64],
-) -> Result<(), String> {
-    let err = |e: &dyn std::fmt::Display| format!("plot {}: {e}", path.display());
+) -> Result<(), DrawError> {
+    let err = |e: &dyn std::fmt::Display| DrawError::on(path, e);
     let k = vessels.len().max(1);
     let cols = k.min(3);
     let rows = k.div_ceil(cols);

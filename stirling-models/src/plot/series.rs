@@ -6,7 +6,7 @@ use std::path::Path;
 use plotters::prelude::*;
 
 use super::axes;
-use super::poles::DrawError;
+use super::DrawError;
 
 /// Finite `(lo, hi)` of `v` padded by 5 % (a unit band when flat).
 fn span<'a>(v: impl Iterator<Item = &'a f64>) -> (f64, f64) {

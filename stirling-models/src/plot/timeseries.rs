@@ -8,7 +8,7 @@ use std::path::Path;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
-use super::axes;
+use super::{axes, DrawError};
 
 /// The legend strip width [px].
 const STRIP: u32 = 150;
@@ -44,8 +44,8 @@ pub fn startup_svg(
     ix: usize,
     iy: usize,
     pressures: &[(String, usize)],
-) -> Result<(), String> {
-    let err = |e: &dyn std::fmt::Display| format!("plot {}: {e}", path.display());
+) -> Result<(), DrawError> {
+    let err = |e: &dyn std::fmt::Display| DrawError::on(path, e);
     let root = SVGBackend::new(path, (900 + STRIP, 720)).into_drawing_area();
     root.fill(&WHITE).map_err(|e| err(&e))?;
     let root = root
