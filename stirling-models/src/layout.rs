@@ -49,6 +49,17 @@ impl StateLayout {
         self.gas.iter().position(|&g| g == i)
     }
 
+    /// The velocity state of the body whose position is state `pos`.
+    pub fn velocity_of(model: &dyn Model, pos: usize) -> Option<usize> {
+        let states = model.states();
+        let StateKind::Position(b) = states.get(pos)?.kind else {
+            return None;
+        };
+        states
+            .iter()
+            .position(|s| matches!(s.kind, StateKind::Velocity(v) if v == b))
+    }
+
     /// The cold-side CV's pressure state (the last CV), if the model has gas.
     pub fn cold(&self) -> Option<usize> {
         self.pressures.last().copied()

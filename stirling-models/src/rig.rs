@@ -118,8 +118,24 @@ pub enum RigError {
     Params(#[from] crate::params::ParamError),
     #[error("simulation of the truth model failed: {0}")]
     Sim(#[from] crate::sim::SimError),
-    #[error("{0}")]
-    Bad(String),
+    #[error("{option} must be {need} (got {got})")]
+    Setting {
+        option: &'static str,
+        got: String,
+        need: String,
+    },
+    #[error("--t-end {t_end} s at --rate {rate} Hz is {:.0} samples, more than the 5 million the rig writes", t_end * rate)]
+    TooManySamples { t_end: f64, rate: f64 },
+    #[error("unknown channel `{channel}` in --channels: expected some of {known}")]
+    UnknownChannel { channel: String, known: String },
+    #[error("--channels is empty: name at least one of p, p_hot, x, y")]
+    NoChannels,
+    #[error("the measured pressure would go negative: its minimum {min:.0} Pa plus --offset-p {offset} minus 5 x --noise-p {noise} is not positive")]
+    NegativePressure { min: f64, offset: f64, noise: f64 },
+    #[error("`{model}` has no gas volume to measure")]
+    NoGas { model: String },
+    #[error("channel p_hot asked for, but `{model}` has a single gas volume")]
+    NoHotSide { model: String },
     #[error("`{0}` exists: pass --force to overwrite")]
     Exists(PathBuf),
     #[error("cannot write `{0}`: {1}")]
@@ -143,46 +159,45 @@ pub const MIN_RATE: f64 = 200.0;
 
 /// Check the settings before the (long) simulation.
 fn validate(cfg: &RigConfig) -> Result<(), RigError> {
-    let bad = |what: String| Err(RigError::Bad(what));
+    let bad = |option, got: f64, need: &str| {
+        Err(RigError::Setting {
+            option,
+            got: got.to_string(),
+            need: need.into(),
+        })
+    };
     if !(cfg.t_end > 0.0 && cfg.t_end.is_finite()) {
-        return bad(format!(
-            "--t-end must be a positive number of seconds (got {})",
-            cfg.t_end
-        ));
+        return bad("--t-end", cfg.t_end, "a positive number of seconds");
     }
     if !(cfg.settle >= 0.0 && cfg.settle.is_finite()) {
-        return bad(format!("--settle must be >= 0 s (got {})", cfg.settle));
+        return bad("--settle", cfg.settle, ">= 0 s");
     }
     if !(cfg.rate >= MIN_RATE && cfg.rate <= 1e6) {
-        return bad(format!(
-            "--rate must be between {MIN_RATE} Hz and 1 MHz (got {}): the engine runs near 13 Hz and the fit needs its waveform resolved",
-            cfg.rate
-        ));
+        return bad("--rate", cfg.rate, &format!("between {MIN_RATE} Hz and 1 MHz: the engine runs near 13 Hz and the fit needs its waveform resolved"));
     }
     if cfg.t_end * cfg.rate > 5e6 {
-        return bad(format!(
-            "--t-end {} s at --rate {} Hz is {:.0} samples, more than the 5 million the rig writes",
-            cfg.t_end,
-            cfg.rate,
-            cfg.t_end * cfg.rate
-        ));
+        return Err(RigError::TooManySamples {
+            t_end: cfg.t_end,
+            rate: cfg.rate,
+        });
     }
-    if !(cfg.noise_p >= 0.0 && cfg.noise_x >= 0.0) {
-        return bad(format!(
-            "noise levels must be non-negative (got --noise-p {}, --noise-x {})",
-            cfg.noise_p, cfg.noise_x
-        ));
-    }
-    for c in &cfg.channels {
-        if !crate::data::CHANNELS.contains(&c.as_str()) {
-            return bad(format!(
-                "unknown channel `{c}` in --channels: expected some of {}",
-                crate::data::CHANNELS.join(", ")
-            ));
+    for (option, v) in [("--noise-p", cfg.noise_p), ("--noise-x", cfg.noise_x)] {
+        if !(v >= 0.0) {
+            return bad(option, v, "a non-negative noise level");
         }
     }
+    if let Some(c) = cfg
+        .channels
+        .iter()
+        .find(|c| !crate::data::CHANNELS.contains(&c.as_str()))
+    {
+        return Err(RigError::UnknownChannel {
+            channel: c.clone(),
+            known: crate::data::CHANNELS.join(", "),
+        });
+    }
     if cfg.channels.is_empty() {
-        return bad("--channels is empty: name at least one of p, p_hot, x, y".into());
+        return Err(RigError::NoChannels);
     }
     Ok(())
 }
@@ -192,10 +207,11 @@ fn validate(cfg: &RigConfig) -> Result<(), RigError> {
 fn check_pressure(p: &[f64], cfg: &RigConfig) -> Result<(), RigError> {
     let lo = p.iter().copied().fold(f64::INFINITY, f64::min);
     if lo + cfg.offset_p - 5.0 * cfg.noise_p <= 0.0 {
-        return Err(RigError::Bad(format!(
-            "the measured pressure would go negative: its minimum {lo:.0} Pa plus --offset-p {} minus 5 x --noise-p {} is not positive",
-            cfg.offset_p, cfg.noise_p
-        )));
+        return Err(RigError::NegativePressure {
+            min: lo,
+            offset: cfg.offset_p,
+            noise: cfg.noise_p,
+        });
     }
     Ok(())
 }
@@ -228,10 +244,9 @@ pub fn run(cfg: &RigConfig) -> Result<RigOutput, RigError> {
     )?;
     let ps = StateLayout::of(model.as_ref()).pressures;
     let (Some(&ic), Some(&ih)) = (ps.last(), ps.first()) else {
-        return Err(RigError::Bad(format!(
-            "`{}` has no gas volume to measure",
-            cfg.model
-        )));
+        return Err(RigError::NoGas {
+            model: cfg.model.clone(),
+        });
     };
     let ncv = ps.len();
     let col = |i: usize| traj.x.iter().map(|r| r[i]).collect::<Vec<f64>>();
@@ -265,10 +280,9 @@ pub fn run(cfg: &RigConfig) -> Result<RigOutput, RigError> {
     let t: Vec<f64> = (0..=count).map(|k| k as f64 * dt).collect();
     let want = |c: &str| cfg.channels.iter().any(|k| k == c);
     if want("p_hot") && ph.is_none() {
-        return Err(RigError::Bad(format!(
-            "channel p_hot asked for, but `{}` has a single gas volume",
-            cfg.model
-        )));
+        return Err(RigError::NoHotSide {
+            model: cfg.model.clone(),
+        });
     }
     let data = Measured {
         source: format!("rig:{}", model.name()),

@@ -14,21 +14,18 @@ pub(super) struct Blocks {
 
 pub(super) fn blocks(data: &Measured, opts: &DiagnoseOptions) -> Result<Blocks, DiagnoseError> {
     if data.t.len() < 100 {
-        return Err(DiagnoseError::Bad(format!(
-            "{}: {} samples are too few to diagnose",
-            data.source,
-            data.t.len()
-        )));
+        return Err(DiagnoseError::TooFewSamples {
+            file: data.source.clone(),
+            samples: data.t.len(),
+            need: 100,
+        });
     }
     let t0 = data.t[0];
     let t1 = data.t[data.t.len() - 1];
     let train = opts.train.unwrap_or((t0, t0 + 0.6 * (t1 - t0)));
     let holdout = opts.holdout.unwrap_or((train.1, t1));
     if holdout.0 < train.1 - 1e-12 {
-        return Err(DiagnoseError::Bad(format!(
-            "the held-out block {}:{} must start after the training block {}:{}",
-            holdout.0, holdout.1, train.0, train.1
-        )));
+        return Err(DiagnoseError::BlockOrder { train, holdout });
     }
     let dt = data.dt();
     let idx = |t: f64| (((t - t0) / dt).round().max(0.0) as usize).min(data.t.len() - 1);
@@ -36,20 +33,21 @@ pub(super) fn blocks(data: &Measured, opts: &DiagnoseOptions) -> Result<Blocks, 
     let train_idx = ((idx(train.0) + burn).min(idx(train.1)), idx(train.1));
     let hold_idx = (idx(holdout.0).max(train_idx.1), idx(holdout.1) + 1);
     if train_idx.1 < train_idx.0 + 50 || hold_idx.1 < hold_idx.0 + 50 {
-        return Err(DiagnoseError::Bad(format!(
-            "{}: the record ({:.3} s) is too short to diagnose: the training block (after a {} s burn-in) and the held-out block need at least 50 samples each; a diagnosis needs a few cycles to fit and a few more to hold out",
-            data.source,
-            t1 - t0,
-            opts.fit.burn_in
-        )));
+        return Err(DiagnoseError::ShortRecord {
+            file: data.source.clone(),
+            seconds: t1 - t0,
+            burn_in: opts.fit.burn_in,
+            need: 50,
+        });
     }
     let motion = data.x.as_ref().or(data.p.as_ref());
     if let Some(v) = motion {
         if cycle_frequency(&v[hold_idx.0..hold_idx.1], dt).is_none() {
-            return Err(DiagnoseError::Bad(format!(
-                "{}: the held-out block {:.3}:{:.3} s holds fewer than two cycles: too few to hold out (a longer record, or --train/--holdout)",
-                data.source, holdout.0, holdout.1
-            )));
+            return Err(DiagnoseError::HoldoutCycles {
+                file: data.source.clone(),
+                from: holdout.0,
+                to: holdout.1,
+            });
         }
     }
     Ok(Blocks {

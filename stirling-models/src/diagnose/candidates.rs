@@ -16,21 +16,20 @@ pub(super) fn candidates(
     };
     let mut v = Vec::new();
     for n in names {
-        let e = effects::effect(n).ok_or_else(|| {
-            DiagnoseError::Bad(format!(
-                "unknown effect `{n}`: expected one of {}",
-                effects::EFFECTS
-                    .iter()
-                    .map(|e| e.name)
-                    .collect::<Vec<_>>()
-                    .join(", ")
-            ))
+        let e = effects::effect(n).ok_or_else(|| DiagnoseError::UnknownEffect {
+            name: n.clone(),
+            known: effects::EFFECTS
+                .iter()
+                .map(|e| e.name)
+                .collect::<Vec<_>>()
+                .join(", "),
         })?;
         if !e.applies_to.contains(&base.as_str()) {
-            return Err(DiagnoseError::Bad(format!(
-                "effect `{n}` does not apply to `{base}` (it applies to {})",
-                e.applies_to.join(", ")
-            )));
+            return Err(DiagnoseError::NotApplicable {
+                effect: n.clone(),
+                model: base.clone(),
+                applies: e.applies_to.join(", "),
+            });
         }
         v.push(e);
     }
@@ -42,8 +41,7 @@ pub fn nominal_model(
     base: &str,
     n: Option<usize>,
 ) -> Result<(Box<dyn Model>, Vec<f64>), DiagnoseError> {
-    let m = effects::augmented(base, n, Closure::Full)
-        .map_err(|e| DiagnoseError::Bad(e.to_string()))?;
+    let m = effects::augmented(base, n, Closure::Full)?;
     let p = effects::nominal_params(m.as_ref());
     Ok((m, p))
 }

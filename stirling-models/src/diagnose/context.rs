@@ -4,6 +4,7 @@
 use stirling_dsl::Model;
 
 use super::joint::Joint;
+use super::DiagnoseError;
 use crate::data::{cycle_mean, Measured};
 use crate::fit::FittedStage;
 use crate::signal::{high_pass, project_drift};
@@ -40,11 +41,8 @@ pub struct Prediction {
 }
 
 /// The prediction of a fitted stage at variables `u`, from its training start to `last`.
-pub fn predict(st: &FittedStage, u: &[f64], last: usize) -> Result<Vec<Prediction>, String> {
-    let run = st
-        .stage
-        .run(u, st.first, last, false)
-        .map_err(|e| e.to_string())?;
+pub fn predict(st: &FittedStage, u: &[f64], last: usize) -> Result<Vec<Prediction>, DiagnoseError> {
+    let run = st.stage.run(u, st.first, last, false)?;
     Ok(st
         .stage
         .outputs
@@ -109,14 +107,22 @@ impl Context<'_> {
     }
 
     /// The evaluation of a set of predictions (effect values `theta`, parameters `p`).
-    pub fn eval(&self, preds: &[Prediction], theta: Vec<f64>, p: Vec<f64>) -> Result<Eval, String> {
+    pub fn eval(
+        &self,
+        preds: &[Prediction],
+        theta: Vec<f64>,
+        p: Vec<f64>,
+    ) -> Result<Eval, DiagnoseError> {
         let nt = self.data.t.len();
         let (mut channels, mut resid, mut pred) = (Vec::new(), Vec::new(), Vec::new());
         for pr in preds {
-            let meas = self
-                .data
-                .channel(&pr.channel)
-                .ok_or_else(|| format!("channel `{}` missing", pr.channel))?;
+            let meas =
+                self.data
+                    .channel(&pr.channel)
+                    .ok_or_else(|| DiagnoseError::MissingChannel {
+                        file: self.data.source.clone(),
+                        channel: pr.channel.clone(),
+                    })?;
             let mut r = vec![f64::NAN; nt];
             let mut pv = vec![f64::NAN; nt];
             for (k, v) in pr.values.iter().enumerate() {
@@ -131,7 +137,7 @@ impl Context<'_> {
             pred.push(pv);
         }
         if channels.is_empty() {
-            return Err("the calibration produced no output series".into());
+            return Err(DiagnoseError::NoOutputs);
         }
         let hp: Vec<Vec<f64>> = resid
             .iter()
@@ -147,13 +153,16 @@ impl Context<'_> {
                 h
             })
             .collect();
-        let sample_err = |range: (usize, usize)| -> Result<f64, String> {
+        let sample_err = |range: (usize, usize)| -> Result<f64, DiagnoseError> {
             let mut total = 0.0;
             for i in range.0..range.1 {
                 for (c, r) in channels.iter().zip(&hp) {
                     let z = r[i] / self.noise_of(c);
                     if !z.is_finite() {
-                        return Err(format!("no model output for `{c}` at sample {i}"));
+                        return Err(DiagnoseError::NoModelOutput {
+                            channel: c.clone(),
+                            sample: i,
+                        });
                     }
                     total += z * z;
                 }
@@ -176,7 +185,12 @@ impl Context<'_> {
     }
 
     /// The evaluation of a fitted joint problem: its stages at `u`, the others nominal.
-    pub fn eval_joint(&self, joint: &Joint, u: &[f64], theta: Vec<f64>) -> Result<Eval, String> {
+    pub fn eval_joint(
+        &self,
+        joint: &Joint,
+        u: &[f64],
+        theta: Vec<f64>,
+    ) -> Result<Eval, DiagnoseError> {
         let last = self.hold_idx.1 - 1;
         let mut preds = Vec::new();
         for (si, nom) in self.nominal_preds.iter().enumerate() {

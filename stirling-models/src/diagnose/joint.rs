@@ -16,6 +16,7 @@
 use nalgebra::DMatrix;
 use stirling_dsl::Model;
 
+use super::DiagnoseError;
 use crate::effects::{EffectInfo, EffectTarget};
 use crate::fit::prior::prior_rows;
 use crate::fit::sensitivity::Signal;
@@ -77,7 +78,7 @@ impl<'a> Joint<'a> {
         e: &EffectInfo,
         shapes: &[(&str, f64)],
         free_shapes: bool,
-    ) -> Result<Self, String> {
+    ) -> Result<Self, DiagnoseError> {
         let mut stages: Vec<(usize, FittedStage<'a>)> = Vec::new();
         let mut effect: Vec<EffectVar> = Vec::new();
         let n_nom: usize = nominal.iter().map(|s| s.stage.vars.len()).sum();
@@ -125,11 +126,10 @@ impl<'a> Joint<'a> {
                 linked.push((si, sigs));
             }
             if !adds.iter().any(|(_, v)| v.name == q.name) {
-                return Err(format!(
-                    "`{}` enters neither driven subsystem of `{}`",
-                    q.name,
-                    model.name()
-                ));
+                return Err(DiagnoseError::NotDriven {
+                    param: q.name.into(),
+                    model: model.name().into(),
+                });
             }
         }
         let mut map = Vec::new();
@@ -289,7 +289,7 @@ fn link(
     adds: &[(usize, Var)],
     linked: &[(usize, Vec<Signal>)],
     name: &str,
-) -> Result<Option<(usize, Var, Vec<Signal>)>, String> {
+) -> Result<Option<(usize, Var, Vec<Signal>)>, DiagnoseError> {
     let Some(mech) = nominal
         .iter()
         .position(|s| is_mechanics(s) && !s.stage.derived.is_empty())
@@ -310,8 +310,7 @@ fn link(
     st.vars.push(gvar.clone());
     let mut u = gas.u.clone();
     u.push(0.0);
-    let d = unmeasured::difference_sensitivity(&st, &u, st.vars.len() - 1, gas.first)
-        .map_err(|e| e.to_string())?;
+    let d = unmeasured::difference_sensitivity(&st, &u, st.vars.len() - 1, gas.first)?;
     let cold = d.len() - 1;
     let queued: usize = linked
         .iter()
@@ -333,7 +332,7 @@ fn kind_in(
     st: &FittedStage,
     e: &EffectInfo,
     name: &str,
-) -> Result<Option<VarKind>, String> {
+) -> Result<Option<VarKind>, DiagnoseError> {
     let mech = is_mechanics(st);
     let outputs = |pred: &dyn Fn(&str) -> bool| -> Vec<usize> {
         st.stage
@@ -348,7 +347,10 @@ fn kind_in(
         (EffectTarget::Model, _) => {
             let j = model
                 .param_index(name)
-                .ok_or_else(|| format!("model `{}` has no parameter `{name}`", model.name()))?;
+                .ok_or_else(|| DiagnoseError::UnknownParameter {
+                    name: name.into(),
+                    model: model.name().into(),
+                })?;
             // which rows the effect enters, with its strengths on and its shapes (travel,
             // smoothing) small, so that it acts at the probe state `classify` uses
             let mut p = st.stage.p.clone();
@@ -421,9 +423,7 @@ fn kind_in(
             })
         }
         (EffectTarget::Sensor, other) => {
-            return Err(format!(
-                "sensor parameter `{other}` is not handled by the diagnosis"
-            ))
+            return Err(DiagnoseError::SensorParam { name: other.into() })
         }
     })
 }

@@ -10,6 +10,7 @@ use serde::Serialize;
 use stirling_dsl::{Model, StateKind};
 
 use super::context::{Context, Eval};
+use super::DiagnoseError;
 use crate::data::{cycle_mean, Measured};
 use crate::signal::cycle_starts;
 use crate::signal::dft;
@@ -151,9 +152,11 @@ fn free_run(
     last: usize,
     a: f64,
     ar: f64,
-) -> Result<CycleFeatures, String> {
+) -> Result<CycleFeatures, DiagnoseError> {
     let (Some(xm), Some(ym)) = (data.x.as_ref(), data.y.as_ref()) else {
-        return Err("free run needs x and y".into());
+        return Err(DiagnoseError::NeedsPositions {
+            stage: "the localization's free run",
+        });
     };
     let dt = data.dt();
     let (sx, vx) = savitzky_golay(xm, dt, 6, 4);
@@ -189,9 +192,14 @@ fn free_run(
         &samples,
         &SimOptions::default(),
     )
-    .map_err(|e| e.to_string())?;
+    .map_err(|source| DiagnoseError::Sim {
+        stage: "the localization's free run",
+        source,
+    })?;
     let ps = crate::layout::StateLayout::of(model).pressures;
-    let ic = *ps.last().ok_or("no pressure state")?;
+    let ic = *ps.last().ok_or_else(|| DiagnoseError::NoPressure {
+        model: model.name().into(),
+    })?;
     let col = |i: usize| tr.x.iter().map(|r| r[i]).collect::<Vec<f64>>();
     let (x, y, pc) = (col(0), col(2), col(ic));
     // the free run keeps its own phase: its own crossings over the same span

@@ -21,6 +21,10 @@ mod candidates;
 pub mod closure;
 /// The record, its blocks and noise, and the residuals of a model on it.
 pub mod context;
+/// Per-cycle features and waveforms by phase of the cycle.
+mod cycle_features;
+/// Why a diagnosis failed.
+pub mod error;
 mod gap;
 /// The joint problem of one candidate: the calibrated stages extended by its variables.
 pub mod joint;
@@ -33,10 +37,10 @@ pub mod report;
 mod run;
 /// The robust score test of an effect at its null.
 pub mod score;
-/// The simulated gap: held-out cycle features of the free run, before and after.
-pub mod sim_gap;
 /// The self-check on rig records whose effect is withheld.
 pub mod selfcheck;
+/// The simulated gap: held-out cycle features of the free run, before and after.
+pub mod sim_gap;
 /// What a diagnosis reports.
 pub mod types;
 /// The verdict a user reads.
@@ -44,19 +48,11 @@ pub mod verdict;
 
 pub use candidates::nominal_model;
 pub use context::{Context, Eval, Prediction};
+pub use error::DiagnoseError;
 pub use run::diagnose;
 pub use types::{ChannelError, Diagnosis, EffectEstimate, GapBefore, ParamShift, RankEntry};
 
 use crate::fit::FitOptions;
-
-/// Why a diagnosis failed.
-#[derive(Clone, Debug, thiserror::Error)]
-pub enum DiagnoseError {
-    #[error("{0}")]
-    Bad(String),
-    #[error("the nominal calibration failed: {0}")]
-    Nominal(String),
-}
 
 /// Options of a diagnosis.
 #[derive(Clone, Debug)]

@@ -19,6 +19,7 @@ use super::context::{Context, Eval};
 use super::joint::{EffectVar, Joint};
 use super::score::{robust_score, Score};
 use super::types::{EffectEstimate, RankEntry};
+use super::DiagnoseError;
 use crate::effects::{EffectInfo, EffectTarget};
 use crate::fit::lm::{self, LmOptions};
 use crate::fit::FittedStage;
@@ -50,8 +51,8 @@ fn shape_grid(ctx: &Context, e: &EffectInfo) -> Vec<Vec<(&'static str, f64)>> {
 }
 
 /// The score test of `joint` at its start.
-fn screen(ctx: &Context, joint: &Joint, u0: &[f64]) -> Result<Score, String> {
-    let (r, j, blocks) = joint.residuals(u0).map_err(|e| e.to_string())?;
+fn screen(ctx: &Context, joint: &Joint, u0: &[f64]) -> Result<Score, DiagnoseError> {
+    let (r, j, blocks) = joint.residuals(u0)?;
     let strengths: Vec<&EffectVar> = joint.effect.iter().filter(|v| !v.shape).collect();
     let test: Vec<usize> = strengths.iter().map(|v| v.index).collect();
     let skip: Vec<usize> = joint
@@ -90,7 +91,7 @@ fn fit(
     start: &[f64],
     score: &Score,
     opts: &LmOptions,
-) -> Result<(lm::LmResult, Vec<usize>), String> {
+) -> Result<(lm::LmResult, Vec<usize>), DiagnoseError> {
     let mut u0 = start.to_vec();
     let strengths: Vec<&EffectVar> = joint.effect.iter().filter(|v| !v.shape).collect();
     for (v, &s) in strengths.iter().zip(&score.step) {
@@ -103,8 +104,7 @@ fn fit(
     }
     let mut fixed: Vec<usize> = Vec::new();
     for _ in 0..=strengths.len() {
-        let res = solve(joint, &u0, &fixed, opts)
-            .ok_or_else(|| "the joint fit could not evaluate its start".to_string())?;
+        let res = solve(joint, &u0, &fixed, opts).ok_or(DiagnoseError::JointStart)?;
         let below: Vec<usize> = strengths
             .iter()
             .filter(|v| v.bounded && !fixed.contains(&v.index) && res.x[v.index] < 0.0)
@@ -123,7 +123,7 @@ fn fit(
             .filter(|(i, _)| !fixed.contains(i))
             .for_each(|(_, (a, b))| *a = *b);
     }
-    Err("the joint fit did not settle its bounds".into())
+    Err(DiagnoseError::JointBounds)
 }
 
 /// Estimates with 95 % intervals from the Gauss-Newton covariance at the optimum.
@@ -237,7 +237,7 @@ pub fn screen_candidate(
                 best = Some((sc, shapes.clone()))
             }
             Ok(_) => {}
-            Err(msg) => entry.note = Some(msg),
+            Err(e) => entry.note = Some(e.to_string()),
         }
     }
     let (score, shapes) = match best {
@@ -309,8 +309,8 @@ pub fn assess(
     }
     match out {
         Ok(eval) => Assessed { entry, eval },
-        Err(msg) => {
-            entry.note = Some(msg);
+        Err(e) => {
+            entry.note = Some(e.to_string());
             Assessed { entry, eval: None }
         }
     }
@@ -327,7 +327,7 @@ fn fit_candidate(
     shapes: &[(&'static str, f64)],
     opts: &LmOptions,
     entry: &mut RankEntry,
-) -> Result<Option<Eval>, String> {
+) -> Result<Option<Eval>, DiagnoseError> {
     let joint = Joint::new(ctx.model, nominal, s2, e, shapes, !shapes.is_empty())?;
     // starts: from the nominal optimum at the one-step estimate; a strength with a shape (end
     // stops) is not smooth in its strength, so also at fixed strengths; and for a model effect
@@ -342,7 +342,7 @@ fn fit_candidate(
         starts.push((Some(1.0), true));
     }
     // the starts are independent: in parallel
-    let results: Vec<Result<(lm::LmResult, Vec<usize>), String>> = {
+    let results: Vec<Result<(lm::LmResult, Vec<usize>), DiagnoseError>> = {
         use rayon::prelude::*;
         starts
             .par_iter()
@@ -362,7 +362,7 @@ fn fit_candidate(
             .collect()
     };
     let mut best: Option<(lm::LmResult, Vec<usize>)> = None;
-    let mut last_err = String::new();
+    let mut last_err = DiagnoseError::JointStart;
     for r in results {
         match r {
             Ok(r) if best.as_ref().is_none_or(|b| r.0.cost < b.0.cost) => best = Some(r),

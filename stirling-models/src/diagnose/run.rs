@@ -43,8 +43,7 @@ pub fn diagnose(
     fit_opts.multiple_shooting = None;
     fit_opts.input_noise_draws = 0;
     fit_opts.prior = opts.prior;
-    let (id, stages) = fit::identify_stages(model, p0, data, &fit_opts)
-        .map_err(|e| DiagnoseError::Nominal(e.to_string()))?;
+    let (id, stages) = fit::identify_stages(model, p0, data, &fit_opts)?;
     let mut p_nom = p0.to_vec();
     for (name, v) in &id.params {
         if let Some(i) = model.param_index(name) {
@@ -61,8 +60,7 @@ pub fn diagnose(
     let nominal_preds = stages
         .iter()
         .map(|st| predict(st, &st.u, last))
-        .collect::<Result<Vec<_>, String>>()
-        .map_err(DiagnoseError::Nominal)?;
+        .collect::<Result<Vec<_>, _>>()?;
     let ctx = Context {
         model,
         data,
@@ -85,20 +83,16 @@ pub fn diagnose(
                     opts.seed,
                 )
             })
-            .collect::<Result<Vec<_>, _>>()
-            .map_err(|e| DiagnoseError::Nominal(e.to_string()))?,
+            .collect::<Result<Vec<_>, _>>()?,
         fits: std::sync::atomic::AtomicUsize::new(1),
         progress: opts.progress,
     };
     let all: Vec<Prediction> = ctx.nominal_preds.iter().flatten().cloned().collect();
-    let nominal = ctx
-        .eval(&all, vec![], p_nom.clone())
-        .map_err(DiagnoseError::Nominal)?;
+    let nominal = ctx.eval(&all, vec![], p_nom.clone())?;
     let s2 = stages
         .iter()
         .map(joint::variance_factor)
-        .collect::<Result<Vec<f64>, _>>()
-        .map_err(|e| DiagnoseError::Nominal(e.to_string()))?;
+        .collect::<Result<Vec<f64>, _>>()?;
     let localization = localize::localize(model, &p_nom, data, &nominal, &ctx);
     if let Some(progress) = opts.progress {
         progress(&format!(
@@ -169,11 +163,19 @@ pub fn diagnose(
         cands.len(),
         &gap_before.shifts,
     );
-    let (simulation_gap, simulation_gap_note) =
-        match simulated_gap(model, data, &id.offsets, &b, &p_nom, &ranking, after.as_ref(), opts) {
-            Ok(g) => (Some(g), None),
-            Err(e) => (None, Some(e.to_string())),
-        };
+    let (simulation_gap, simulation_gap_note) = match simulated_gap(
+        model,
+        data,
+        &id.offsets,
+        &b,
+        &p_nom,
+        &ranking,
+        after.as_ref(),
+        opts,
+    ) {
+        Ok(g) => (Some(g), None),
+        Err(e) => (None, Some(e.to_string())),
+    };
     Ok(Diagnosis {
         simulation_gap,
         simulation_gap_note,

@@ -210,8 +210,10 @@ pub fn run(
     static RUNS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
     let run = RUNS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
     let dir = std::env::temp_dir().join(format!("stirling-selfcheck-{}-{run}", std::process::id()));
-    std::fs::create_dir_all(&dir)
-        .map_err(|e| DiagnoseError::Bad(format!("cannot create {}: {e}", dir.display())))?;
+    std::fs::create_dir_all(&dir).map_err(|source| DiagnoseError::Io {
+        path: dir.clone(),
+        source,
+    })?;
     let mut cases = Vec::new();
     for (k, (truth, strength)) in plan.iter().enumerate() {
         let t = Instant::now();
@@ -231,13 +233,18 @@ pub fn run(
             channels: channels.clone(),
             ..Default::default()
         };
-        let out = rig::run(&cfg).map_err(|e| DiagnoseError::Bad(format!("rig ({truth}): {e}")))?;
+        let out = rig::run(&cfg).map_err(|source| DiagnoseError::Rig {
+            truth: truth.to_string(),
+            source,
+        })?;
         // only the CSV crosses over: written, then read back like any measured file
         let path = dir.join(format!("case{k}.csv"));
-        write_csv(&path, &out.data, &[])
-            .map_err(|e| DiagnoseError::Bad(format!("cannot write {}: {e}", path.display())))?;
+        write_csv(&path, &out.data, &[]).map_err(|source| DiagnoseError::Io {
+            path: path.clone(),
+            source,
+        })?;
         drop(out);
-        let data = read_csv(&path).map_err(|e| DiagnoseError::Bad(e.to_string()))?;
+        let data = read_csv(&path)?;
         let _ = std::fs::remove_file(&path);
         let d = diagnose(model.as_ref(), &p0, &data, &opts.diagnose)?;
         let truth_rank = d
@@ -335,14 +342,14 @@ pub fn run_library(
 ) -> Result<SelfCheck, DiagnoseError> {
     let clock = Instant::now();
     if let Some(bad) = opts.effects.iter().flatten().find(|n| effect(n).is_none()) {
-        return Err(DiagnoseError::Bad(format!(
-            "unknown effect `{bad}` (the library: {})",
-            effects_for("nsection")
+        return Err(DiagnoseError::UnknownEffect {
+            name: bad.clone(),
+            known: effects_for("nsection")
                 .iter()
                 .map(|e| e.name)
                 .collect::<Vec<_>>()
-                .join(", ")
-        )));
+                .join(", "),
+        });
     }
     let wanted = |name: &str| {
         opts.effects

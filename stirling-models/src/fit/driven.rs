@@ -138,8 +138,13 @@ impl Stage<'_> {
             // block-diagonal Newton matrix: the sparse LU factors the blocks one by one
             sim.linear_solver = LinearSolverKind::Sparse;
         }
-        let traj = integrate(&sys, &x0, t_end, &samples, &sim, Hooks::default())
-            .map_err(|e| FitError::Sim(self.name.to_string(), e.to_string()))?;
+        let traj =
+            integrate(&sys, &x0, t_end, &samples, &sim, Hooks::default()).map_err(|source| {
+                FitError::Sim {
+                    stage: self.name.to_string(),
+                    source,
+                }
+            })?;
         let (mut yhat, mut dyhat) = self.outputs_of(&traj.x, &th, &gain, &col_of, sens);
         for (o, &tau) in lag.iter().enumerate() {
             if tau > 0.0 {

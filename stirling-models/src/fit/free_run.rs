@@ -21,7 +21,7 @@
 use std::time::Instant;
 
 use serde::Serialize;
-use stirling_dsl::{Model, StateKind};
+use stirling_dsl::Model;
 
 use super::report::{fit_percent, ChannelFit};
 use super::static_shift::cold_weight;
@@ -68,17 +68,17 @@ pub fn channels(model: &dyn Model, data: &Measured) -> Result<Vec<Channel>, FitE
     let layout = StateLayout::of(model);
     let (pos, ps) = (&layout.positions, &layout.pressures);
     let (Some(x), Some(y), Some(p)) = (&data.x, &data.y, &data.p) else {
-        return Err(FitError::Bad(format!(
-            "{}: the free run needs the columns p, x and y",
-            data.source
-        )));
+        return Err(FitError::MissingColumns {
+            file: data.source.clone(),
+            stage: "the free run",
+        });
     };
     if pos.len() != 2 || ps.is_empty() {
-        return Err(FitError::Bad(format!(
-            "the free run expects two bodies and a gas model; `{}` has {} bodies",
-            model.name(),
-            pos.len()
-        )));
+        return Err(FitError::Bodies {
+            stage: "the free run",
+            model: model.name().into(),
+            found: pos.len(),
+        });
     }
     let mut out = vec![
         Channel {
@@ -135,13 +135,10 @@ pub fn measured_state(
         let (v, d) = smooth(&c.data, h);
         x[c.state] = v - off.get(&c.name);
         // the velocity state follows its position state
-        let vel = states
-            .iter()
-            .position(|s| {
-                matches!((s.kind, states[c.state].kind),
-                    (StateKind::Velocity(a), StateKind::Position(b)) if a == b)
-            })
-            .ok_or_else(|| FitError::Bad("a body without a velocity state".into()))?;
+        let vel = StateLayout::velocity_of(model, c.state).ok_or_else(|| FitError::NoVelocity {
+            model: model.name().into(),
+            position: states[c.state].name.clone(),
+        })?;
         x[vel] = d;
     }
     let layout = StateLayout::of(model);
@@ -282,10 +279,13 @@ pub fn free_run(
     let idx = |t: f64| (((t - t0) / dt).round().max(0.0) as usize).min(nt - 1);
     let (a, b) = (idx(block.0), idx(block.1));
     if b < a + 10 {
-        return Err(FitError::Bad(format!(
-            "{name}: the block {}:{} is too short",
-            block.0, block.1
-        )));
+        return Err(FitError::ShortBlock {
+            stage: name.into(),
+            from: block.0,
+            to: block.1,
+            samples: b + 1 - a.min(b + 1),
+            need: 11,
+        });
     }
     let h = ((opts.smooth / dt).round() as usize).max(3);
     let x0 = measured_state(model, p, data, off, a, h)?;
@@ -298,7 +298,10 @@ pub fn free_run(
         &samples,
         &opts.sim,
     )
-    .map_err(|e| FitError::Sim(name.into(), e.to_string()))?;
+    .map_err(|source| FitError::Sim {
+        stage: name.into(),
+        source,
+    })?;
     let meas: Vec<(String, Vec<f64>)> = ch
         .iter()
         .map(|c| (c.name.clone(), c.data[a..=b].to_vec()))

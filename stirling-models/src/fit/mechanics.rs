@@ -51,6 +51,7 @@ pub fn stage<'a>(
     };
     if layout.positions.len() != 2 {
         return Err(FitError::Bodies {
+            stage: "stage 1",
             model: model.name().into(),
             found: layout.positions.len(),
         });

@@ -7,24 +7,45 @@
 //! ([`multiple_shooting`]) and a free-run validation from the measured initial state
 //! ([`free_run`]), since a self-excited oscillator drifts in phase.
 
+/// Which free parameter belongs to which stage.
 pub mod classify;
+/// The two driven subsystems and their stage problem.
 pub mod driven;
+/// Why a fit failed.
+pub mod error;
+/// Whether a record moves enough to carry a fit.
 pub mod excitation;
+/// Free-run validation from the measured initial state.
 pub mod free_run;
+/// Stage 2: the gas driven by the measured displacements.
 pub mod gas;
+/// The two-stage identification.
 pub mod identify;
+/// Errors in variables: noise on the prescribed inputs.
 pub mod input_noise;
+/// Levenberg-Marquardt.
 pub mod lm;
+/// Stage 1: the mechanics driven by the pressures on their faces.
 pub mod mechanics;
+/// Multiple-shooting refinement over short free-running segments.
 pub mod multiple_shooting;
+/// Log-normal priors on fitted model parameters.
 pub mod prior;
+/// The measured record as the stages see it.
 pub mod record;
+/// Estimates, standard errors, intervals, correlations (statistics, no figures).
 pub mod report;
+/// Forward sensitivities of a driven subsystem.
 pub mod sensitivity;
+/// Sensor distortions fitted as stage variables.
 pub mod sensors;
+/// Fitting one driven stage.
 pub mod stage_fit;
+/// The static response of the bodies to a pressure offset.
 pub mod static_shift;
+/// Pressures the mechanics need but the record lacks.
 pub mod unmeasured;
+/// The variables of a driven-stage fit.
 pub mod vars;
 
 use serde::Serialize;
@@ -35,49 +56,8 @@ pub use classify::{classify, default_free};
 pub use identify::{identify, identify_stages};
 pub use stage_fit::FittedStage;
 
+pub use error::FitError;
 use report::{ChannelFit, FitStats};
-
-/// Why a fit failed.
-#[derive(Clone, Debug, thiserror::Error)]
-pub enum FitError {
-    #[error("{0}")]
-    Bad(String),
-    #[error("{0}: simulation failed: {1}")]
-    Sim(String, String),
-    #[error("{0}: the optimizer could not evaluate the starting point")]
-    Start(String),
-    #[error("unknown parameter `{name}` of model `{model}`: see `stirling info {model}`")]
-    UnknownParameter { name: String, model: String },
-    #[error(
-        "parameter `{name}` does not enter the equations of `{model}`: it cannot be identified"
-    )]
-    NotInEquations { name: String, model: String },
-    #[error("{file}: {samples} samples are too few to fit")]
-    TooFewSamples { file: String, samples: usize },
-    #[error(transparent)]
-    Sampling(crate::data::DataError),
-    #[error("{file}: channel `{channel}` does not move enough to fit: its standard deviation on the training block is {sd:.3e}, its noise level {noise:.3e} (needs more than {} times the noise); is the engine running in this record?", excitation::MIN_SIGNAL_TO_NOISE)]
-    NoExcitation {
-        file: String,
-        channel: String,
-        sd: f64,
-        noise: f64,
-    },
-    #[error("{file}: the training block ({seconds:.3} s) holds fewer than two cycles of the motion: the record is too short (or does not oscillate) to identify the dynamics")]
-    TooFewCycles { file: String, seconds: f64 },
-    #[error("the training block {from}:{to} holds {samples} samples, fewer than 11")]
-    ShortTraining { from: f64, to: f64, samples: usize },
-    #[error("{file}: {stage} needs the columns p, x and y")]
-    MissingColumns { file: String, stage: &'static str },
-    #[error("parameter `{name}` = {value:.4e} fell below {floor:.4e} (2 % of its start): the data push it out of the physical range")]
-    ParamRange {
-        name: String,
-        value: f64,
-        floor: f64,
-    },
-    #[error("stage 1 expects two bodies (displacer x, piston y); `{model}` has {found}")]
-    Bodies { model: String, found: usize },
-}
 
 /// Options of the two-stage fit.
 #[derive(Clone, Debug)]

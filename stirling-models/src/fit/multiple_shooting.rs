@@ -195,7 +195,10 @@ impl Problem<'_> {
                 &self.sim,
                 Hooks::default(),
             )
-            .map_err(|e| FitError::Sim("multiple shooting".into(), e.to_string()))?;
+            .map_err(|source| FitError::Sim {
+                stage: "multiple shooting".into(),
+                source,
+            })?;
             ends.push(traj.x[traj.x.len() - 1][..n].to_vec());
             // the last sample belongs to the next segment, except in the last one
             let used = if s + 1 == nseg { b - a + 1 } else { b - a };
@@ -254,15 +257,20 @@ pub fn multiple_shooting(
     let a = idx(block.0);
     let b = idx(block.1.min(block.0 + opts.span));
     if b < a + 20 {
-        return Err(FitError::Bad(format!(
-            "multiple shooting: the block {}:{} is too short",
-            block.0, block.1
-        )));
+        return Err(FitError::ShortBlock {
+            stage: "multiple shooting".into(),
+            from: block.0,
+            to: block.1,
+            samples: b + 1 - a.min(b + 1),
+            need: 21,
+        });
     }
     let f = crate::signal::cycle_frequency(&ch[0].data[a..=b], dt)
         .or_else(|| crate::signal::cycle_frequency(&ch[1].data[a..=b], dt))
-        .ok_or_else(|| {
-            FitError::Bad("multiple shooting: fewer than two cycles in the block".into())
+        .ok_or_else(|| FitError::BlockCycles {
+            stage: "multiple shooting".into(),
+            from: block.0,
+            to: block.1,
         })?;
     let seg_len = ((opts.cycles / f / dt).round() as usize).max(10);
     let nseg = ((b - a) as f64 / seg_len as f64).round().max(1.0) as usize;

@@ -41,9 +41,7 @@ pub fn static_shift(
                 })
                 .sum::<f64>()
         });
-        let dq = lu.solve(&(-rhs)).ok_or_else(|| {
-            FitError::Bad("the static stiffness of the bodies is singular".into())
-        })?;
+        let dq = lu.solve(&(-rhs)).ok_or(FitError::SingularStatics)?;
         *o = dq.iter().copied().collect();
     }
     Ok(out)

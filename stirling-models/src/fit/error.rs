@@ -1,0 +1,67 @@
+//! Why a fit failed: one typed error for every stage of the identification.
+
+use crate::sim::SimError;
+
+use super::excitation;
+
+/// Why a fit failed.
+#[derive(Clone, Debug, thiserror::Error)]
+pub enum FitError {
+    #[error("{stage}: simulation failed: {source}")]
+    Sim {
+        stage: String,
+        #[source]
+        source: SimError,
+    },
+    #[error("{stage}: the block {from}:{to} s holds {samples} samples, fewer than {need}")]
+    ShortBlock {
+        stage: String,
+        from: f64,
+        to: f64,
+        samples: usize,
+        need: usize,
+    },
+    #[error("{stage}: the block {from}:{to} s holds fewer than two cycles of the motion")]
+    BlockCycles { stage: String, from: f64, to: f64 },
+    #[error("the static stiffness of the bodies is singular: no static shift of the offsets")]
+    SingularStatics,
+    #[error("`{model}`: body `{position}` has no velocity state")]
+    NoVelocity { model: String, position: String },
+    #[error("{0}: the optimizer could not evaluate the starting point")]
+    Start(String),
+    #[error("unknown parameter `{name}` of model `{model}`: see `stirling info {model}`")]
+    UnknownParameter { name: String, model: String },
+    #[error(
+        "parameter `{name}` does not enter the equations of `{model}`: it cannot be identified"
+    )]
+    NotInEquations { name: String, model: String },
+    #[error("{file}: {samples} samples are too few to fit")]
+    TooFewSamples { file: String, samples: usize },
+    #[error(transparent)]
+    Sampling(crate::data::DataError),
+    #[error("{file}: channel `{channel}` does not move enough to fit: its standard deviation on the training block is {sd:.3e}, its noise level {noise:.3e} (needs more than {} times the noise); is the engine running in this record?", excitation::MIN_SIGNAL_TO_NOISE)]
+    NoExcitation {
+        file: String,
+        channel: String,
+        sd: f64,
+        noise: f64,
+    },
+    #[error("{file}: the training block ({seconds:.3} s) holds fewer than two cycles of the motion: the record is too short (or does not oscillate) to identify the dynamics")]
+    TooFewCycles { file: String, seconds: f64 },
+    #[error("the training block {from}:{to} holds {samples} samples, fewer than 11")]
+    ShortTraining { from: f64, to: f64, samples: usize },
+    #[error("{file}: {stage} needs the columns p, x and y")]
+    MissingColumns { file: String, stage: &'static str },
+    #[error("parameter `{name}` = {value:.4e} fell below {floor:.4e} (2 % of its start): the data push it out of the physical range")]
+    ParamRange {
+        name: String,
+        value: f64,
+        floor: f64,
+    },
+    #[error("{stage} expects two bodies (displacer x, piston y); `{model}` has {found}")]
+    Bodies {
+        stage: &'static str,
+        model: String,
+        found: usize,
+    },
+}
