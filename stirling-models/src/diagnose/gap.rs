@@ -1,18 +1,13 @@
-//! The nominal model's held-out gap per channel, with features and calibrated parameters.
+//! The nominal model's held-out gap per channel, with the calibrated parameters and how far
+//! they moved from their starts.
 
 use super::context::{Context, Eval};
-use super::localize;
 use super::types::{ChannelError, GapBefore, ParamShift};
 use crate::fit;
 use crate::fit::FittedStage;
 
-/// The nominal model's held-out gap per channel, with features and calibrated parameters.
-pub(super) fn gap_before(
-    ctx: &Context,
-    nominal: &Eval,
-    stages: &[FittedStage],
-    loc: &localize::Localization,
-) -> GapBefore {
+/// The nominal model's held-out gap per channel, with the calibrated parameters.
+pub(super) fn gap_before(ctx: &Context, nominal: &Eval, stages: &[FittedStage]) -> GapBefore {
     let (a, b) = ctx.hold_idx;
     let channels = nominal
         .channels
@@ -57,7 +52,6 @@ pub(super) fn gap_before(
         channels,
         holdout_error: nominal.holdout_error,
         train_error: nominal.train_error,
-        features: loc.features.clone(),
         params,
     }
 }

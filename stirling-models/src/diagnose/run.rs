@@ -4,16 +4,17 @@ use std::time::Instant;
 
 use stirling_dsl::Model;
 
-use super::blocks::blocks;
+use super::blocks::{blocks, Blocks};
 use super::candidates::candidates;
-use super::context::{predict, Context, Prediction};
+use super::context::{predict, Context, Eval, Prediction};
 use super::gap::gap_before;
 use super::types::{Diagnosis, RankEntry};
 use super::{
     closure, joint, localize, rank, score, sim_gap, verdict, DiagnoseError, DiagnoseOptions,
 };
 use crate::data::Measured;
-use crate::fit;
+use crate::effects::{EffectInfo, EffectTarget};
+use crate::fit::{self, FitOptions, FittedStage, Identification};
 use crate::signal::noise_sigma;
 
 /// Diagnose `model` (a base model with an augmented member: `cv1`, `nsection`) from starting
@@ -27,135 +28,37 @@ pub fn diagnose(
     let clock = Instant::now();
     let b = blocks(data, opts)?;
     let cands = candidates(model, &opts.effects)?;
-    let noise: Vec<(String, f64)> = data
-        .channels()
-        .iter()
-        .filter_map(|c| {
-            data.channel(c)
-                .map(|v| (c.to_string(), noise_sigma(v).max(1e-12)))
-        })
-        .collect();
-    let mut fit_opts = opts.fit.clone();
-    fit_opts.train = Some(b.train);
-    fit_opts.holdout = Some(b.holdout);
-    // the diagnosis needs the stages, not the validation extras
-    fit_opts.free_run = None;
-    fit_opts.multiple_shooting = None;
-    fit_opts.input_noise_draws = 0;
-    fit_opts.prior = opts.prior;
-    let (id, stages) = fit::identify_stages(model, p0, data, &fit_opts)?;
-    let mut p_nom = p0.to_vec();
-    for (name, v) in &id.params {
-        if let Some(i) = model.param_index(name) {
-            p_nom[i] = *v;
-        }
-    }
-    let starts = crate::signal::cycle_starts(data, (b.train_idx.0, b.hold_idx.1));
-    let period = if starts.len() >= 2 {
-        (starts[starts.len() - 1] - starts[0]) / (starts.len() - 1)
-    } else {
-        0
-    };
-    let last = b.hold_idx.1 - 1;
-    let nominal_preds = stages
-        .iter()
-        .map(|st| predict(st, &st.u, last))
-        .collect::<Result<Vec<_>, _>>()?;
-    let ctx = Context {
-        model,
-        data,
-        noise,
-        train_idx: b.train_idx,
-        hold_idx: b.hold_idx,
-        half_period: period / 2,
-        lag: score::bandwidth(b.train_idx.1 - b.train_idx.0, period),
-        p_nom: p_nom.clone(),
-        nominal_preds,
-        input_noise: stages
-            .iter()
-            .map(|st| {
-                st.stage.input_noise_draws(
-                    &st.u,
-                    st.first,
-                    st.last,
-                    &st.keep,
-                    opts.noise_draws,
-                    opts.seed,
-                )
-            })
-            .collect::<Result<Vec<_>, _>>()?,
-        fits: std::sync::atomic::AtomicUsize::new(1),
-        progress: opts.progress,
-    };
+    let (id, stages) = fit::identify_stages(model, p0, data, &calibration_options(opts, &b))?;
+    let p_nom = nominal_params(model, p0, &id);
+    let ctx = context(model, data, &b, &stages, p_nom.clone(), opts)?;
     let all: Vec<Prediction> = ctx.nominal_preds.iter().flatten().cloned().collect();
     let nominal = ctx.eval(&all, vec![], p_nom.clone())?;
     let s2 = stages
         .iter()
         .map(joint::variance_factor)
         .collect::<Result<Vec<f64>, _>>()?;
-    let localization = localize::localize(model, &p_nom, data, &nominal, &ctx);
-    if let Some(progress) = opts.progress {
-        progress(&format!(
+    let localization = localize::localize(data, &nominal, &ctx);
+    report_progress(opts, || {
+        format!(
             "nominal calibration done ({:.1} s); assessing {} candidate effects",
             clock.elapsed().as_secs_f64(),
             cands.len()
-        ));
-    }
-    let mut lm = opts.fit.lm;
-    lm.max_iter = opts.joint_iters;
-    // trial steps of at most one typical strength: far trials (an engine stopped by friction)
-    // are slow to integrate and rejected anyway
-    lm.max_step = 1.0;
-    // the candidates are independent: one per core. First the score screens (one residual
-    // and Jacobian each); then the joint fits, of the significant candidates only (the
-    // verdict names only a significant one), or of all with `fit_all`
-    let level = opts.alpha / cands.len().max(1) as f64;
-    let mut assessed: Vec<rank::Assessed> = {
-        use rayon::prelude::*;
-        let screened: Vec<rank::Screened> = cands
-            .par_iter()
-            .map(|e| rank::screen_candidate(&ctx, &stages, &s2, e))
-            .collect();
-        if let Some(progress) = opts.progress {
-            let sig = screened.iter().filter(|s| s.significant(level)).count();
-            progress(&format!(
-                "screened {} candidates ({:.1} s): {sig} significant at {level:.1e}{}",
-                screened.len(),
-                clock.elapsed().as_secs_f64(),
-                if opts.fit_all { "; fitting all" } else { "" }
-            ));
-        }
-        screened
-            .into_par_iter()
-            .map(|s| {
-                if opts.fit_all || s.significant(level) {
-                    rank::assess(&ctx, &stages, &s2, &nominal, s, &lm)
-                } else {
-                    s.unfitted("not fitted: its score is not significant (--fit-all fits it)")
-                }
-            })
-            .collect()
+        )
+    });
+    let gap_before = gap_before(&ctx, &nominal, &stages);
+    let absorbed = gap_before
+        .shifts
+        .iter()
+        .any(|s| s.prior_sd.is_some_and(|z| z.abs() > ABSORBED_SD));
+    let nom = Nominal {
+        stages: &stages,
+        s2: &s2,
+        eval: &nominal,
+        absorbed,
     };
-    rank::sort(&mut assessed, level);
-    for a in assessed.iter_mut() {
-        if let Some(ev) = &a.eval {
-            let c = closure::closure(
-                data,
-                &nominal,
-                ev,
-                ctx.hold_idx,
-                &ctx,
-                opts.bootstrap,
-                opts.seed,
-            );
-            a.entry.closure_fraction = Some(c.fraction);
-            a.entry.ci_low = Some(c.ci_low);
-            a.entry.ci_high = Some(c.ci_high);
-        }
-    }
+    let assessed = assess_all(&ctx, &nom, &cands, opts, clock);
     let after = assessed.first().and_then(|a| a.eval.clone());
     let ranking: Vec<RankEntry> = assessed.into_iter().map(|a| a.entry).collect();
-    let gap_before = gap_before(&ctx, &nominal, &stages, &localization);
     let verdict = verdict::decide(
         &ranking,
         &nominal,
@@ -163,7 +66,7 @@ pub fn diagnose(
         cands.len(),
         &gap_before.shifts,
     );
-    let (simulation_gap, simulation_gap_note) = match simulated_gap(
+    let sim = simulated_gap(
         model,
         data,
         &id.offsets,
@@ -172,7 +75,8 @@ pub fn diagnose(
         &ranking,
         after.as_ref(),
         opts,
-    ) {
+    );
+    let (simulation_gap, simulation_gap_note) = match sim {
         Ok(g) => (Some(g), None),
         Err(e) => (None, Some(e.to_string())),
     };
@@ -194,6 +98,182 @@ pub fn diagnose(
     })
 }
 
+/// A progress line, when the caller asked for them.
+fn report_progress(opts: &DiagnoseOptions, line: impl FnOnce() -> String) {
+    if let Some(progress) = opts.progress {
+        progress(&line());
+    }
+}
+
+/// The options of the nominal calibration: the diagnosis's blocks, the stages without the
+/// validation extras.
+fn calibration_options(opts: &DiagnoseOptions, b: &Blocks) -> FitOptions {
+    let mut fit_opts = opts.fit.clone();
+    fit_opts.train = Some(b.train);
+    fit_opts.holdout = Some(b.holdout);
+    fit_opts.free_run = None;
+    fit_opts.multiple_shooting = None;
+    fit_opts.input_noise_draws = 0;
+    fit_opts.prior = opts.prior;
+    fit_opts
+}
+
+/// The calibrated parameters in the order of the model's parameter vector.
+fn nominal_params(model: &dyn Model, p0: &[f64], id: &Identification) -> Vec<f64> {
+    let mut p_nom = p0.to_vec();
+    for (name, v) in &id.params {
+        if let Some(i) = model.param_index(name) {
+            p_nom[i] = *v;
+        }
+    }
+    p_nom
+}
+
+/// The record, its blocks and noise, and the nominal stages' predictions.
+fn context<'a>(
+    model: &'a dyn Model,
+    data: &'a Measured,
+    b: &Blocks,
+    stages: &[FittedStage],
+    p_nom: Vec<f64>,
+    opts: &DiagnoseOptions,
+) -> Result<Context<'a>, DiagnoseError> {
+    let noise: Vec<(String, f64)> = data
+        .channels()
+        .iter()
+        .filter_map(|c| {
+            data.channel(c)
+                .map(|v| (c.to_string(), noise_sigma(v).max(1e-12)))
+        })
+        .collect();
+    let starts = crate::signal::cycle_starts(data, (b.train_idx.0, b.hold_idx.1));
+    let period = if starts.len() >= 2 {
+        (starts[starts.len() - 1] - starts[0]) / (starts.len() - 1)
+    } else {
+        0
+    };
+    let last = b.hold_idx.1 - 1;
+    let nominal_preds = stages
+        .iter()
+        .map(|st| predict(st, &st.u, last))
+        .collect::<Result<Vec<_>, _>>()?;
+    let input_noise = stages
+        .iter()
+        .map(|st| {
+            let (draws, seed) = (opts.noise_draws, opts.seed);
+            st.stage
+                .input_noise_draws(&st.u, st.first, st.last, &st.keep, draws, seed)
+        })
+        .collect::<Result<Vec<_>, _>>()?;
+    Ok(Context {
+        model,
+        data,
+        noise,
+        train_idx: b.train_idx,
+        hold_idx: b.hold_idx,
+        half_period: period / 2,
+        lag: score::bandwidth(b.train_idx.1 - b.train_idx.0, period),
+        p_nom,
+        nominal_preds,
+        input_noise,
+        fits: std::sync::atomic::AtomicUsize::new(1),
+        progress: opts.progress,
+    })
+}
+
+/// A calibrated parameter further than this many prior standard deviations from its start
+/// says the calibration absorbed something (see [`assess_all`]).
+const ABSORBED_SD: f64 = 2.0;
+
+/// The nominal calibration as the candidates see it.
+struct Nominal<'s, 'a> {
+    stages: &'s [FittedStage<'a>],
+    /// The stages' variance factors.
+    s2: &'s [f64],
+    eval: &'s Eval,
+    /// Whether a calibrated parameter moved beyond [`ABSORBED_SD`] prior deviations.
+    absorbed: bool,
+}
+
+/// Screen every candidate, fit the significant ones, rank them and attach the closure of
+/// each fitted one. The candidates are independent: one per core.
+///
+/// The score screen is a local test at the calibrated optimum: when the calibration has
+/// absorbed an effect into the nominal parameters (a leak into the heat-transfer
+/// coefficients), the effect's own basin is out of its sight. The parameter shifts see
+/// it, so when a shift exceeds [`ABSORBED_SD`] prior deviations the model effects are
+/// fitted too (their joint fit also starts at the typical strength with the nominal
+/// parameters reset). `fit_all` fits every candidate.
+fn assess_all(
+    ctx: &Context,
+    nom: &Nominal,
+    cands: &[&'static EffectInfo],
+    opts: &DiagnoseOptions,
+    clock: Instant,
+) -> Vec<rank::Assessed> {
+    use rayon::prelude::*;
+    let mut lm = opts.fit.lm;
+    lm.max_iter = opts.joint_iters;
+    // trial steps of at most one typical strength: far trials (an engine stopped by friction)
+    // are slow to integrate and rejected anyway
+    lm.max_step = 1.0;
+    let level = opts.alpha / cands.len().max(1) as f64;
+    let (stages, s2, nominal) = (nom.stages, nom.s2, nom.eval);
+    let screened: Vec<rank::Screened> = cands
+        .par_iter()
+        .map(|e| rank::screen_candidate(ctx, stages, s2, e))
+        .collect();
+    let fit = |s: &rank::Screened| {
+        opts.fit_all
+            || s.significant(level)
+            || (nom.absorbed && s.effect.target == EffectTarget::Model)
+    };
+    report_progress(opts, || {
+        let sig = screened.iter().filter(|s| s.significant(level)).count();
+        let fitted = screened.iter().filter(|s| fit(s)).count();
+        let why = if opts.fit_all {
+            " (--fit-all)"
+        } else if nom.absorbed && fitted > sig {
+            " (the calibration moved a parameter beyond 2 prior sd: the model effects too)"
+        } else {
+            ""
+        };
+        format!(
+            "screened {} candidates ({:.1} s): {sig} significant at {level:.1e}; fitting {fitted}{why}",
+            screened.len(),
+            clock.elapsed().as_secs_f64(),
+        )
+    });
+    let mut assessed: Vec<rank::Assessed> = screened
+        .into_par_iter()
+        .map(|s| {
+            if fit(&s) {
+                rank::assess(ctx, stages, s2, nominal, s, &lm)
+            } else {
+                s.unfitted("not fitted: its score is not significant (--fit-all fits it)")
+            }
+        })
+        .collect();
+    rank::sort(&mut assessed, level);
+    for a in assessed.iter_mut() {
+        if let Some(ev) = &a.eval {
+            let c = closure::closure(
+                ctx.data,
+                nominal,
+                ev,
+                ctx.hold_idx,
+                ctx,
+                opts.bootstrap,
+                opts.seed,
+            );
+            a.entry.closure_fraction = Some(c.fraction);
+            a.entry.ci_low = Some(c.ci_low);
+            a.entry.ci_high = Some(c.ci_high);
+        }
+    }
+    assessed
+}
+
 /// The simulated gap before and after the leading fitted candidate (the sensor effects
 /// distort the simulated outputs as they distort the data).
 #[allow(clippy::too_many_arguments)]
@@ -201,10 +281,10 @@ fn simulated_gap(
     model: &dyn Model,
     data: &Measured,
     offsets: &crate::fit::free_run::SensorOffsets,
-    b: &super::blocks::Blocks,
+    b: &Blocks,
     p_nom: &[f64],
     ranking: &[RankEntry],
-    after: Option<&super::context::Eval>,
+    after: Option<&Eval>,
     opts: &DiagnoseOptions,
 ) -> Result<sim_gap::SimulationGap, sim_gap::SimGapError> {
     let before = sim_gap::Simulated {

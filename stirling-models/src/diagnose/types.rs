@@ -26,8 +26,6 @@ pub struct GapBefore {
     pub holdout_error: f64,
     /// The same on the training block.
     pub train_error: f64,
-    /// Limit-cycle features, measured vs free run of the calibrated model.
-    pub features: localize::Features,
     /// The calibrated nominal parameters (the fitted subset).
     pub params: Vec<(String, f64)>,
     /// How far the calibration moved each fitted parameter from its starting value: a gap

@@ -7,14 +7,13 @@
 use std::time::Instant;
 
 use serde::Serialize;
+use stirling_dsl::Model;
 
 use super::candidates::nominal_model;
-use super::run::diagnose;
 use super::types::Diagnosis;
 use super::{DiagnoseError, DiagnoseOptions};
-use crate::data::{read_csv, write_csv};
+
 use crate::effects::{effect, effects_for};
-use crate::rig::{self, RigConfig};
 
 /// What the self-check runs.
 #[derive(Clone, Debug)]
@@ -142,7 +141,7 @@ pub fn settings(name: &str, m: f64) -> Vec<String> {
 }
 
 /// The rig's value of effect parameter `name`: from the settings, else the model default.
-fn truth_value(set: &[String], model: &dyn stirling_dsl::Model, p_nom: &[f64], name: &str) -> f64 {
+fn truth_value(set: &[String], model: &dyn Model, p_nom: &[f64], name: &str) -> f64 {
     set.iter()
         .filter_map(|s| s.split_once('='))
         .find(|(k, _)| *k == name)
@@ -150,6 +149,15 @@ fn truth_value(set: &[String], model: &dyn stirling_dsl::Model, p_nom: &[f64], n
         .or_else(|| model.param_index(name).map(|i| p_nom[i]))
         .unwrap_or(f64::NAN)
 }
+
+/// One case: a rig record, its CSV, its diagnosis and what the user reads of it.
+mod case;
+/// The confusion matrix over the cases.
+mod summary;
+
+use case::{measured_channels, perturbed_start, scratch_dir, Bench};
+pub use summary::matrix_markdown;
+use summary::summarize;
 
 /// Run the self-check.
 pub fn run(
@@ -164,173 +172,36 @@ pub fn run(
             .map(|e| e.name.to_string())
             .collect(),
     };
-    let mut plan: Vec<(String, f64)> = if opts.clean {
-        vec![("none".into(), 0.0)]
-    } else {
-        vec![]
-    };
-    for n in &names {
-        for &s in &opts.strengths {
-            plan.push((n.clone(), s));
-        }
-    }
     let (model, p_nom) = nominal_model(&opts.model, opts.n)?;
-    // `p_hot` only where the model has a hot side (more than one CV)
-    let multi_cv = crate::layout::StateLayout::of(model.as_ref())
-        .pressures
-        .len()
-        > 1;
-    let channels: Vec<String> = opts
-        .channels
-        .iter()
-        .filter(|c| multi_cv || c.as_str() != "p_hot")
-        .cloned()
-        .collect();
     let label = match opts.n {
         Some(n) => format!("{} n={n}", opts.model),
         None => opts.model.clone(),
     };
-    let mut p0 = p_nom.clone();
-    for (k, (name, sign)) in [
-        ("kd", 1.0),
-        ("kp", -1.0),
-        ("bd", 1.0),
-        ("bp", -1.0),
-        ("hh", 1.0),
-        ("hk", -1.0),
-    ]
-    .iter()
-    .enumerate()
-    {
-        if let Some(i) = model.param_index(name) {
-            p0[i] *= 1.0 + sign * opts.perturb * (1.0 - 0.1 * k as f64);
-        }
-    }
-    // one folder per run: self-checks may run concurrently in one process (tests)
-    static RUNS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
-    let run = RUNS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-    let dir = std::env::temp_dir().join(format!("stirling-selfcheck-{}-{run}", std::process::id()));
-    std::fs::create_dir_all(&dir).map_err(|source| DiagnoseError::Io {
-        path: dir.clone(),
-        source,
-    })?;
+    let bench = Bench {
+        model: model.as_ref(),
+        p_nom: &p_nom,
+        p0: perturbed_start(model.as_ref(), &p_nom, opts.perturb),
+        channels: measured_channels(model.as_ref(), &opts.channels),
+        dir: scratch_dir()?,
+        label: label.clone(),
+    };
     let mut cases = Vec::new();
-    for (k, (truth, strength)) in plan.iter().enumerate() {
-        let t = Instant::now();
-        let set = if truth == "none" {
-            vec![]
-        } else {
-            settings(truth, *strength)
-        };
-        let cfg = RigConfig {
-            model: opts.model.clone(),
-            n: opts.n,
-            effects: set.clone(),
-            t_end: opts.t_end,
-            settle: opts.settle,
-            rate: opts.rate,
-            seed: opts.seed + k as u64,
-            channels: channels.clone(),
-            ..Default::default()
-        };
-        let out = rig::run(&cfg).map_err(|source| DiagnoseError::Rig {
-            truth: truth.to_string(),
-            source,
-        })?;
-        // only the CSV crosses over: written, then read back like any measured file
-        let path = dir.join(format!("case{k}.csv"));
-        write_csv(&path, &out.data, &[]).map_err(|source| DiagnoseError::Io {
-            path: path.clone(),
-            source,
-        })?;
-        drop(out);
-        let data = read_csv(&path)?;
-        let _ = std::fs::remove_file(&path);
-        let d = diagnose(model.as_ref(), &p0, &data, &opts.diagnose)?;
-        let truth_rank = d
-            .ranking
-            .iter()
-            .position(|r| &r.effect == truth)
-            .map(|i| i + 1);
-        let verdict = d
-            .verdict
-            .effect
-            .clone()
-            .filter(|_| d.verdict.verdict == "effect")
-            .unwrap_or_else(|| d.verdict.verdict.clone());
-        let entry = d.ranking.iter().find(|r| &r.effect == truth);
-        let fitted = entry
-            .map(|r| {
-                r.params
-                    .iter()
-                    .map(|q| {
-                        let tv = truth_value(&set, model.as_ref(), &p_nom, &q.name);
-                        (q.name.clone(), tv, q.value, q.ci_low, q.ci_high)
-                    })
-                    .collect()
-            })
-            .unwrap_or_default();
-        let pass = if truth == "none" {
-            verdict == "no_significant_gap"
-        } else {
-            &verdict == truth
-        };
-        let case = Case {
-            model: label.clone(),
-            truth: truth.clone(),
-            strength: *strength,
-            settings: set,
-            verdict,
-            truth_rank,
-            top: d.ranking.first().map(|r| r.effect.clone()),
-            closure_fraction: entry.and_then(|r| r.closure_fraction),
-            ci_low: entry.and_then(|r| r.ci_low),
-            ci_high: entry.and_then(|r| r.ci_high),
-            fitted,
-            pass,
-            seconds: t.elapsed().as_secs_f64(),
-            fits: d.fits,
-            diagnosis: Some(Box::new(d)),
-        };
+    for (k, (truth, strength)) in plan(opts, &names).iter().enumerate() {
+        let case = bench.case(opts, k, truth, *strength)?;
         progress(&case);
         cases.push(case);
     }
-    let _ = std::fs::remove_dir(&dir);
+    let _ = std::fs::remove_dir(&bench.dir);
     Ok(summarize(label, cases, &names, clock))
 }
 
-/// The confusion matrix of `cases` over the effects `names`.
-fn summarize(model: String, cases: Vec<Case>, names: &[String], clock: Instant) -> SelfCheck {
-    let mut labels = vec!["none".to_string()];
-    labels.extend(names.iter().cloned());
-    let mut columns: Vec<String> = names.to_vec();
-    columns.push("unexplained".into());
-    columns.push("no_significant_gap".into());
-    let mut matrix = vec![vec![0usize; columns.len()]; labels.len()];
-    for c in &cases {
-        let r = labels.iter().position(|l| l == &c.truth).expect("label");
-        let col = columns
-            .iter()
-            .position(|l| l == &c.verdict)
-            .unwrap_or(columns.len() - 2);
-        matrix[r][col] += 1;
-    }
-    let clean: Vec<&Case> = cases.iter().filter(|c| c.truth == "none").collect();
-    SelfCheck {
-        model,
-        passed: cases.iter().filter(|c| c.pass).count(),
-        total: cases.len(),
-        clean: clean.len(),
-        false_alarms: clean
-            .iter()
-            .filter(|c| c.verdict != "no_significant_gap" && c.verdict != "unexplained")
-            .count(),
-        cases,
-        labels,
-        matrix,
-        columns,
-        seconds: clock.elapsed().as_secs_f64(),
-    }
+/// The cases: a clean record (when asked), then every effect at every strength.
+fn plan(opts: &SelfCheckOptions, names: &[String]) -> Vec<(String, f64)> {
+    let clean = opts.clean.then(|| ("none".to_string(), 0.0));
+    let withheld = names
+        .iter()
+        .flat_map(|n| opts.strengths.iter().map(move |&s| (n.clone(), s)));
+    clean.into_iter().chain(withheld).collect()
 }
 
 /// The self-check of every effect in the library: each on the smallest model it applies to
@@ -384,23 +255,4 @@ pub fn run_library(
     let mut names = on_cv1;
     names.extend(on_nsection);
     Ok(summarize("library".into(), cases, &names, clock))
-}
-
-/// The confusion matrix as a Markdown table.
-pub fn matrix_markdown(sc: &SelfCheck) -> String {
-    let mut s = format!(
-        "| truth \\ verdict | {} |\n|---|{}\n",
-        sc.columns.join(" | "),
-        "---|".repeat(sc.columns.len())
-    );
-    for (l, row) in sc.labels.iter().zip(&sc.matrix) {
-        s += &format!(
-            "| {l} | {} |\n",
-            row.iter()
-                .map(|v| v.to_string())
-                .collect::<Vec<_>>()
-                .join(" | ")
-        );
-    }
-    s
 }
