@@ -91,11 +91,30 @@ impl SimulationGap {
         }
         if let Some(c) = &self.closure {
             s.push_str(&format!(
-                "\nclosure of the simulated gap by `{after}`: {:.2} [{:.2}, {:.2}] (1 - sum of squared feature errors after / before)\n",
-                c.value, c.ci_low, c.ci_high
+                "\nclosure of the simulated gap by `{after}`: {:.2} [{:.2}, {:.2}] (1 - sum of squared feature errors after / before){}\n",
+                c.value,
+                c.ci_low,
+                c.ci_high,
+                self.closure_note()
             ));
         }
         s
+    }
+
+    /// What the closure interval says, when it says less than its value suggests.
+    fn closure_note(&self) -> &'static str {
+        let Some(c) = &self.closure else { return "" };
+        let off = |e: &FeatureError| e.ci_low > 0.0 || e.ci_high < 0.0;
+        let offs = self.rows.iter().filter(|r| off(&r.before)).count();
+        if offs == 0 {
+            ": no feature is off before (every interval holds 0): the free run already matches the record within its cycle-to-cycle scatter, so there is nothing to close in simulation"
+        } else if c.ci_low <= 0.0 && c.ci_high >= 0.0 {
+            ": the interval holds 0: no measurable change in simulation"
+        } else if c.ci_high < 0.0 {
+            ": the simulated gap grew: the effect, fitted on the driven subsystems, does not carry over to the free run"
+        } else {
+            ""
+        }
     }
 }
 

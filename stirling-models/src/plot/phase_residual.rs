@@ -34,7 +34,7 @@ pub fn phase_residual(path: &Path, title: &str, panels: &[Panel]) -> Result<(), 
     let root = root
         .titled(title, ("sans-serif", 18))
         .map_err(|e| err(&e))?;
-    for (area, panel) in root.split_evenly((k, 1)).iter().zip(panels) {
+    for (pi, (area, panel)) in root.split_evenly((k, 1)).iter().zip(panels).enumerate() {
         let (s, unit) = scale(panel.channel);
         let lim = panel
             .lines
@@ -44,13 +44,16 @@ pub fn phase_residual(path: &Path, title: &str, panels: &[Panel]) -> Result<(), 
             .fold(0.0f64, |m, v| m.max((s * v).abs()))
             .max(1e-12)
             * 1.1;
+        // the legend, on the first panel only, sits in headroom above the lines
+        let top = if pi == 0 { 1.8 * lim } else { lim };
         let mut c = ChartBuilder::on(area)
             .margin(8)
             .x_label_area_size(30)
             .y_label_area_size(70)
-            .build_cartesian_2d(0.0..360.0, -lim..lim)
+            .build_cartesian_2d(0.0..360.0, -lim..top)
             .map_err(|e| err(&e))?;
         c.configure_mesh()
+            .y_labels(7)
             .x_desc(axes::label("phase of the cycle", "deg"))
             .y_desc(axes::label(
                 &format!("{} measured - model", panel.channel),
@@ -74,11 +77,14 @@ pub fn phase_residual(path: &Path, title: &str, panels: &[Panel]) -> Result<(), 
                 .label(*name)
                 .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], color));
         }
-        c.configure_series_labels()
-            .border_style(BLACK)
-            .background_style(WHITE)
-            .draw()
-            .map_err(|e| err(&e))?;
+        if pi == 0 {
+            c.configure_series_labels()
+                .position(SeriesLabelPosition::UpperRight)
+                .border_style(BLACK)
+                .background_style(WHITE)
+                .draw()
+                .map_err(|e| err(&e))?;
+        }
     }
     root.present().map_err(|e| err(&e))
 }
