@@ -48,6 +48,7 @@ pub fn random_state(model: &dyn Model, p: &[f64], spread: Spread, rng: &mut StdR
                 }
             },
             StateKind::Mass(_) => *xi * (1.0 + 0.05 * u),
+            StateKind::WallTemperature(_) => *xi + 20.0 * u,
         };
     }
     x
@@ -85,6 +86,7 @@ pub fn state_scales(model: &dyn Model, p: &[f64]) -> Vec<f64> {
             StateKind::Velocity(_) => 0.1,
             StateKind::Pressure(_) => 100.0,
             StateKind::Mass(_) => x0.abs(),
+            StateKind::WallTemperature(_) => 10.0,
         })
         .collect()
 }

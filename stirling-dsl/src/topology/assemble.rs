@@ -14,14 +14,15 @@
 use super::decl::{LinkDecl, Topology, Vessel};
 use super::frame::{place, Place};
 use super::system::{BlockInfo, BlockKind, Row, System, Variant, VesselTerms, VARIANTS};
+use super::walls::PortHeat;
 use crate::expr::{At, Func, Id, Sym};
 use crate::Closure;
 
-/// Where a row is assembled: a scalar block, or a section variant of an array CV.
+/// Where a row is assembled: a scalar block, or a section variant of an array CV or wall.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-enum RowAt {
+pub(super) enum RowAt {
     Scalar,
-    Array(usize, Variant),
+    Array(Vessel, Variant),
 }
 
 /// Quantities of a CV in its own frame.
@@ -41,26 +42,32 @@ pub fn assemble(topo: &mut Topology, closure: Closure) -> System {
     Assembler::new(topo, closure).run()
 }
 
-struct Assembler<'t> {
-    t: &'t mut Topology,
+pub(super) struct Assembler<'t> {
+    pub(super) t: &'t mut Topology,
     closure: Closure,
     array_blocks: Vec<bool>,
     cv: Vec<CvTemplate>,
+    /// Per CV, the heat of each port that names a declared wall, in the CV's frame.
+    pub(super) port_heat: Vec<Vec<PortHeat>>,
 }
 
 impl<'t> Assembler<'t> {
     fn new(t: &'t mut Topology, closure: Closure) -> Self {
         let (nb, ncv) = (t.bodies.len(), t.cvs.len());
-        let mut array_blocks = vec![false; 2 * nb + 2 * ncv];
+        let mut array_blocks = vec![false; 2 * nb + 2 * ncv + t.walls.len()];
         for (i, c) in t.cvs.iter().enumerate() {
             array_blocks[2 * nb + i] = c.array;
             array_blocks[2 * nb + ncv + i] = c.array;
+        }
+        for (w, wall) in t.walls.iter().enumerate() {
+            array_blocks[Topology::wall_block(nb, ncv, w) as usize] = wall.array;
         }
         Self {
             t,
             closure,
             array_blocks,
             cv: Vec::new(),
+            port_heat: Vec::new(),
         }
     }
 
@@ -106,6 +113,7 @@ impl<'t> Assembler<'t> {
             (0..self.t.cvs.len()).map(|i| self.cv_terms(i)).collect();
         vessels.extend((0..self.t.spaces.len()).map(|s| self.space_terms(s)));
         let (mech_energy, mech_power) = (self.mech_energy(), self.mech_power());
+        let (walls, wall_boundary_heat) = self.wall_terms();
         let array_blocks = self.array_blocks.clone();
         System {
             closure: self.closure,
@@ -116,6 +124,8 @@ impl<'t> Assembler<'t> {
             vessels,
             mech_energy,
             mech_power,
+            walls,
+            wall_boundary_heat,
             array_blocks,
         }
     }
@@ -156,6 +166,7 @@ impl<'t> Assembler<'t> {
                 });
             }
         }
+        out.extend(self.wall_blocks());
         out
     }
 
@@ -181,10 +192,13 @@ impl<'t> Assembler<'t> {
         (dv, vdot)
     }
 
-    /// Every state symbol set to zero: the rest position of section 6.
+    /// The rest state of section 6: every body state zero, every wall temperature at its
+    /// declared rest value (in the frame of the expression).
     fn at_rest(&mut self, id: Id) -> Id {
-        self.t.arena.subst(id, &mut |a, s| {
-            matches!(s, Sym::State(..)).then(|| a.num(0.0))
+        let rest = self.wall_rests();
+        self.t.arena.subst(id, &mut |a, s| match s {
+            Sym::State(b, _) => Some(rest.get(&b).copied().unwrap_or_else(|| a.num(0.0))),
+            _ => None,
         })
     }
 
@@ -222,7 +236,7 @@ impl<'t> Assembler<'t> {
         let mr = a.mul(m, gas.r);
         let t_raw = a.div(pv, mr);
         let t = a.named(&tl, t_raw);
-        let q_raw = self.heat(&c.ports, t);
+        let q_raw = self.heat(i, &c.ports, t);
         let q = self.t.arena.named(&ql, q_raw);
         CvTemplate {
             p,
@@ -235,17 +249,31 @@ impl<'t> Assembler<'t> {
         }
     }
 
-    /// `sum h A (Tw - T)`.
-    fn heat(&mut self, ports: &[super::decl::PortDecl], t: Id) -> Id {
-        let a = &mut self.t.arena;
-        let mut q = a.num(0.0);
+    /// `sum h A (Tw - T)` of CV `i`; the terms of ports to declared walls are named
+    /// `Q_cv_port` and recorded for the walls' balances.
+    fn heat(&mut self, i: usize, ports: &[super::decl::PortDecl], t: Id) -> Id {
+        let mut q = self.t.arena.num(0.0);
+        let mut to_walls = Vec::new();
         for port in ports {
+            let label = self.port_label(i, &port.name);
+            let a = &mut self.t.arena;
             let ha = a.mul(port.h, port.area);
             let dt = a.sub(port.wall, t);
-            let term = a.mul(ha, dt);
+            let mut term = a.mul(ha, dt);
+            if let Some(wall) = port.wall_ref {
+                term = a.named(&label, term);
+                to_walls.push(PortHeat { wall, q: term });
+            }
             q = a.add(q, term);
         }
+        self.port_heat.push(to_walls);
         q
+    }
+
+    fn port_label(&self, i: usize, port: &str) -> String {
+        let c = &self.t.cvs[i];
+        let j = if c.array { "[j]" } else { "" };
+        format!("Q_{}_{port}{j}", c.name)
     }
 
     /// `m_i0 = Pcharge V_i0 / (R T_i0)`, `T_i0 = sum h Aw Tw / sum h Aw` at rest.
@@ -272,7 +300,7 @@ impl<'t> Assembler<'t> {
         a.div(pv, rt)
     }
 
-    fn placed(&mut self, id: Id, at: Place) -> Id {
+    pub(super) fn placed(&mut self, id: Id, at: Place) -> Id {
         place(&mut self.t.arena, id, at, &self.array_blocks)
     }
 
@@ -283,9 +311,18 @@ impl<'t> Assembler<'t> {
             BlockKind::Pressure(i) | BlockKind::Mass(i) => {
                 let want_p = matches!(b.kind, BlockKind::Pressure(_));
                 if b.array {
-                    Row::Array(VARIANTS.map(|v| self.balance(i, RowAt::Array(i, v), want_p)))
+                    Row::Array(
+                        VARIANTS.map(|v| self.balance(i, RowAt::Array(Vessel::Cv(i), v), want_p)),
+                    )
                 } else {
                     Row::Scalar(self.balance(i, RowAt::Scalar, want_p))
+                }
+            }
+            BlockKind::WallTemperature(w) => {
+                if b.array {
+                    Row::Array(VARIANTS.map(|v| self.wall_row(w, RowAt::Array(Vessel::Wall(w), v))))
+                } else {
+                    Row::Scalar(self.wall_row(w, RowAt::Scalar))
                 }
             }
         }
@@ -296,6 +333,7 @@ impl<'t> Assembler<'t> {
             BlockKind::Position(_) | BlockKind::Velocity(_) => self.t.arena.num(0.0),
             BlockKind::Pressure(_) => self.t.gas.as_ref().expect("checked").charge,
             BlockKind::Mass(i) => self.cv[i].m0,
+            BlockKind::WallTemperature(w) => self.t.walls[w].rest,
         };
         if b.array {
             Row::Array([id; 4])
@@ -400,7 +438,7 @@ impl<'t> Assembler<'t> {
                 if end.vessel != Vessel::Cv(i) {
                     continue;
                 }
-                if let Some(base) = touches(end.at, row, l) {
+                if let Some(base) = touches(end.at, row, rel_min(l.from.at, l.to.at)) {
                     out.push(self.flow(l, row, base, into));
                 }
             }
@@ -447,8 +485,9 @@ impl<'t> Assembler<'t> {
                     sp.name.clone(),
                 )
             }
+            Vessel::Wall(_) => unreachable!("checked: a mass-flow link never ends at a wall"),
             Vessel::Cv(c) => {
-                let pl = end_place(c, at, row, base);
+                let pl = end_place(vessel, at, row, base);
                 let tpl = self.cv[c];
                 let (p, t) = (self.placed(tpl.p, pl), self.placed(tpl.t, pl));
                 let shown = match pl {
@@ -475,6 +514,14 @@ impl<'t> Assembler<'t> {
         let pv = a.mul(tpl.p, tpl.v);
         let energy = a.div(pv, gm1);
         let zero = a.num(0.0);
+        // heat exchanged with a declared wall stays inside the system
+        let heat = match self.port_heat[i].iter().map(|h| h.q).collect::<Vec<_>>() {
+            internal if internal.is_empty() => tpl.q,
+            internal => {
+                let sum = a.sum(internal);
+                a.sub(tpl.q, sum)
+            }
+        };
         let c = &self.t.cvs[i];
         VesselTerms {
             name: c.name.clone(),
@@ -483,7 +530,7 @@ impl<'t> Assembler<'t> {
             pressure: tpl.p,
             volume: tpl.v,
             energy,
-            heat: tpl.q,
+            heat,
             boundary: zero,
             mass: tpl.m,
             temperature: tpl.t,
@@ -582,8 +629,8 @@ struct Flow {
 }
 
 /// Whether a link end at `at` touches the row's section; returns the row's offset in the
-/// link's frame (`0`, or `1` for the upper end of a chain link).
-fn touches(at: At, row: RowAt, l: &LinkDecl) -> Option<i32> {
+/// link's frame (`0`, or `1` for the upper end of a chain link whose lower offset is `rel_min`).
+pub(super) fn touches(at: At, row: RowAt, rel_min: i32) -> Option<i32> {
     match (at, row) {
         (At::Scalar, RowAt::Scalar) => Some(0),
         (At::First, RowAt::Array(_, v)) => {
@@ -591,7 +638,7 @@ fn touches(at: At, row: RowAt, l: &LinkDecl) -> Option<i32> {
         }
         (At::Last, RowAt::Array(_, v)) => matches!(v, Variant::Single | Variant::Last).then_some(0),
         (At::Rel(r), RowAt::Array(_, v)) => {
-            let upper = r > rel_min(l);
+            let upper = r > rel_min;
             let ok = if upper {
                 matches!(v, Variant::Interior | Variant::Last)
             } else {
@@ -603,14 +650,15 @@ fn touches(at: At, row: RowAt, l: &LinkDecl) -> Option<i32> {
     }
 }
 
-fn rel_min(l: &LinkDecl) -> i32 {
+/// The lower `Rel` offset of a link's two ends (`0` if neither is `Rel`).
+pub(super) fn rel_min(from: At, to: At) -> i32 {
     let r = |a: At| if let At::Rel(r) = a { r } else { 0 };
-    r(l.from.at).min(r(l.to.at))
+    r(from).min(r(to))
 }
 
-/// Where a link end sits relative to the row's own section.
-fn end_place(cv: usize, at: At, row: RowAt, base: i32) -> Place {
-    let own_array = matches!(row, RowAt::Array(c, _) if c == cv);
+/// Where a link end of array `vessel` sits relative to the row's own section.
+pub(super) fn end_place(vessel: Vessel, at: At, row: RowAt, base: i32) -> Place {
+    let own_array = matches!(row, RowAt::Array(v, _) if v == vessel);
     match at {
         At::Scalar => Place::Own,
         At::Rel(r) => Place::Shift(r - base),
@@ -625,7 +673,7 @@ fn end_place(cv: usize, at: At, row: RowAt, base: i32) -> Place {
     }
 }
 
-fn end_name(name: &str, array: bool, at: At) -> String {
+pub(super) fn end_name(name: &str, array: bool, at: At) -> String {
     if !array {
         return name.to_string();
     }

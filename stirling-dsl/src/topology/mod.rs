@@ -4,10 +4,11 @@ mod assemble;
 mod decl;
 pub mod frame;
 mod system;
+mod walls;
 
 pub use assemble::assemble;
 pub use decl::{
-    BodyDecl, CouplingDecl, CvDecl, End, FaceDecl, GasDecl, LinkDecl, ParamDecl, PortDecl,
-    SpaceDecl, Topology, Vessel,
+    BodyDecl, ConductionDecl, CouplingDecl, CvDecl, End, FaceDecl, GasDecl, HeatEnd, LinkDecl,
+    ParamDecl, PortDecl, SpaceDecl, Topology, Vessel, WallDecl,
 };
-pub use system::{BlockInfo, BlockKind, Row, System, Variant, VesselTerms, VARIANTS};
+pub use system::{BlockInfo, BlockKind, Row, System, Variant, VesselTerms, WallTerms, VARIANTS};

@@ -33,10 +33,10 @@ pub mod report;
 mod run;
 /// The robust score test of an effect at its null.
 pub mod score;
-/// The simulated gap: held-out cycle features of the free run, before and after.
-pub mod sim_gap;
 /// The self-check on rig records whose effect is withheld.
 pub mod selfcheck;
+/// The simulated gap: held-out cycle features of the free run, before and after.
+pub mod sim_gap;
 /// What a diagnosis reports.
 pub mod types;
 /// The verdict a user reads.

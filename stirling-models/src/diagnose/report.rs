@@ -67,7 +67,10 @@ fn phase_figure(d: &Diagnosis, dir: &Path) -> Result<Option<String>, DrawError> 
 fn localization_figures(d: &Diagnosis, dir: &Path) -> Result<Vec<String>, DrawError> {
     let loc = &d.localization;
     let group = |f: &dyn Fn(&super::localize::ChannelLoc) -> Vec<f64>| -> Vec<(String, Vec<f64>)> {
-        loc.channels.iter().map(|c| (c.channel.clone(), f(c))).collect()
+        loc.channels
+            .iter()
+            .map(|c| (c.channel.clone(), f(c)))
+            .collect()
     };
     plot::bars::bars(
         &dir.join("residual_phase.svg"),
@@ -80,17 +83,28 @@ fn localization_figures(d: &Diagnosis, dir: &Path) -> Result<Vec<String>, DrawEr
     plot::bars::bars(
         &dir.join("residual_harmonics.svg"),
         "driven subsystems: residual amplitude / noise level by harmonic",
-        &format!("harmonic 0..{} [multiple of the cycle frequency]", HARMONICS - 1),
+        &format!(
+            "harmonic 0..{} [multiple of the cycle frequency]",
+            HARMONICS - 1
+        ),
         "amplitude / (2 sigma / sqrt N) [-]",
         &group(&|c| c.harmonics.iter().map(|a| a / c.harmonic_noise).collect()),
         Some(1.0),
     )?;
-    Ok(vec!["residual_phase.svg".into(), "residual_harmonics.svg".into()])
+    Ok(vec![
+        "residual_phase.svg".into(),
+        "residual_harmonics.svg".into(),
+    ])
 }
 
 /// The driven prediction of `ch` on (the first 0.25 s of) the held-out block, before and
 /// after the leading effect.
-fn overlay_figure(d: &Diagnosis, data: &Measured, ch: &str, dir: &Path) -> Result<Option<String>, DrawError> {
+fn overlay_figure(
+    d: &Diagnosis,
+    data: &Measured,
+    ch: &str,
+    dir: &Path,
+) -> Result<Option<String>, DrawError> {
     let (Some(b), Some(meas)) = (d.before.as_ref(), data.channel(ch)) else {
         return Ok(None);
     };
@@ -100,9 +114,16 @@ fn overlay_figure(d: &Diagnosis, data: &Measured, ch: &str, dir: &Path) -> Resul
     let (t0, dt) = (data.t[0], data.dt());
     let i0 = ((d.holdout.0 - t0) / dt).round() as usize;
     let i1 = (((d.holdout.1 - t0) / dt).round() as usize + 1).min(data.t.len());
-    let i1 = i1.min(i0 + (0.25 / dt) as usize).max(i0 + 2).min(data.t.len());
+    let i1 = i1
+        .min(i0 + (0.25 / dt) as usize)
+        .max(i0 + 2)
+        .min(data.t.len());
     let mut lines = vec![("nominal", &b.pred[ci][i0..i1])];
-    if let Some((a, k)) = d.after.as_ref().and_then(|a| a.channels.iter().position(|c| c == ch).map(|k| (a, k))) {
+    if let Some((a, k)) = d
+        .after
+        .as_ref()
+        .and_then(|a| a.channels.iter().position(|c| c == ch).map(|k| (a, k)))
+    {
         lines.push(("with leading effect", &a.pred[k][i0..i1]));
     }
     let f = format!("overlay_{ch}.svg");
@@ -133,7 +154,11 @@ pub fn write(d: &Diagnosis, data: &Measured, dir: &Path) -> Result<PathBuf, Repo
 fn markdown(d: &Diagnosis, data: &Measured, figs: &[String]) -> String {
     let mut s = String::new();
     let v = &d.verdict;
-    let effect = v.effect.as_ref().map(|e| format!(" (`{e}`)")).unwrap_or_default();
+    let effect = v
+        .effect
+        .as_ref()
+        .map(|e| format!(" (`{e}`)"))
+        .unwrap_or_default();
     let _ = writeln!(s, "# Gap diagnosis: `{}` on `{}`\n", d.model, data.source);
     let _ = writeln!(s, "**Verdict: {}{effect}**; {}\n", v.verdict, v.reason);
     let _ = writeln!(
@@ -176,7 +201,11 @@ fn driven_section(s: &mut String, d: &Diagnosis) {
         "\n## Where: the driven subsystems (held out)\n\n| channel | RMS | noise | RMS/noise |\n|---|---|---|---|"
     );
     for c in &d.gap_before.channels {
-        let _ = writeln!(s, "| {} | {:.4e} | {:.4e} | {:.3} |", c.channel, c.rms, c.noise, c.ratio);
+        let _ = writeln!(
+            s,
+            "| {} | {:.4e} | {:.4e} | {:.3} |",
+            c.channel, c.rms, c.noise, c.ratio
+        );
     }
     let _ = writeln!(
         s,
@@ -205,7 +234,12 @@ fn ranking_section(s: &mut String, d: &Diagnosis) {
         let params: Vec<String> = r
             .params
             .iter()
-            .map(|q| format!("{} = {:.3e} [{:.3e}, {:.3e}] {}", q.name, q.value, q.ci_low, q.ci_high, q.unit))
+            .map(|q| {
+                format!(
+                    "{} = {:.3e} [{:.3e}, {:.3e}] {}",
+                    q.name, q.value, q.ci_low, q.ci_high, q.unit
+                )
+            })
             .collect();
         let _ = writeln!(
             s,

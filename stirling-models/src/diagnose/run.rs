@@ -169,11 +169,19 @@ pub fn diagnose(
         cands.len(),
         &gap_before.shifts,
     );
-    let (simulation_gap, simulation_gap_note) =
-        match simulated_gap(model, data, &id.offsets, &b, &p_nom, &ranking, after.as_ref(), opts) {
-            Ok(g) => (Some(g), None),
-            Err(e) => (None, Some(e.to_string())),
-        };
+    let (simulation_gap, simulation_gap_note) = match simulated_gap(
+        model,
+        data,
+        &id.offsets,
+        &b,
+        &p_nom,
+        &ranking,
+        after.as_ref(),
+        opts,
+    ) {
+        Ok(g) => (Some(g), None),
+        Err(e) => (None, Some(e.to_string())),
+    };
     Ok(Diagnosis {
         simulation_gap,
         simulation_gap_note,

@@ -85,9 +85,8 @@ pub struct SimulationGap {
 impl SimulationGap {
     /// The feature table as Markdown (readable as plain text too).
     pub fn markdown(&self) -> String {
-        let ci = |e: &FeatureError| {
-            format!("{:+.3} [{:+.3}, {:+.3}]", e.value, e.ci_low, e.ci_high)
-        };
+        let ci =
+            |e: &FeatureError| format!("{:+.3} [{:+.3}, {:+.3}]", e.value, e.ci_low, e.ci_high);
         let after = self.effect.as_deref().unwrap_or("-");
         let mut s = format!(
             "| feature | measured | error before | error after `{after}` | unit |\n|---|---|---|---|---|\n"
@@ -290,7 +289,11 @@ fn errors(meas: &[[f64; 7]], sim: &[[f64; 7]], k: usize) -> Vec<[f64; 7]> {
 fn mean_errors(e: &[[f64; 7]], idx: &[usize]) -> [f64; 7] {
     let mut out = [0.0; 7];
     for f in 0..7 {
-        let v: Vec<f64> = idx.iter().map(|&c| e[c][f]).filter(|v| v.is_finite()).collect();
+        let v: Vec<f64> = idx
+            .iter()
+            .map(|&c| e[c][f])
+            .filter(|v| v.is_finite())
+            .collect();
         out[f] = v.iter().sum::<f64>() / v.len().max(1) as f64;
     }
     out
@@ -427,7 +430,9 @@ mod tests {
         let y = (0..n)
             .map(|k| 0.5 * env(k) * (w * t(k) - 60f64.to_radians()).sin())
             .collect();
-        let p = (0..n).map(|k| 1e5 + 1e7 * env(k) * (w * t(k)).sin()).collect();
+        let p = (0..n)
+            .map(|k| 1e5 + 1e7 * env(k) * (w * t(k)).sin())
+            .collect();
         (x, y, p)
     }
 
@@ -450,16 +455,25 @@ mod tests {
         let (x, y, p) = series(12.5, 0.0, 2000, dt);
         let (xs, ys, ps) = series(13.0, 0.0, 2000, dt);
         let area = (0.01, 0.002);
-        let (m, s) = (Cycles::of(&x, &y, &p, dt, area), Cycles::of(&xs, &ys, &ps, dt, area));
+        let (m, s) = (
+            Cycles::of(&x, &y, &p, dt, area),
+            Cycles::of(&xs, &ys, &ps, dt, area),
+        );
         for (r, amp) in m.residual(&s).iter().zip([0.01, 0.005, 1e5]) {
             let worst = r.iter().fold(0.0f64, |a, v| a.max(v.abs()));
-            assert!(worst < 0.02 * amp, "same shape, other frequency: {worst} of {amp}");
+            assert!(
+                worst < 0.02 * amp,
+                "same shape, other frequency: {worst} of {amp}"
+            );
         }
         let scaled: Vec<f64> = x.iter().map(|v| 0.9 * v).collect();
         let s = Cycles::of(&scaled, &y, &p, dt, area);
         let rx = &m.residual(&s)[0];
         let peak = rx.iter().fold(0.0f64, |a, v| a.max(v.abs()));
-        assert!((peak / 0.001 - 1.0).abs() < 0.05, "10 % of a 1 cm amplitude: {peak}");
+        assert!(
+            (peak / 0.001 - 1.0).abs() < 0.05,
+            "10 % of a 1 cm amplitude: {peak}"
+        );
     }
 
     #[test]

@@ -5,16 +5,16 @@ pub mod bars;
 /// The error of a figure that could not be drawn.
 mod error;
 pub use error::DrawError;
-/// Measured points against two model lines over time (before and after an effect).
-pub mod overlay;
-/// Mean residual by phase of the cycle, before and after an effect, one panel per channel.
-pub mod phase_residual;
 /// Axis labels with units, power-of-ten ticks.
 pub mod axes;
 /// Bode diagram with the margins marked (seed Figure 8).
 pub mod bode;
 /// Root locus over a parameter.
 pub mod locus;
+/// Measured points against two model lines over time (before and after an effect).
+pub mod overlay;
+/// Mean residual by phase of the cycle, before and after an effect, one panel per channel.
+pub mod phase_residual;
 /// Pole map with the right half plane shaded (seed Figure 6).
 pub mod poles;
 /// PV diagram per vessel over one cycle.

@@ -31,7 +31,10 @@ pub fn overlay(
     let (lo, hi) = m
         .iter()
         .fold((f64::MAX, f64::MIN), |(l, h), p| (l.min(p.1), h.max(p.1)));
-    let (t0, t1) = (t.first().copied().unwrap_or(0.0), t.last().copied().unwrap_or(1.0));
+    let (t0, t1) = (
+        t.first().copied().unwrap_or(0.0),
+        t.last().copied().unwrap_or(1.0),
+    );
     if !(lo <= hi) || !(t0 < t1) {
         return Err(err(&"no finite measured samples to draw"));
     }

@@ -52,7 +52,10 @@ pub fn phase_residual(path: &Path, title: &str, panels: &[Panel]) -> Result<(), 
             .map_err(|e| err(&e))?;
         c.configure_mesh()
             .x_desc(axes::label("phase of the cycle", "deg"))
-            .y_desc(axes::label(&format!("{} measured - model", panel.channel), unit))
+            .y_desc(axes::label(
+                &format!("{} measured - model", panel.channel),
+                unit,
+            ))
             .draw()
             .map_err(|e| err(&e))?;
         c.draw_series(LineSeries::new(vec![(0.0, 0.0), (360.0, 0.0)], BLACK))
