@@ -40,3 +40,64 @@ fn rest_state_is_an_equilibrium() {
         }
     }
 }
+
+fn all(n: usize, closure: Closure) -> [Box<dyn Model>; 3] {
+    [
+        Box::new(HeadWall::new(n, closure).unwrap()),
+        Box::new(MatrixWall::new(n, closure).unwrap()),
+        Box::new(HeadMatrix::new(n, closure).unwrap()),
+    ]
+}
+
+/// The generated Jacobian and parameter Jacobian against Ridders-extrapolated central
+/// differences (relative 1e-6 on entries above 1e-8 of their scaled row or column maximum),
+/// at 4 seeded random states of each pressure spread.
+#[test]
+fn jacobians_match_finite_differences() {
+    for n in [1, 2, 3, 10, 50] {
+        let closures: &[Closure] = if n <= 3 {
+            &[Closure::Full, Closure::Frozen]
+        } else {
+            &[Closure::Full]
+        };
+        for &closure in closures {
+            for (k, m) in all(n, closure).iter().enumerate() {
+                let label = format!("{} n={n} ({closure})", m.name());
+                common::assert_jacobians(m.as_ref(), &label, 1000 + 10 * n as u64 + k as u64, 4);
+            }
+        }
+    }
+}
+
+/// docs/physics.md section 10 with walls: `d/dt (gas + walls + mechanics) = heat from outside
+/// + boundary + mechanical`, to round-off at random states; the gas mass does not change.
+#[test]
+fn energy_budget_holds_with_walls() {
+    let mut worst = 0.0f64;
+    for n in [1, 2, 3, 10, 50] {
+        for m in all(n, Closure::Full) {
+            let p = m.default_params();
+            let mut rng = common::rng(77 + n as u64);
+            for spread in [common::Spread::Wide, common::Spread::Balanced] {
+                for _ in 0..4 {
+                    let x = common::random_state(m.as_ref(), &p, spread, &mut rng);
+                    let (de, terms) = common::energy_rate(m.as_ref(), &p, &x);
+                    let gap = (de - terms).abs() / m.energy(&p, &x);
+                    worst = worst.max(gap);
+                    assert!(
+                        gap < 1e-12,
+                        "{} n={n}: dE/dt {de:e} vs terms {terms:e}",
+                        m.name()
+                    );
+                    let (dm, size) = common::mass_rate(m.as_ref(), &p, &x);
+                    assert!(
+                        size > 0.0 && dm.abs() <= 1e-14 * size,
+                        "{} n={n}: dm/dt {dm:e} of {size:e}",
+                        m.name()
+                    );
+                }
+            }
+        }
+    }
+    eprintln!("energy budget: max |dE/dt - terms| / E = {worst:.2e} (1/s)");
+}
