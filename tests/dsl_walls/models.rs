@@ -142,3 +142,32 @@ wall_engine! {
         link matrix[n - 1] -> Tk { conductance: 2.0 * Gm * n }
     }
 }
+
+stirling_model! {
+    /// One gas space on one piston whose liner is a thermal mass cooled to the ambient.
+    pub model OneWall {
+        params {
+            R: 287.05 "J/(kg K)",
+            gamma: 1.4 "-",
+            P0: 101325.0 "Pa",
+            m: 0.33363 "kg",
+            k: 61.482 "N/m",
+            A: 2.6e-3 "m^2",
+            V0: 1.5e-4 "m^3",
+            Tamb: 300.0 "K",
+            h: 500.0 "W/(m^2 K)",
+            Aw: 0.0128 "m^2",
+            /// heat capacity of the liner
+            C: 50.0 "J/K",
+            /// conductance from the liner to the ambient
+            G: 0.5 "W/K",
+            eps: 1.0e-5 "kg/s",
+        }
+        gas { R: R, gamma: gamma, charge: P0, mdot_eps: eps }
+        body piston(y, w) { mass: m, spring: k }
+        space bounce { pressure: P0, faces { piston: A } }
+        cv gas { volume: V0, faces { piston: -A }, port liner { h: h, area: Aw, wall: sleeve } }
+        wall sleeve { capacity: C, rest: Tamb }
+        link sleeve -> Tamb { conductance: G }
+    }
+}

@@ -147,16 +147,22 @@ pub fn walls(arena: &Arena, lay: &Layout, private: &TokenStream) -> TokenStream 
         { #(#lets)* __q += #heat0; #(__e += #es;)* #(__q += #hs;)* }
     };
     for w in lay.sys.walls.iter().filter(|w| w.array) {
-        let b = emit_block(arena, &[w.energy, w.heat], &leaf, private);
+        let heated = arena.as_const(w.heat) != Some(0.0);
+        let roots = if heated {
+            vec![w.energy, w.heat]
+        } else {
+            vec![w.energy]
+        };
+        let b = emit_block(arena, &roots, &leaf, private);
         let (lets, outs) = (b.lets, b.outputs);
-        let (e, q) = (&outs[0], &outs[1]);
+        let (e, q) = (&outs[0], outs.get(1).map(|q| quote!(__q += #q;)));
         code.extend(quote! {
             for j in 0..n {
                 let jf = j as f64;
                 let _ = jf;
                 #(#lets)*
                 __e += #e;
-                __q += #q;
+                #q
             }
         });
     }

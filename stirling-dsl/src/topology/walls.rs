@@ -118,7 +118,7 @@ impl Assembler<'_> {
     /// Temperature and display name of a conduction end seen from `row`.
     fn heat_end(&mut self, end: HeatEnd, row: RowAt, base: i32) -> (Id, String) {
         match end {
-            HeatEnd::Fixed(t) => (t, String::new()),
+            HeatEnd::Fixed(t) => (t, self.fixed_name(t)),
             HeatEnd::Wall(e) => {
                 let Vessel::Wall(w) = e.vessel else {
                     unreachable!("a conduction end is a wall")
@@ -135,6 +135,15 @@ impl Assembler<'_> {
                 let wall = &self.t.walls[w];
                 (t, end_name(&wall.name, wall.array, shown))
             }
+        }
+    }
+
+    /// The display name of a fixed temperature: its parameter or `let` name.
+    fn fixed_name(&self, t: Id) -> String {
+        match *self.t.arena.node(t) {
+            Node::Sym(Sym::Param(k)) => self.t.params[k as usize].name.clone(),
+            Node::Named(i, _) => self.t.arena.name(i).to_string(),
+            _ => "fixed".to_string(),
         }
     }
 
