@@ -141,7 +141,8 @@ impl Lower {
             _ => None,
         };
         let Some(base) = base.filter(|b| self.is_wall(b)) else {
-            let msg = format!("unknown wall `{}`: a port's `wall` is a declared wall ({}) or a temperature expression of parameters", quote::quote!(#ix).to_string().split('[').next().unwrap_or("").trim(), self.wall_list());
+            let name = base.map_or_else(|| quote::quote!(#ix).to_string(), |b| b.to_string());
+            let msg = format!("unknown wall `{name}`: a port's `wall` is a declared wall ({}) or a temperature expression of parameters", self.wall_list());
             self.cx.error(ix.expr.span(), msg);
             return None;
         };
