@@ -13,6 +13,7 @@
 
 use super::decl::{LinkDecl, Topology, Vessel};
 use super::frame::{place, Place};
+use super::links::{end_name, end_place, enthalpy, quadratic_flow, rel_min, touches};
 use super::system::{BlockInfo, BlockKind, Row, System, Variant, VesselTerms, VARIANTS};
 use super::walls::PortHeat;
 use crate::expr::{At, Func, Id, Sym};
@@ -27,14 +28,14 @@ pub(super) enum RowAt {
 
 /// Quantities of a CV in its own frame.
 #[derive(Clone, Copy, Debug)]
-struct CvTemplate {
-    p: Id,
-    m: Id,
-    v: Id,
-    vdot: Id,
-    t: Id,
-    q: Id,
-    m0: Id,
+pub(super) struct CvTemplate {
+    pub(super) p: Id,
+    pub(super) m: Id,
+    pub(super) v: Id,
+    pub(super) vdot: Id,
+    pub(super) t: Id,
+    pub(super) q: Id,
+    pub(super) m0: Id,
 }
 
 /// Assemble the equations of `topo` under `closure`.
@@ -46,7 +47,7 @@ pub(super) struct Assembler<'t> {
     pub(super) t: &'t mut Topology,
     closure: Closure,
     array_blocks: Vec<bool>,
-    cv: Vec<CvTemplate>,
+    pub(super) cv: Vec<CvTemplate>,
     /// Per CV, the heat of each port that names a declared wall, in the CV's frame.
     pub(super) port_heat: Vec<Vec<PortHeat>>,
 }
@@ -171,7 +172,7 @@ impl<'t> Assembler<'t> {
     }
 
     /// Position and velocity symbols of body `k`.
-    fn body_syms(&mut self, k: usize) -> (Id, Id) {
+    pub(super) fn body_syms(&mut self, k: usize) -> (Id, Id) {
         let a = &mut self.t.arena;
         (
             a.sym(Sym::State(Topology::pos_block(k), At::Scalar)),
@@ -180,7 +181,7 @@ impl<'t> Assembler<'t> {
     }
 
     /// `sum coeff * q` and `sum coeff * v` over faces.
-    fn face_sums(&mut self, faces: &[super::decl::FaceDecl]) -> (Id, Id) {
+    pub(super) fn face_sums(&mut self, faces: &[super::decl::FaceDecl]) -> (Id, Id) {
         let (mut dv, mut vdot) = (self.t.arena.num(0.0), self.t.arena.num(0.0));
         for f in faces.iter().cloned() {
             let (q, v) = self.body_syms(f.body);
@@ -447,7 +448,7 @@ impl<'t> Assembler<'t> {
     }
 
     /// The flow of link `l` seen from `row`, whose own section is `base` in the link's frame.
-    fn flow(&mut self, l: &LinkDecl, row: RowAt, base: i32, into: bool) -> Flow {
+    pub(super) fn flow(&mut self, l: &LinkDecl, row: RowAt, base: i32, into: bool) -> Flow {
         let (p_from, t_from, from_name) = self.end_state(l.from.vessel, l.from.at, row, base);
         let (p_to, t_to, to_name) = self.end_state(l.to.vessel, l.to.at, row, base);
         let shift = if l.is_chain() {
@@ -504,220 +505,11 @@ impl<'t> Assembler<'t> {
             }
         }
     }
-
-    fn cv_terms(&mut self, i: usize) -> VesselTerms {
-        let tpl = self.cv[i];
-        let gas = self.t.gas.clone().expect("checked");
-        let a = &mut self.t.arena;
-        let one = a.num(1.0);
-        let gm1 = a.sub(gas.gamma, one);
-        let pv = a.mul(tpl.p, tpl.v);
-        let energy = a.div(pv, gm1);
-        let zero = a.num(0.0);
-        // heat exchanged with a declared wall stays inside the system
-        let heat = match self.port_heat[i].iter().map(|h| h.q).collect::<Vec<_>>() {
-            internal if internal.is_empty() => tpl.q,
-            internal => {
-                let sum = a.sum(internal);
-                a.sub(tpl.q, sum)
-            }
-        };
-        let c = &self.t.cvs[i];
-        VesselTerms {
-            name: c.name.clone(),
-            array: c.array,
-            is_cv: true,
-            pressure: tpl.p,
-            volume: tpl.v,
-            energy,
-            heat,
-            boundary: zero,
-            mass: tpl.m,
-            temperature: tpl.t,
-        }
-    }
-
-    fn space_terms(&mut self, s: usize) -> VesselTerms {
-        let sp = self.t.spaces[s].clone();
-        let (dv, vdot) = self.face_sums(&sp.faces);
-        let outflow = self.space_enthalpy_out(s);
-        let a = &mut self.t.arena;
-        let volume = a.add(sp.volume, dv);
-        let work = a.mul(sp.pressure, vdot);
-        let boundary = a.sub(work, outflow);
-        let zero = a.num(0.0);
-        let temperature = sp.temperature.unwrap_or_else(|| a.num(f64::NAN));
-        VesselTerms {
-            name: sp.name.clone(),
-            array: false,
-            is_cv: false,
-            pressure: sp.pressure,
-            volume,
-            energy: zero,
-            heat: zero,
-            boundary,
-            mass: zero,
-            temperature,
-        }
-    }
-
-    /// Enthalpy flowing from the CVs into space `s` (scalar CV ends only; checked).
-    fn space_enthalpy_out(&mut self, s: usize) -> Id {
-        let links = self.t.links.clone();
-        let mut terms = Vec::new();
-        for l in &links {
-            let into_space = l.to.vessel == Vessel::Space(s);
-            if !into_space && l.from.vessel != Vessel::Space(s) {
-                continue;
-            }
-            let f = self.flow(l, RowAt::Scalar, 0, true);
-            let a = &mut self.t.arena;
-            terms.push(if into_space { f.h } else { a.neg(f.h) });
-        }
-        self.t.arena.sum(terms)
-    }
-
-    fn mech_energy(&mut self) -> Id {
-        let mut total = self.t.arena.num(0.0);
-        for k in 0..self.t.bodies.len() {
-            let b = self.t.bodies[k].clone();
-            let (q, v) = self.body_syms(k);
-            let a = &mut self.t.arena;
-            let half = a.num(0.5);
-            let (v2, q2) = (a.powi(v, 2), a.powi(q, 2));
-            let (mv, kq) = (a.mul(b.mass, v2), a.mul(b.spring, q2));
-            let s = a.add(mv, kq);
-            let e = a.mul(half, s);
-            total = a.add(total, e);
-        }
-        total
-    }
-
-    /// `sum v (F - c v - cq v|v|) - sum c (v_a - v_b)^2`.
-    fn mech_power(&mut self) -> Id {
-        let mut total = self.t.arena.num(0.0);
-        for k in 0..self.t.bodies.len() {
-            let b = self.t.bodies[k].clone();
-            let v = self.body_syms(k).1;
-            let a = &mut self.t.arena;
-            let cv = a.mul(b.damper, v);
-            let av = a.func(Func::Abs, v);
-            let vav = a.mul(v, av);
-            let qv = a.mul(b.quad_damper, vav);
-            let f = a.sub(b.force, cv);
-            let f = a.sub(f, qv);
-            let p = a.mul(v, f);
-            total = a.add(total, p);
-        }
-        for c in self.t.couplings.clone() {
-            let (va, vb) = (self.body_syms(c.a).1, self.body_syms(c.b).1);
-            let a = &mut self.t.arena;
-            let dv = a.sub(va, vb);
-            let d2 = a.powi(dv, 2);
-            let p = a.mul(c.damper, d2);
-            total = a.sub(total, p);
-        }
-        total
-    }
 }
 
 /// One link's flow as seen by a CV balance.
-struct Flow {
-    mdot: Id,
-    h: Id,
-    into: bool,
-}
-
-/// Whether a link end at `at` touches the row's section; returns the row's offset in the
-/// link's frame (`0`, or `1` for the upper end of a chain link whose lower offset is `rel_min`).
-pub(super) fn touches(at: At, row: RowAt, rel_min: i32) -> Option<i32> {
-    match (at, row) {
-        (At::Scalar, RowAt::Scalar) => Some(0),
-        (At::First, RowAt::Array(_, v)) => {
-            matches!(v, Variant::Single | Variant::First).then_some(0)
-        }
-        (At::Last, RowAt::Array(_, v)) => matches!(v, Variant::Single | Variant::Last).then_some(0),
-        (At::Rel(r), RowAt::Array(_, v)) => {
-            let upper = r > rel_min;
-            let ok = if upper {
-                matches!(v, Variant::Interior | Variant::Last)
-            } else {
-                matches!(v, Variant::First | Variant::Interior)
-            };
-            ok.then_some(r)
-        }
-        _ => None,
-    }
-}
-
-/// The lower `Rel` offset of a link's two ends (`0` if neither is `Rel`).
-pub(super) fn rel_min(from: At, to: At) -> i32 {
-    let r = |a: At| if let At::Rel(r) = a { r } else { 0 };
-    r(from).min(r(to))
-}
-
-/// Where a link end of array `vessel` sits relative to the row's own section.
-pub(super) fn end_place(vessel: Vessel, at: At, row: RowAt, base: i32) -> Place {
-    let own_array = matches!(row, RowAt::Array(v, _) if v == vessel);
-    match at {
-        At::Scalar => Place::Own,
-        At::Rel(r) => Place::Shift(r - base),
-        At::First => match row {
-            RowAt::Array(_, Variant::Single | Variant::First) if own_array => Place::Own,
-            _ => Place::First,
-        },
-        At::Last => match row {
-            RowAt::Array(_, Variant::Single | Variant::Last) if own_array => Place::Own,
-            _ => Place::Last,
-        },
-    }
-}
-
-pub(super) fn end_name(name: &str, array: bool, at: At) -> String {
-    if !array {
-        return name.to_string();
-    }
-    match at {
-        At::First => format!("{name}[0]"),
-        At::Last => format!("{name}[n-1]"),
-        At::Rel(r) => format!("{name}[{}]", super::frame::index_text(r)),
-        At::Scalar => name.to_string(),
-    }
-}
-
-/// `dP = R mdot + Rq mdot |mdot|` solved for `mdot`: `2 dP / (R + sqrt(R^2 + 4 Rq |dP|))`.
-fn quadratic_flow(a: &mut crate::expr::Arena, dp: Id, r: Id, rq: Id) -> Id {
-    let (two, four) = (a.num(2.0), a.num(4.0));
-    let r2 = a.powi(r, 2);
-    let adp = a.func(Func::Abs, dp);
-    let t = a.mul(four, rq);
-    let t = a.mul(t, adp);
-    let s = a.add(r2, t);
-    let root = a.func(Func::Sqrt, s);
-    let den = a.add(r, root);
-    let num = a.mul(two, dp);
-    a.div(num, den)
-}
-
-/// `H = cp mdot (s T_from + (1 - s) T_to)`, `s = (1 + tanh(mdot/eps))/2`, `cp = gamma R/(gamma-1)`.
-fn enthalpy(
-    a: &mut crate::expr::Arena,
-    mdot: Id,
-    t_from: Id,
-    t_to: Id,
-    gas: &super::decl::GasDecl,
-) -> Id {
-    let (one, half) = (a.num(1.0), a.num(0.5));
-    let ratio = a.div(mdot, gas.mdot_eps);
-    let th = a.func(Func::Tanh, ratio);
-    let opt = a.add(one, th);
-    let s = a.mul(half, opt);
-    let dt = a.sub(t_from, t_to);
-    let sdt = a.mul(s, dt);
-    let t_up = a.add(t_to, sdt);
-    let gm1 = a.sub(gas.gamma, one);
-    let gr = a.mul(gas.gamma, gas.r);
-    let cp = a.div(gr, gm1);
-    let cm = a.mul(cp, mdot);
-    a.mul(cm, t_up)
+pub(super) struct Flow {
+    pub(super) mdot: Id,
+    pub(super) h: Id,
+    pub(super) into: bool,
 }

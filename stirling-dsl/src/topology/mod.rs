@@ -1,8 +1,10 @@
 //! The topology description and its energetic assembly into equations.
 
 mod assemble;
+mod budget;
 mod decl;
 pub mod frame;
+mod links;
 mod system;
 mod walls;
 

@@ -13,9 +13,10 @@
 
 use std::collections::HashMap;
 
-use super::assemble::{end_name, end_place, rel_min, touches, Assembler, RowAt};
+use super::assemble::{Assembler, RowAt};
 use super::decl::{ConductionDecl, HeatEnd, Topology, Vessel};
 use super::frame::Place;
+use super::links::{end_name, end_place, rel_min, touches};
 use super::system::{BlockInfo, BlockKind, WallTerms};
 use crate::expr::{At, Id, Node, Sym};
 
