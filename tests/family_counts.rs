@@ -76,6 +76,7 @@ fn assert_layout(m: &dyn Model, ncv: usize) {
             StateKind::Velocity(_) => "m/s",
             StateKind::Pressure(_) => "Pa",
             StateKind::Mass(_) => "kg",
+            StateKind::WallTemperature(_) => "K",
         };
         assert_eq!(u, want, "{} {k:?}", m.name());
     }

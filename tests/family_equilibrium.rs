@@ -48,6 +48,7 @@ fn typical(m: &dyn Model, p: &[f64], eq: &[f64]) -> Vec<f64> {
             StateKind::Velocity(_) => 0.1,
             StateKind::Pressure(_) => 0.01 * pmean,
             StateKind::Mass(_) => 0.01 * e,
+            StateKind::WallTemperature(_) => 1.0,
         })
         .collect()
 }
@@ -65,6 +66,7 @@ fn off_equilibrium(m: &dyn Model, p: &[f64]) -> Vec<f64> {
             StateKind::Velocity(_) => *xi += -0.1,
             StateKind::Pressure(i) => *xi = pmean * (1.0 + 0.01 * (i + 1) as f64),
             StateKind::Mass(i) => *xi *= 1.02 * (1.0 - 0.005 * i as f64),
+            StateKind::WallTemperature(_) => *xi += 1.0,
         }
     }
     x
@@ -112,7 +114,9 @@ fn equilibrium_is_at_rest_at_the_charge_pressure() {
                     assert_eq!(*v, 0.0, "{} {}", label(m), s.name)
                 }
                 StateKind::Pressure(_) => assert_eq!(*v, pmean, "{} {}", label(m), s.name),
-                StateKind::Mass(_) => assert!(*v > 0.0, "{} {}", label(m), s.name),
+                StateKind::Mass(_) | StateKind::WallTemperature(_) => {
+                    assert!(*v > 0.0, "{} {}", label(m), s.name)
+                }
             }
         }
     }
@@ -157,6 +161,7 @@ fn step(m: &dyn Model, x: &[f64]) -> Vec<f64> {
             StateKind::Velocity(_) => 1e-6,
             StateKind::Pressure(_) => 1e-4,
             StateKind::Mass(_) => 1e-7 * v.abs(),
+            StateKind::WallTemperature(_) => 1e-4,
         })
         .collect()
 }

@@ -16,6 +16,12 @@
 //!     link hot -> regen[0] { resistance: Rf / (2.0 * n) }
 //!     link regen[j] -> regen[j + 1] for j in 0..n - 1 { resistance: Rf / n, quadratic: Rq / n }
 //!     link cold -> bounce { conductance: Gleak }            // mdot = G dP, exact zero at G = 0
+//!     wall head { capacity: Ch, rest: Th, input: Qin }      // a thermal mass: Tw_head is a state
+//!     wall matrix[n] { capacity: Cm / n, rest: Th - (j + 0.5) * (Th - Tk) / n }
+//!     // a CV port names a wall instead of a fixed temperature: `wall: head`, `wall: matrix[j]`
+//!     link matrix[j] -> matrix[j + 1] for j in 0..n - 1 { conductance: Gm * n }  // conduction
+//!     link head -> matrix[0] { conductance: 2.0 * Gm * n }  // between walls ...
+//!     link matrix[n - 1] -> Tk { conductance: 2.0 * Gm * n } // ... or to a fixed temperature
 //! }
 //! ```
 
@@ -164,6 +170,8 @@ pub enum Item {
     Coupling(CouplingAst),
     Space(VesselAst),
     Cv(VesselAst),
+    /// A wall with a temperature state (its fields; faces and ports are refused).
+    Wall(VesselAst),
     Link(LinkAst),
 }
 
@@ -232,11 +240,12 @@ fn item(input: ParseStream) -> syn::Result<Item> {
         }
         "space" => Item::Space(vessel(input)?),
         "cv" => Item::Cv(vessel(input)?),
+        "wall" => Item::Wall(vessel(input)?),
         "link" => link(input, kw.span())?,
         other => {
             return Err(syn::Error::new(
                 kw.span(),
-                format!("unknown item `{other}`: expected one of name, params, let, gas, body, coupling, space, cv, link"),
+                format!("unknown item `{other}`: expected one of name, params, let, gas, body, coupling, space, cv, wall, link"),
             ))
         }
     };

@@ -78,14 +78,16 @@ pub(crate) struct Lower {
     declared: HashMap<String, Span>,
     params: HashMap<String, u32>,
     lets: HashMap<String, Id>,
-    states: HashMap<String, Sym>,
+    pub(crate) states: HashMap<String, Sym>,
     bodies: HashMap<String, usize>,
     pub(crate) vessels: HashMap<String, Vessel>,
     cv_arrays: Vec<bool>,
+    /// Declared walls: index and whether an array.
+    pub(crate) walls: HashMap<String, (usize, bool)>,
 }
 
 impl Lower {
-    fn declare(&mut self, id: &Ident) -> bool {
+    pub(crate) fn declare(&mut self, id: &Ident) -> bool {
         let name = id.to_string();
         if self.declared.contains_key(&name) {
             self.cx.error(id.span(), format!("duplicate name `{name}`: every parameter, let, state, body, space and CV needs its own name"));
@@ -133,6 +135,11 @@ impl Lower {
             }
         }
         for it in &ast.items {
+            if let Item::Wall(v) = it {
+                self.declare_wall(v);
+            }
+        }
+        for it in &ast.items {
             match it {
                 Item::Let(name, e) => self.let_(name, e),
                 Item::Gas(span, f) => self.gas(*span, f),
@@ -140,6 +147,7 @@ impl Lower {
                 Item::Coupling(c) => self.coupling(c),
                 Item::Space(v) => self.space(v),
                 Item::Cv(v) => self.cv(v),
+                Item::Wall(v) => self.wall(v),
                 Item::Link(l) => self.link(l),
                 Item::Name(_) | Item::Params(_) => {}
             }
@@ -185,7 +193,7 @@ impl Lower {
     }
 
     /// As [`Lower::expr`], and the value must not depend on the motion.
-    fn static_expr(&mut self, e: &syn::Expr, index: Option<&str>, what: &str) -> Id {
+    pub(crate) fn static_expr(&mut self, e: &syn::Expr, index: Option<&str>, what: &str) -> Id {
         let id = self.expr(e, index);
         if self
             .topo
@@ -292,7 +300,7 @@ impl Lower {
     }
 
     /// Split fields into the known ones; unknown or repeated fields are errors.
-    fn fields<'f>(
+    pub(crate) fn fields<'f>(
         &mut self,
         fields: &'f [Field],
         known: &[&str],
@@ -319,7 +327,7 @@ impl Lower {
         out
     }
 
-    fn required(
+    pub(crate) fn required(
         &mut self,
         f: &HashMap<String, &Field>,
         key: &str,
@@ -339,7 +347,7 @@ impl Lower {
         }
     }
 
-    fn optional(
+    pub(crate) fn optional(
         &mut self,
         f: &HashMap<String, &Field>,
         key: &str,
@@ -465,9 +473,7 @@ impl Lower {
         let what = format!("control volume `{}`", v.name);
         let index = v.array.as_ref().map(|_| "j");
         if let Some(n) = &v.array {
-            if n != "n" {
-                self.cx.error(n.span(), format!("{what}: an array's length is the run-time section count: write `[n]`, found `[{n}]`"));
-            }
+            self.check_array_length(n, &what);
             if let Some(f) = v.faces.first() {
                 self.cx.error(f.name.span(), format!("{what}: faces on an array of CVs are not supported; give the faces to a single CV"));
             }
@@ -505,14 +511,14 @@ impl Lower {
         let f = self.fields(&p.fields, &["h", "area", "wall"], &what);
         let h = self.required(&f, "h", p.name.span(), &what, index);
         let area = self.required(&f, "area", p.name.span(), &what, index);
-        let wall = match f.get("wall") {
-            Some(field) => self.expr(&field.value, index),
+        let (wall, wall_ref) = match f.get("wall") {
+            Some(field) => self.port_wall(&field.value, index),
             None => {
                 self.cx.error(
                     p.name.span(),
-                    format!("{what} has no wall temperature: expected `wall: <expression>`"),
+                    format!("{what} has no wall temperature: expected `wall: <expression>` or `wall: <declared wall>`"),
                 );
-                self.topo.arena.num(1.0)
+                (self.topo.arena.num(1.0), None)
             }
         };
         PortDecl {
@@ -520,10 +526,14 @@ impl Lower {
             h,
             area,
             wall,
+            wall_ref,
         }
     }
 
     fn link(&mut self, l: &LinkAst) {
+        if self.is_wall(&l.from.name) || self.is_wall(&l.to.name) {
+            return self.conduction(l);
+        }
         let var = l.range.as_ref().map(|r| r.var.to_string());
         let from = self.end(&l.from, var.as_deref());
         let to = self.end(&l.to, var.as_deref());
@@ -564,7 +574,11 @@ impl Lower {
             quadratic,
             conductance,
         };
-        if self.link_shape_ok(l, &link) {
+        if self.link_shape_ok(
+            l,
+            (link.from.vessel, link.from.at),
+            (link.to.vessel, link.to.at),
+        ) {
             self.topo.links.push(link);
         }
     }
@@ -612,6 +626,18 @@ impl Lower {
             }
             (Some(ix), true) => self.index(ix, var).map(|at| End { vessel, at }),
         }
+    }
+
+    pub(crate) fn bodies_len(&self) -> usize {
+        self.bodies.len()
+    }
+
+    pub(crate) fn cvs_len(&self) -> usize {
+        self.cv_arrays.len()
+    }
+
+    pub(crate) fn is_param_or_let(&self, name: &str) -> bool {
+        self.params.contains_key(name) || self.lets.contains_key(name)
     }
 
     /// Whether CV number `i` (declaration order) is an array.

@@ -9,6 +9,7 @@ mod check;
 mod expand;
 mod expr;
 mod links;
+mod walls;
 
 use proc_macro::TokenStream;
 

@@ -2,7 +2,7 @@
 //! chain link stays inside its array.
 
 use stirling_dsl::expr::{At, Sym};
-use stirling_dsl::topology::{LinkDecl, Vessel};
+use stirling_dsl::topology::Vessel;
 use syn::spanned::Spanned;
 
 use crate::ast::LinkAst;
@@ -49,9 +49,14 @@ impl Lower {
 
     /// A chain link (`a[j] -> a[j + 1] for j in 0..n - 1`) must stay inside its array;
     /// a link without `for` must name fixed sections.
-    pub(crate) fn link_shape_ok(&mut self, l: &LinkAst, link: &LinkDecl) -> bool {
+    pub(crate) fn link_shape_ok(
+        &mut self,
+        l: &LinkAst,
+        from: (Vessel, At),
+        to: (Vessel, At),
+    ) -> bool {
         let rel = |at: At| if let At::Rel(r) = at { Some(r) } else { None };
-        let (rf, rt) = (rel(link.from.at), rel(link.to.at));
+        let (rf, rt) = (rel(from.1), rel(to.1));
         let Some(range) = &l.range else {
             if rf.is_some() || rt.is_some() {
                 self.cx.error(
@@ -66,7 +71,7 @@ impl Lower {
             self.cx.error(range.span, "a `for` link must index both ends with the range variable, e.g. `a[j] -> a[j + 1]`");
             return false;
         };
-        if link.from.vessel != link.to.vessel {
+        if from.0 != to.0 {
             self.cx
                 .error(l.span, "a chain link must join sections of one array");
             return false;
@@ -87,7 +92,7 @@ impl Lower {
             return false;
         }
         if e_off + hi as f64 > 0.0 {
-            let name = self.vessel_name(link.from.vessel);
+            let name = self.vessel_name(from.0);
             let reach = e_off as i32 + hi - 1;
             let reach = if reach == 0 {
                 "n".to_string()
@@ -111,6 +116,10 @@ impl Lower {
     }
 
     fn vessel_name(&self, v: Vessel) -> String {
+        if let Vessel::Wall(w) = v {
+            let found = self.walls.iter().find(|(_, &(i, _))| i == w);
+            return found.map(|(k, _)| k.clone()).unwrap_or_default();
+        }
         self.vessels
             .iter()
             .find(|(_, &x)| x == v)

@@ -60,6 +60,43 @@ const TWO_CV: &str = r#"
     }
 "#;
 
+/// A regenerator chain `r[n]` whose matrix `matrix[n]` is a thermal mass, conducting along
+/// itself and to the fixed ends.
+const WALL_ARRAY: &str = r#"
+    /// A hot CV and a regenerator chain with a matrix of finite heat capacity.
+    pub model WallArray {
+        params {
+            R: 287.05 "J/(kg K)",
+            gamma: 1.4 "-",
+            P0: 101325.0 "Pa",
+            m: 0.3 "kg",
+            k: 60.0 "N/m",
+            A: 2.6e-3 "m^2",
+            V0: 1.5e-4 "m^3",
+            Vr: 4.0e-5 "m^3",
+            Th: 600.0 "K",
+            Tk: 300.0 "K",
+            h: 100.0 "W/(m^2 K)",
+            Aw: 0.0377 "m^2",
+            Rf: 1.0e5 "Pa s/kg",
+            Cm: 25.0 "J/K",
+            Gm: 0.03 "W/K",
+            eps: 1.0e-5 "kg/s",
+        }
+        gas { R: R, gamma: gamma, charge: P0, mdot_eps: eps }
+        body piston(y, w) { mass: m, spring: k }
+        space bounce { pressure: P0, faces { piston: A } }
+        cv hot { volume: V0, faces { piston: -A }, port heater { h: h, area: Aw, wall: Th } }
+        cv r[n] { volume: Vr / n, port matrix { h: h, area: Aw / n, wall: matrix[j] } }
+        wall matrix[n] { capacity: Cm / n, rest: Th - (j + 0.5) * (Th - Tk) / n }
+        link hot -> r[0] { resistance: Rf / n }
+        link r[j] -> r[j + 1] for j in 0..n - 1 { resistance: Rf / n }
+        link matrix[j] -> matrix[j + 1] for j in 0..n - 1 { conductance: Gm * n }
+        link Th -> matrix[0] { conductance: 2.0 * Gm * n }
+        link matrix[n - 1] -> Tk { conductance: 2.0 * Gm * n }
+    }
+"#;
+
 fn parse(src: &str) -> ModelAst {
     syn::parse_str(src).expect("the test model parses")
 }
@@ -68,6 +105,20 @@ fn parse(src: &str) -> ModelAst {
 fn expanded(src: &str) -> String {
     let tokens = expand(parse(src)).unwrap_or_else(|e| panic!("expansion failed: {e}"));
     let file: syn::File = syn::parse2(tokens).expect("the expansion is valid Rust");
+    prettyplease::unparse(&file)
+}
+
+/// Only the generated methods named `names` of the expansion, formatted.
+fn methods(src: &str, names: &[&str]) -> String {
+    let tokens = expand(parse(src)).unwrap_or_else(|e| panic!("expansion failed: {e}"));
+    let mut file: syn::File = syn::parse2(tokens).expect("the expansion is valid Rust");
+    file.items.retain_mut(|item| match item {
+        syn::Item::Impl(imp) if imp.trait_.is_none() => {
+            imp.items.retain(|it| matches!(it, syn::ImplItem::Fn(f) if names.contains(&f.sig.ident.to_string().as_str())));
+            !imp.items.is_empty()
+        }
+        _ => false,
+    });
     prettyplease::unparse(&file)
 }
 
@@ -113,4 +164,19 @@ fn equations_two_cv_full() {
 #[test]
 fn equations_two_cv_frozen() {
     insta::assert_snapshot!(equations(TWO_CV, "model twocv, closure frozen"));
+}
+
+/// The generated Rust of a wall array: the right-hand side, the Jacobian and the walls'
+/// energy terms of the full closure.
+#[test]
+fn expansion_wall_array() {
+    insta::assert_snapshot!(methods(
+        WALL_ARRAY,
+        &["__rhs_full", "__jac_full", "__walls_full"]
+    ));
+}
+
+#[test]
+fn equations_wall_array_full() {
+    insta::assert_snapshot!(equations(WALL_ARRAY, "model wallarray, closure full"));
 }

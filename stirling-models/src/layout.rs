@@ -15,6 +15,8 @@ pub struct StateLayout {
     /// CV pressures, in vessel order (the hot side first in the family).
     pub pressures: Vec<usize>,
     pub masses: Vec<usize>,
+    /// Wall temperatures (walls with a heat capacity), in wall order.
+    pub walls: Vec<usize>,
 }
 
 impl StateLayout {
@@ -39,6 +41,7 @@ impl StateLayout {
                     l.gas.push(i);
                     l.masses.push(i);
                 }
+                StateKind::WallTemperature(_) => l.walls.push(i),
             }
         }
         l

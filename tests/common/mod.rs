@@ -48,6 +48,7 @@ pub fn random_state(model: &dyn Model, p: &[f64], spread: Spread, rng: &mut StdR
                 }
             },
             StateKind::Mass(_) => *xi * (1.0 + 0.05 * u),
+            StateKind::WallTemperature(_) => *xi + 20.0 * u,
         };
     }
     x
@@ -85,6 +86,7 @@ pub fn state_scales(model: &dyn Model, p: &[f64]) -> Vec<f64> {
             StateKind::Velocity(_) => 0.1,
             StateKind::Pressure(_) => 100.0,
             StateKind::Mass(_) => x0.abs(),
+            StateKind::WallTemperature(_) => 10.0,
         })
         .collect()
 }
@@ -97,18 +99,21 @@ pub fn state_scales(model: &dyn Model, p: &[f64]) -> Vec<f64> {
 /// The quadratic flow law's `mdot(dP)` is only once differentiable at `dP = 0` (it holds
 /// `dP |dP|`), so a central difference must not straddle that point either: the pressure
 /// step is also at most 5 % of the smallest gap between two pressures of `x`.
+///
+/// Wall temperatures start at 1 K: they enter the gas rows linearly (`h A (Tw - T)`), whose
+/// values reach `|P'| ~ 5e11 Pa/s` at wide pressure spreads on short links (n = 50), so a
+/// 0.01 K step leaves a round-off of `eps |P'| / h ~ 5e-3` on `dP'/dTw = (gamma-1) h A / V
+/// = 3.77e4`, 1e-6 relative: the size of the tolerance.
 pub fn fd_steps(model: &dyn Model, p: &[f64], x: &[f64]) -> Vec<f64> {
     let dp = 1e-3f64.min(0.05 * min_pressure_gap(model, x));
     let states = model.states();
     states
         .iter()
         .zip(state_scales(model, p))
-        .map(|(s, scale)| {
-            if matches!(s.kind, StateKind::Pressure(_)) {
-                dp
-            } else {
-                1e-3 * scale
-            }
+        .map(|(s, scale)| match s.kind {
+            StateKind::Pressure(_) => dp,
+            StateKind::WallTemperature(_) => 1.0,
+            _ => 1e-3 * scale,
         })
         .collect()
 }
@@ -346,4 +351,32 @@ pub fn assert_jacobians(model: &dyn Model, label: &str, seed: u64, count: usize)
         report.len(),
         report.join("\n")
     );
+}
+
+/// The energy budget of docs/physics.md section 10 at one state: `(dE/dt, heat + boundary +
+/// mechanical)`. `E` (gas `P V/(gamma-1)` with `V` affine in the positions, kinetic, spring and
+/// wall `C Tw` energies) is a quadratic polynomial of the states, so the central difference
+/// along the right-hand side is exact up to round-off: the check holds to round-off.
+pub fn energy_rate(model: &dyn Model, p: &[f64], x: &[f64]) -> (f64, f64) {
+    let n = model.n_states();
+    let mut f = vec![0.0; n];
+    model.rhs(p, x, 0.0, &mut f);
+    let h = 1e-3;
+    let at = |s: f64| -> Vec<f64> { x.iter().zip(&f).map(|(xi, fi)| xi + s * fi).collect() };
+    let de = (model.energy(p, &at(h)) - model.energy(p, &at(-h))) / (2.0 * h);
+    let w = model.power(p, x);
+    (de, w.heat + w.boundary + w.mechanical)
+}
+
+/// `(sum m_i', sum |m_i'|)` over the mass states: the closed gas's mass rate, which must
+/// vanish to the round-off of the sum (`eps sum |m_i'|`).
+pub fn mass_rate(model: &dyn Model, p: &[f64], x: &[f64]) -> (f64, f64) {
+    let mut f = vec![0.0; model.n_states()];
+    model.rhs(p, x, 0.0, &mut f);
+    let masses = model.states().into_iter().zip(f);
+    let rates: Vec<f64> = masses
+        .filter(|(s, _)| matches!(s.kind, StateKind::Mass(_)))
+        .map(|(_, r)| r)
+        .collect();
+    (rates.iter().sum(), rates.iter().map(|r| r.abs()).sum())
 }

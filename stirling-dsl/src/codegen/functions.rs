@@ -99,8 +99,13 @@ pub fn closure_methods(
         ),
     ];
     let ns = f("n_states");
+    let walls = (!lay.topo.walls.is_empty()).then(|| {
+        let body = terms::walls(arena, lay, private);
+        method(&f("walls"), xp.clone(), quote!(-> [f64; 2]), lay, body)
+    });
     let items = quote! {
         #(#items)*
+        #walls
         #[allow(clippy::all)]
         fn #ns(&self) -> usize {
             let n: usize = self.n;

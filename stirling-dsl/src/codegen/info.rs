@@ -34,6 +34,15 @@ fn cv_element_offset(topo: &Topology, i: usize) -> (usize, usize) {
     )
 }
 
+/// Wall-element offset of wall `w`: `(scalars before, arrays before)`.
+fn wall_element_offset(topo: &Topology, w: usize) -> (usize, usize) {
+    let before = &topo.walls[..w];
+    (
+        before.iter().filter(|x| !x.array).count(),
+        before.iter().filter(|x| x.array).count(),
+    )
+}
+
 /// Body of `fn states(&self) -> Vec<StateInfo>` for one closure.
 pub fn states(lay: &Layout, krate: &TokenStream) -> TokenStream {
     let topo = lay.topo;
@@ -43,12 +52,13 @@ pub fn states(lay: &Layout, krate: &TokenStream) -> TokenStream {
             BlockKind::Velocity(k) => (quote!(Velocity), "m/s", format!("velocity of the {}", topo.bodies[k].name), Some(k)),
             BlockKind::Pressure(i) => (quote!(Pressure), "Pa", format!("gas pressure in CV {}", topo.cvs[i].name), None),
             BlockKind::Mass(i) => (quote!(Mass), "kg", format!("gas mass in CV {}", topo.cvs[i].name), None),
+            BlockKind::WallTemperature(w) => (quote!(WallTemperature), "K", format!("temperature of wall {}", topo.walls[w].name), None),
         };
-        let cv = match b.kind {
-            BlockKind::Pressure(i) | BlockKind::Mass(i) => i,
-            _ => 0,
+        let (s, a) = match b.kind {
+            BlockKind::Pressure(i) | BlockKind::Mass(i) => cv_element_offset(topo, i),
+            BlockKind::WallTemperature(w) => wall_element_offset(topo, w),
+            _ => (0, 0),
         };
-        let (s, a) = cv_element_offset(topo, cv);
         let index = match elem {
             Some(k) => quote!(#k),
             None => quote!(#s + #a * n + j),
@@ -123,6 +133,7 @@ pub fn topology(topo: &Topology, lay: &Layout, krate: &TokenStream) -> TokenStre
                 crate::topology::frame::Place::Own,
             ),
             Vessel::Space(s) => topo.spaces[s].name.clone(),
+            Vessel::Wall(w) => topo.walls[w].name.clone(),
         };
         let (f, t, r, chain) = (end(&l.from), end(&l.to), p.expr(l.resistance), l.is_chain());
         quote! { #krate::LinkInfo { from: #f, to: #t, resistance: #r, chain: #chain } }

@@ -197,6 +197,13 @@ fn model_impl(topo: &Topology, spec: &ModelSpec, st: &Statics) -> TokenStream {
     let mech = call("mech", quote!(p, x));
     let masses = call("masses", quote!(p, out));
     let n_states = call("n_states", quote!());
+    // walls add their energy `C Tw` and the heat from outside into them
+    let (wall_e, heat) = if topo.walls.is_empty() {
+        (quote!(), quote!(heat))
+    } else {
+        let walls = call("walls", quote!(p, x));
+        (quote!(+ (#walls)[0]), quote!(heat: heat + (#walls)[1]))
+    };
     quote! {
         impl #krate::Model for #ident {
             fn name(&self) -> &'static str { #name }
@@ -242,13 +249,13 @@ fn model_impl(topo: &Topology, spec: &ModelSpec, st: &Statics) -> TokenStream {
                 let mut total = 0.0;
                 let f = &mut |_: usize, v: [f64; 7]| total += v[2];
                 #vessels
-                total + (#mech)[0]
+                total + (#mech)[0] #wall_e
             }
             fn power(&self, p: &[f64], x: &[f64]) -> #krate::PowerTerms {
                 let (mut heat, mut boundary) = (0.0, 0.0);
                 let f = &mut |_: usize, v: [f64; 7]| { heat += v[3]; boundary += v[4]; };
                 #vessels
-                #krate::PowerTerms { heat, boundary, mechanical: (#mech)[1] }
+                #krate::PowerTerms { #heat, boundary, mechanical: (#mech)[1] }
             }
             fn equations(&self, style: #krate::Style) -> String {
                 match (self.closure, style) {

@@ -128,3 +128,43 @@ pub fn masses(arena: &Arena, lay: &Layout, private: &TokenStream) -> TokenStream
     });
     quote! { #(#lets)* #(#stores)* }
 }
+
+/// `[sum C Tw, heat from outside into the walls]` over every wall element (only for a
+/// topology with walls).
+pub fn walls(arena: &Arena, lay: &Layout, private: &TokenStream) -> TokenStream {
+    let leaf = |s: Sym| lay.leaf(s);
+    let scalar: Vec<&crate::topology::WallTerms> =
+        lay.sys.walls.iter().filter(|w| !w.array).collect();
+    let mut roots = vec![lay.sys.wall_boundary_heat];
+    roots.extend(scalar.iter().flat_map(|w| [w.energy, w.heat]));
+    let b = emit_block(arena, &roots, &leaf, private);
+    let (lets, outs) = (b.lets, b.outputs);
+    let (heat0, rest) = (&outs[0], &outs[1..]);
+    let (es, hs): (Vec<_>, Vec<_>) = rest.chunks(2).map(|c| (&c[0], &c[1])).unzip();
+    let mut code = quote! {
+        let mut __e = 0.0f64;
+        let mut __q = 0.0f64;
+        { #(#lets)* __q += #heat0; #(__e += #es;)* #(__q += #hs;)* }
+    };
+    for w in lay.sys.walls.iter().filter(|w| w.array) {
+        let heated = arena.as_const(w.heat) != Some(0.0);
+        let roots = if heated {
+            vec![w.energy, w.heat]
+        } else {
+            vec![w.energy]
+        };
+        let b = emit_block(arena, &roots, &leaf, private);
+        let (lets, outs) = (b.lets, b.outputs);
+        let (e, q) = (&outs[0], outs.get(1).map(|q| quote!(__q += #q;)));
+        code.extend(quote! {
+            for j in 0..n {
+                let jf = j as f64;
+                let _ = jf;
+                #(#lets)*
+                __e += #e;
+                #q
+            }
+        });
+    }
+    quote! { #code [__e, __q] }
+}

@@ -23,6 +23,8 @@ pub enum StateKind {
     Pressure(usize),
     /// Gas mass of CV element `k`.
     Mass(usize),
+    /// Temperature of wall element `k` (declaration order, arrays expanded).
+    WallTemperature(usize),
 }
 
 /// One state with its meaning.
@@ -46,7 +48,9 @@ pub struct BodyInfo {
 /// `dE/dt = heat + boundary + mechanical`.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct PowerTerms {
-    /// Heat into the gas through all ports.
+    /// Heat from outside the system: through the gas ports to fixed wall temperatures, the
+    /// walls' inputs and the conduction from fixed temperatures into walls (heat exchanged
+    /// between the gas and a declared wall stays inside).
     pub heat: f64,
     /// Work and enthalpy from given-pressure spaces (`Pb dVb/dt`).
     pub boundary: f64,
@@ -116,7 +120,7 @@ pub trait Model: Send + Sync {
     fn temperatures(&self, p: &[f64], x: &[f64], out: &mut [f64]);
     /// Total gas mass in the CVs.
     fn gas_mass(&self, p: &[f64], x: &[f64]) -> f64;
-    /// Stored energy `sum P V/(gamma-1) + sum m v^2/2 + k q^2/2`.
+    /// Stored energy `sum P V/(gamma-1) + sum m v^2/2 + k q^2/2 + sum C Tw` (walls).
     fn energy(&self, p: &[f64], x: &[f64]) -> f64;
     /// The terms of `dE/dt`.
     fn power(&self, p: &[f64], x: &[f64]) -> PowerTerms;

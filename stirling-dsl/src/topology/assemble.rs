@@ -13,27 +13,29 @@
 
 use super::decl::{LinkDecl, Topology, Vessel};
 use super::frame::{place, Place};
+use super::links::{end_name, end_place, enthalpy, quadratic_flow, rel_min, touches};
 use super::system::{BlockInfo, BlockKind, Row, System, Variant, VesselTerms, VARIANTS};
+use super::walls::PortHeat;
 use crate::expr::{At, Func, Id, Sym};
 use crate::Closure;
 
-/// Where a row is assembled: a scalar block, or a section variant of an array CV.
+/// Where a row is assembled: a scalar block, or a section variant of an array CV or wall.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-enum RowAt {
+pub(super) enum RowAt {
     Scalar,
-    Array(usize, Variant),
+    Array(Vessel, Variant),
 }
 
 /// Quantities of a CV in its own frame.
 #[derive(Clone, Copy, Debug)]
-struct CvTemplate {
-    p: Id,
-    m: Id,
-    v: Id,
-    vdot: Id,
-    t: Id,
-    q: Id,
-    m0: Id,
+pub(super) struct CvTemplate {
+    pub(super) p: Id,
+    pub(super) m: Id,
+    pub(super) v: Id,
+    pub(super) vdot: Id,
+    pub(super) t: Id,
+    pub(super) q: Id,
+    pub(super) m0: Id,
 }
 
 /// Assemble the equations of `topo` under `closure`.
@@ -41,26 +43,32 @@ pub fn assemble(topo: &mut Topology, closure: Closure) -> System {
     Assembler::new(topo, closure).run()
 }
 
-struct Assembler<'t> {
-    t: &'t mut Topology,
+pub(super) struct Assembler<'t> {
+    pub(super) t: &'t mut Topology,
     closure: Closure,
     array_blocks: Vec<bool>,
-    cv: Vec<CvTemplate>,
+    pub(super) cv: Vec<CvTemplate>,
+    /// Per CV, the heat of each port that names a declared wall, in the CV's frame.
+    pub(super) port_heat: Vec<Vec<PortHeat>>,
 }
 
 impl<'t> Assembler<'t> {
     fn new(t: &'t mut Topology, closure: Closure) -> Self {
         let (nb, ncv) = (t.bodies.len(), t.cvs.len());
-        let mut array_blocks = vec![false; 2 * nb + 2 * ncv];
+        let mut array_blocks = vec![false; 2 * nb + 2 * ncv + t.walls.len()];
         for (i, c) in t.cvs.iter().enumerate() {
             array_blocks[2 * nb + i] = c.array;
             array_blocks[2 * nb + ncv + i] = c.array;
+        }
+        for (w, wall) in t.walls.iter().enumerate() {
+            array_blocks[Topology::wall_block(nb, ncv, w) as usize] = wall.array;
         }
         Self {
             t,
             closure,
             array_blocks,
             cv: Vec::new(),
+            port_heat: Vec::new(),
         }
     }
 
@@ -106,6 +114,7 @@ impl<'t> Assembler<'t> {
             (0..self.t.cvs.len()).map(|i| self.cv_terms(i)).collect();
         vessels.extend((0..self.t.spaces.len()).map(|s| self.space_terms(s)));
         let (mech_energy, mech_power) = (self.mech_energy(), self.mech_power());
+        let (walls, wall_boundary_heat) = self.wall_terms();
         let array_blocks = self.array_blocks.clone();
         System {
             closure: self.closure,
@@ -116,6 +125,8 @@ impl<'t> Assembler<'t> {
             vessels,
             mech_energy,
             mech_power,
+            walls,
+            wall_boundary_heat,
             array_blocks,
         }
     }
@@ -156,11 +167,12 @@ impl<'t> Assembler<'t> {
                 });
             }
         }
+        out.extend(self.wall_blocks());
         out
     }
 
     /// Position and velocity symbols of body `k`.
-    fn body_syms(&mut self, k: usize) -> (Id, Id) {
+    pub(super) fn body_syms(&mut self, k: usize) -> (Id, Id) {
         let a = &mut self.t.arena;
         (
             a.sym(Sym::State(Topology::pos_block(k), At::Scalar)),
@@ -169,7 +181,7 @@ impl<'t> Assembler<'t> {
     }
 
     /// `sum coeff * q` and `sum coeff * v` over faces.
-    fn face_sums(&mut self, faces: &[super::decl::FaceDecl]) -> (Id, Id) {
+    pub(super) fn face_sums(&mut self, faces: &[super::decl::FaceDecl]) -> (Id, Id) {
         let (mut dv, mut vdot) = (self.t.arena.num(0.0), self.t.arena.num(0.0));
         for f in faces.iter().cloned() {
             let (q, v) = self.body_syms(f.body);
@@ -181,10 +193,13 @@ impl<'t> Assembler<'t> {
         (dv, vdot)
     }
 
-    /// Every state symbol set to zero: the rest position of section 6.
+    /// The rest state of section 6: every body state zero, every wall temperature at its
+    /// declared rest value (in the frame of the expression).
     fn at_rest(&mut self, id: Id) -> Id {
-        self.t.arena.subst(id, &mut |a, s| {
-            matches!(s, Sym::State(..)).then(|| a.num(0.0))
+        let rest = self.wall_rests();
+        self.t.arena.subst(id, &mut |a, s| match s {
+            Sym::State(b, _) => Some(rest.get(&b).copied().unwrap_or_else(|| a.num(0.0))),
+            _ => None,
         })
     }
 
@@ -222,7 +237,7 @@ impl<'t> Assembler<'t> {
         let mr = a.mul(m, gas.r);
         let t_raw = a.div(pv, mr);
         let t = a.named(&tl, t_raw);
-        let q_raw = self.heat(&c.ports, t);
+        let q_raw = self.heat(i, &c.ports, t);
         let q = self.t.arena.named(&ql, q_raw);
         CvTemplate {
             p,
@@ -235,17 +250,31 @@ impl<'t> Assembler<'t> {
         }
     }
 
-    /// `sum h A (Tw - T)`.
-    fn heat(&mut self, ports: &[super::decl::PortDecl], t: Id) -> Id {
-        let a = &mut self.t.arena;
-        let mut q = a.num(0.0);
+    /// `sum h A (Tw - T)` of CV `i`; the terms of ports to declared walls are named
+    /// `Q_cv_port` and recorded for the walls' balances.
+    fn heat(&mut self, i: usize, ports: &[super::decl::PortDecl], t: Id) -> Id {
+        let mut q = self.t.arena.num(0.0);
+        let mut to_walls = Vec::new();
         for port in ports {
+            let label = self.port_label(i, &port.name);
+            let a = &mut self.t.arena;
             let ha = a.mul(port.h, port.area);
             let dt = a.sub(port.wall, t);
-            let term = a.mul(ha, dt);
+            let mut term = a.mul(ha, dt);
+            if let Some(wall) = port.wall_ref {
+                term = a.named(&label, term);
+                to_walls.push(PortHeat { wall, q: term });
+            }
             q = a.add(q, term);
         }
+        self.port_heat.push(to_walls);
         q
+    }
+
+    fn port_label(&self, i: usize, port: &str) -> String {
+        let c = &self.t.cvs[i];
+        let j = if c.array { "[j]" } else { "" };
+        format!("Q_{}_{port}{j}", c.name)
     }
 
     /// `m_i0 = Pcharge V_i0 / (R T_i0)`, `T_i0 = sum h Aw Tw / sum h Aw` at rest.
@@ -272,7 +301,7 @@ impl<'t> Assembler<'t> {
         a.div(pv, rt)
     }
 
-    fn placed(&mut self, id: Id, at: Place) -> Id {
+    pub(super) fn placed(&mut self, id: Id, at: Place) -> Id {
         place(&mut self.t.arena, id, at, &self.array_blocks)
     }
 
@@ -283,9 +312,18 @@ impl<'t> Assembler<'t> {
             BlockKind::Pressure(i) | BlockKind::Mass(i) => {
                 let want_p = matches!(b.kind, BlockKind::Pressure(_));
                 if b.array {
-                    Row::Array(VARIANTS.map(|v| self.balance(i, RowAt::Array(i, v), want_p)))
+                    Row::Array(
+                        VARIANTS.map(|v| self.balance(i, RowAt::Array(Vessel::Cv(i), v), want_p)),
+                    )
                 } else {
                     Row::Scalar(self.balance(i, RowAt::Scalar, want_p))
+                }
+            }
+            BlockKind::WallTemperature(w) => {
+                if b.array {
+                    Row::Array(VARIANTS.map(|v| self.wall_row(w, RowAt::Array(Vessel::Wall(w), v))))
+                } else {
+                    Row::Scalar(self.wall_row(w, RowAt::Scalar))
                 }
             }
         }
@@ -296,6 +334,7 @@ impl<'t> Assembler<'t> {
             BlockKind::Position(_) | BlockKind::Velocity(_) => self.t.arena.num(0.0),
             BlockKind::Pressure(_) => self.t.gas.as_ref().expect("checked").charge,
             BlockKind::Mass(i) => self.cv[i].m0,
+            BlockKind::WallTemperature(w) => self.t.walls[w].rest,
         };
         if b.array {
             Row::Array([id; 4])
@@ -400,7 +439,7 @@ impl<'t> Assembler<'t> {
                 if end.vessel != Vessel::Cv(i) {
                     continue;
                 }
-                if let Some(base) = touches(end.at, row, l) {
+                if let Some(base) = touches(end.at, row, rel_min(l.from.at, l.to.at)) {
                     out.push(self.flow(l, row, base, into));
                 }
             }
@@ -409,7 +448,7 @@ impl<'t> Assembler<'t> {
     }
 
     /// The flow of link `l` seen from `row`, whose own section is `base` in the link's frame.
-    fn flow(&mut self, l: &LinkDecl, row: RowAt, base: i32, into: bool) -> Flow {
+    pub(super) fn flow(&mut self, l: &LinkDecl, row: RowAt, base: i32, into: bool) -> Flow {
         let (p_from, t_from, from_name) = self.end_state(l.from.vessel, l.from.at, row, base);
         let (p_to, t_to, to_name) = self.end_state(l.to.vessel, l.to.at, row, base);
         let shift = if l.is_chain() {
@@ -447,8 +486,9 @@ impl<'t> Assembler<'t> {
                     sp.name.clone(),
                 )
             }
+            Vessel::Wall(_) => unreachable!("checked: a mass-flow link never ends at a wall"),
             Vessel::Cv(c) => {
-                let pl = end_place(c, at, row, base);
+                let pl = end_place(vessel, at, row, base);
                 let tpl = self.cv[c];
                 let (p, t) = (self.placed(tpl.p, pl), self.placed(tpl.t, pl));
                 let shown = match pl {
@@ -465,211 +505,11 @@ impl<'t> Assembler<'t> {
             }
         }
     }
-
-    fn cv_terms(&mut self, i: usize) -> VesselTerms {
-        let tpl = self.cv[i];
-        let gas = self.t.gas.clone().expect("checked");
-        let a = &mut self.t.arena;
-        let one = a.num(1.0);
-        let gm1 = a.sub(gas.gamma, one);
-        let pv = a.mul(tpl.p, tpl.v);
-        let energy = a.div(pv, gm1);
-        let zero = a.num(0.0);
-        let c = &self.t.cvs[i];
-        VesselTerms {
-            name: c.name.clone(),
-            array: c.array,
-            is_cv: true,
-            pressure: tpl.p,
-            volume: tpl.v,
-            energy,
-            heat: tpl.q,
-            boundary: zero,
-            mass: tpl.m,
-            temperature: tpl.t,
-        }
-    }
-
-    fn space_terms(&mut self, s: usize) -> VesselTerms {
-        let sp = self.t.spaces[s].clone();
-        let (dv, vdot) = self.face_sums(&sp.faces);
-        let outflow = self.space_enthalpy_out(s);
-        let a = &mut self.t.arena;
-        let volume = a.add(sp.volume, dv);
-        let work = a.mul(sp.pressure, vdot);
-        let boundary = a.sub(work, outflow);
-        let zero = a.num(0.0);
-        let temperature = sp.temperature.unwrap_or_else(|| a.num(f64::NAN));
-        VesselTerms {
-            name: sp.name.clone(),
-            array: false,
-            is_cv: false,
-            pressure: sp.pressure,
-            volume,
-            energy: zero,
-            heat: zero,
-            boundary,
-            mass: zero,
-            temperature,
-        }
-    }
-
-    /// Enthalpy flowing from the CVs into space `s` (scalar CV ends only; checked).
-    fn space_enthalpy_out(&mut self, s: usize) -> Id {
-        let links = self.t.links.clone();
-        let mut terms = Vec::new();
-        for l in &links {
-            let into_space = l.to.vessel == Vessel::Space(s);
-            if !into_space && l.from.vessel != Vessel::Space(s) {
-                continue;
-            }
-            let f = self.flow(l, RowAt::Scalar, 0, true);
-            let a = &mut self.t.arena;
-            terms.push(if into_space { f.h } else { a.neg(f.h) });
-        }
-        self.t.arena.sum(terms)
-    }
-
-    fn mech_energy(&mut self) -> Id {
-        let mut total = self.t.arena.num(0.0);
-        for k in 0..self.t.bodies.len() {
-            let b = self.t.bodies[k].clone();
-            let (q, v) = self.body_syms(k);
-            let a = &mut self.t.arena;
-            let half = a.num(0.5);
-            let (v2, q2) = (a.powi(v, 2), a.powi(q, 2));
-            let (mv, kq) = (a.mul(b.mass, v2), a.mul(b.spring, q2));
-            let s = a.add(mv, kq);
-            let e = a.mul(half, s);
-            total = a.add(total, e);
-        }
-        total
-    }
-
-    /// `sum v (F - c v - cq v|v|) - sum c (v_a - v_b)^2`.
-    fn mech_power(&mut self) -> Id {
-        let mut total = self.t.arena.num(0.0);
-        for k in 0..self.t.bodies.len() {
-            let b = self.t.bodies[k].clone();
-            let v = self.body_syms(k).1;
-            let a = &mut self.t.arena;
-            let cv = a.mul(b.damper, v);
-            let av = a.func(Func::Abs, v);
-            let vav = a.mul(v, av);
-            let qv = a.mul(b.quad_damper, vav);
-            let f = a.sub(b.force, cv);
-            let f = a.sub(f, qv);
-            let p = a.mul(v, f);
-            total = a.add(total, p);
-        }
-        for c in self.t.couplings.clone() {
-            let (va, vb) = (self.body_syms(c.a).1, self.body_syms(c.b).1);
-            let a = &mut self.t.arena;
-            let dv = a.sub(va, vb);
-            let d2 = a.powi(dv, 2);
-            let p = a.mul(c.damper, d2);
-            total = a.sub(total, p);
-        }
-        total
-    }
 }
 
 /// One link's flow as seen by a CV balance.
-struct Flow {
-    mdot: Id,
-    h: Id,
-    into: bool,
-}
-
-/// Whether a link end at `at` touches the row's section; returns the row's offset in the
-/// link's frame (`0`, or `1` for the upper end of a chain link).
-fn touches(at: At, row: RowAt, l: &LinkDecl) -> Option<i32> {
-    match (at, row) {
-        (At::Scalar, RowAt::Scalar) => Some(0),
-        (At::First, RowAt::Array(_, v)) => {
-            matches!(v, Variant::Single | Variant::First).then_some(0)
-        }
-        (At::Last, RowAt::Array(_, v)) => matches!(v, Variant::Single | Variant::Last).then_some(0),
-        (At::Rel(r), RowAt::Array(_, v)) => {
-            let upper = r > rel_min(l);
-            let ok = if upper {
-                matches!(v, Variant::Interior | Variant::Last)
-            } else {
-                matches!(v, Variant::First | Variant::Interior)
-            };
-            ok.then_some(r)
-        }
-        _ => None,
-    }
-}
-
-fn rel_min(l: &LinkDecl) -> i32 {
-    let r = |a: At| if let At::Rel(r) = a { r } else { 0 };
-    r(l.from.at).min(r(l.to.at))
-}
-
-/// Where a link end sits relative to the row's own section.
-fn end_place(cv: usize, at: At, row: RowAt, base: i32) -> Place {
-    let own_array = matches!(row, RowAt::Array(c, _) if c == cv);
-    match at {
-        At::Scalar => Place::Own,
-        At::Rel(r) => Place::Shift(r - base),
-        At::First => match row {
-            RowAt::Array(_, Variant::Single | Variant::First) if own_array => Place::Own,
-            _ => Place::First,
-        },
-        At::Last => match row {
-            RowAt::Array(_, Variant::Single | Variant::Last) if own_array => Place::Own,
-            _ => Place::Last,
-        },
-    }
-}
-
-fn end_name(name: &str, array: bool, at: At) -> String {
-    if !array {
-        return name.to_string();
-    }
-    match at {
-        At::First => format!("{name}[0]"),
-        At::Last => format!("{name}[n-1]"),
-        At::Rel(r) => format!("{name}[{}]", super::frame::index_text(r)),
-        At::Scalar => name.to_string(),
-    }
-}
-
-/// `dP = R mdot + Rq mdot |mdot|` solved for `mdot`: `2 dP / (R + sqrt(R^2 + 4 Rq |dP|))`.
-fn quadratic_flow(a: &mut crate::expr::Arena, dp: Id, r: Id, rq: Id) -> Id {
-    let (two, four) = (a.num(2.0), a.num(4.0));
-    let r2 = a.powi(r, 2);
-    let adp = a.func(Func::Abs, dp);
-    let t = a.mul(four, rq);
-    let t = a.mul(t, adp);
-    let s = a.add(r2, t);
-    let root = a.func(Func::Sqrt, s);
-    let den = a.add(r, root);
-    let num = a.mul(two, dp);
-    a.div(num, den)
-}
-
-/// `H = cp mdot (s T_from + (1 - s) T_to)`, `s = (1 + tanh(mdot/eps))/2`, `cp = gamma R/(gamma-1)`.
-fn enthalpy(
-    a: &mut crate::expr::Arena,
-    mdot: Id,
-    t_from: Id,
-    t_to: Id,
-    gas: &super::decl::GasDecl,
-) -> Id {
-    let (one, half) = (a.num(1.0), a.num(0.5));
-    let ratio = a.div(mdot, gas.mdot_eps);
-    let th = a.func(Func::Tanh, ratio);
-    let opt = a.add(one, th);
-    let s = a.mul(half, opt);
-    let dt = a.sub(t_from, t_to);
-    let sdt = a.mul(s, dt);
-    let t_up = a.add(t_to, sdt);
-    let gm1 = a.sub(gas.gamma, one);
-    let gr = a.mul(gas.gamma, gas.r);
-    let cp = a.div(gr, gm1);
-    let cm = a.mul(cp, mdot);
-    a.mul(cm, t_up)
+pub(super) struct Flow {
+    pub(super) mdot: Id,
+    pub(super) h: Id,
+    pub(super) into: bool,
 }

@@ -65,7 +65,57 @@ pub struct PortDecl {
     pub name: String,
     pub h: Id,
     pub area: Id,
+    /// The wall temperature: an expression, or the state symbol of a declared wall.
     pub wall: Id,
+    /// The declared [`WallDecl`] the port exchanges heat with (`None`: a fixed temperature).
+    pub wall_ref: Option<usize>,
+}
+
+/// A solid wall whose temperature `Tw` is a state (a thermal mass), or an array of `n`:
+/// `C Tw' = input - sum(port heat into the gas) + sum(conduction into the wall)`.
+#[derive(Clone, Debug)]
+pub struct WallDecl {
+    pub name: String,
+    pub array: bool,
+    /// Heat capacity `C` (J/K); may use `Index`/`Count` in an array.
+    pub capacity: Id,
+    /// Temperature at rest, the equilibrium guess (docs/physics.md section 6).
+    pub rest: Id,
+    /// Heat input from outside the system (a heater), zero if not declared.
+    pub input: Id,
+}
+
+/// An end of a conduction link: an element of a declared wall, or a fixed temperature.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum HeatEnd {
+    /// `End::vessel` is a [`Vessel::Wall`].
+    Wall(End),
+    /// A given temperature (an expression of parameters).
+    Fixed(Id),
+}
+
+/// Conduction `Q = G (T_from - T_to)` from `from` to `to`; a chain (`Rel` ends) repeats
+/// for `j in 0..n-1`.
+#[derive(Clone, Debug)]
+pub struct ConductionDecl {
+    pub from: HeatEnd,
+    pub to: HeatEnd,
+    pub conductance: Id,
+}
+
+impl ConductionDecl {
+    /// The `Rel` offsets of the wall ends (`0` for other ends).
+    pub fn rel(&self) -> [Option<i32>; 2] {
+        [self.from, self.to].map(|e| match e {
+            HeatEnd::Wall(End { at: At::Rel(r), .. }) => Some(r),
+            _ => None,
+        })
+    }
+
+    /// Whether the link repeats along an array.
+    pub fn is_chain(&self) -> bool {
+        self.rel().iter().any(Option::is_some)
+    }
 }
 
 /// A space whose pressure is given (a fixed bounce space, or an algebraic pressure such as
@@ -96,6 +146,8 @@ pub struct CvDecl {
 pub enum Vessel {
     Cv(usize),
     Space(usize),
+    /// A declared wall (an end of a conduction link only).
+    Wall(usize),
 }
 
 /// A link end: the vessel and, for arrays, which element.
@@ -140,6 +192,8 @@ pub struct Topology {
     pub spaces: Vec<SpaceDecl>,
     pub cvs: Vec<CvDecl>,
     pub links: Vec<LinkDecl>,
+    pub walls: Vec<WallDecl>,
+    pub conductions: Vec<ConductionDecl>,
 }
 
 impl Topology {
@@ -153,6 +207,12 @@ impl Topology {
         2 * k as u32 + 1
     }
 
+    /// Block number of wall `w` in a topology of `bodies` bodies and `cvs` CVs (after the
+    /// bodies' positions and velocities, the CV pressures and the CV masses).
+    pub fn wall_block(bodies: usize, cvs: usize, w: usize) -> u32 {
+        (2 * bodies + 2 * cvs + w) as u32
+    }
+
     /// Whether CV `i` takes part in a mass-flow link.
     pub fn cv_is_linked(&self, i: usize) -> bool {
         self.links
@@ -160,8 +220,8 @@ impl Topology {
             .any(|l| l.from.vessel == Vessel::Cv(i) || l.to.vessel == Vessel::Cv(i))
     }
 
-    /// Whether any CV is an array.
+    /// Whether any CV or wall is an array.
     pub fn has_array(&self) -> bool {
-        self.cvs.iter().any(|c| c.array)
+        self.cvs.iter().any(|c| c.array) || self.walls.iter().any(|w| w.array)
     }
 }

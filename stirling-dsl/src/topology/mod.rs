@@ -1,13 +1,16 @@
 //! The topology description and its energetic assembly into equations.
 
 mod assemble;
+mod budget;
 mod decl;
 pub mod frame;
+mod links;
 mod system;
+mod walls;
 
 pub use assemble::assemble;
 pub use decl::{
-    BodyDecl, CouplingDecl, CvDecl, End, FaceDecl, GasDecl, LinkDecl, ParamDecl, PortDecl,
-    SpaceDecl, Topology, Vessel,
+    BodyDecl, ConductionDecl, CouplingDecl, CvDecl, End, FaceDecl, GasDecl, HeatEnd, LinkDecl,
+    ParamDecl, PortDecl, SpaceDecl, Topology, Vessel, WallDecl,
 };
-pub use system::{BlockInfo, BlockKind, Row, System, Variant, VesselTerms, VARIANTS};
+pub use system::{BlockInfo, BlockKind, Row, System, Variant, VesselTerms, WallTerms, VARIANTS};

@@ -43,6 +43,8 @@ pub enum BlockKind {
     Velocity(usize),
     Pressure(usize),
     Mass(usize),
+    /// Temperature of wall `w` (declaration order).
+    WallTemperature(usize),
 }
 
 /// One state block: a scalar, or `n` states of an array CV.
@@ -94,6 +96,16 @@ pub struct VesselTerms {
     pub temperature: Id,
 }
 
+/// A wall's share of the energy budget, in its own frame.
+#[derive(Clone, Debug)]
+pub struct WallTerms {
+    pub array: bool,
+    /// `C Tw`.
+    pub energy: Id,
+    /// Heat from outside the system into the wall element: its `input`.
+    pub heat: Id,
+}
+
 /// The assembled model.
 #[derive(Clone, Debug)]
 pub struct System {
@@ -111,6 +123,10 @@ pub struct System {
     pub mech_energy: Id,
     /// Power of the dampers, couplings and extra forces (negative when dissipating).
     pub mech_power: Id,
+    /// Energy terms of every wall.
+    pub walls: Vec<WallTerms>,
+    /// Heat from fixed temperatures into walls through conduction links (a scalar sum).
+    pub wall_boundary_heat: Id,
     /// Whether each symbol block number is an array block.
     pub array_blocks: Vec<bool>,
 }

@@ -20,7 +20,7 @@ pub fn classify(
             StateKind::Position(k) => x[i] = 1e-3 * (1.0 + k as f64),
             StateKind::Velocity(k) => x[i] = 0.1 * (1.0 + 0.5 * k as f64),
             StateKind::Pressure(k) => x[i] *= 1.0 + 0.01 * (1.0 + k as f64),
-            StateKind::Mass(_) => {}
+            StateKind::Mass(_) | StateKind::WallTemperature(_) => {}
         }
     }
     let jp = model.param_jacobian_dense(p, &x, 0.0);

@@ -317,7 +317,9 @@ pub fn multiple_shooting(
             let scale = match states[i].kind {
                 StateKind::Position(_) => 1e-3,
                 StateKind::Velocity(_) => 0.05,
-                StateKind::Pressure(_) | StateKind::Mass(_) => 0.01 * sscale[i],
+                StateKind::Pressure(_) | StateKind::Mass(_) | StateKind::WallTemperature(_) => {
+                    0.01 * sscale[i]
+                }
             };
             vars.push(Var {
                 name: format!("seg{s}.{}", names[i]),

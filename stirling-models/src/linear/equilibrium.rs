@@ -58,6 +58,7 @@ pub fn state_scales(model: &dyn Model, x: &[f64]) -> Vec<f64> {
                 StateKind::Velocity(_) => 1e-1,
                 StateKind::Pressure(_) => 1e3,
                 StateKind::Mass(_) => 1e-9,
+                StateKind::WallTemperature(_) => 1.0,
             };
             v.abs().max(floor)
         })

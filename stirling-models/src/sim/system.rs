@@ -50,7 +50,9 @@ pub fn state_scale(model: &dyn Model, p: &[f64]) -> Vec<f64> {
         .map(|(s, &e)| match s.kind {
             StateKind::Position(_) => 1e-2,
             StateKind::Velocity(_) => 1.0,
-            StateKind::Pressure(_) | StateKind::Mass(_) => e.abs().max(f64::MIN_POSITIVE),
+            StateKind::Pressure(_) | StateKind::Mass(_) | StateKind::WallTemperature(_) => {
+                e.abs().max(f64::MIN_POSITIVE)
+            }
         })
         .collect()
 }
