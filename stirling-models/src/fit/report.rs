@@ -39,6 +39,28 @@ pub struct ChannelFit {
     pub samples: usize,
 }
 
+impl ChannelFit {
+    /// The fit of the model output `yhat` to `y` (no drift band removed).
+    pub fn plain(channel: &str, block: &str, y: &[f64], yhat: &[f64]) -> Self {
+        let fp = fit_percent(y, yhat);
+        let rms = (y
+            .iter()
+            .zip(yhat)
+            .map(|(u, v)| (u - v) * (u - v))
+            .sum::<f64>()
+            / y.len() as f64)
+            .sqrt();
+        ChannelFit {
+            channel: channel.to_string(),
+            block: block.into(),
+            fit_percent: fp,
+            fit_percent_raw: fp,
+            rms,
+            samples: y.len(),
+        }
+    }
+}
+
 /// The statistics of a least-squares fit.
 #[derive(Clone, Debug, Serialize)]
 pub struct FitStats {
