@@ -29,7 +29,7 @@ use super::{FitError, Series};
 use crate::data::Measured;
 use crate::layout::StateLayout;
 use crate::signal::{crossing_frequency, fundamental, savitzky_golay, wrap};
-use crate::sim::{simulate, SimOptions};
+use crate::sim::{simulate, SimOptions, Trajectory};
 
 /// Additive sensor offsets: measured = model + offset.
 #[derive(Clone, Debug, Default, Serialize, PartialEq)]
@@ -348,6 +348,23 @@ fn phase_lag(meas: &[f64], sim: &[f64], dt: f64, f: f64, cycles: f64, len: usize
     wrap(ps - pm)
 }
 
+/// Simulate `model` at `p` from `x0` over `steps` samples `dt` apart.
+fn simulate_steps(
+    model: &dyn Model,
+    p: &[f64],
+    x0: &[f64],
+    (steps, dt): (usize, f64),
+    opts: &SimOptions,
+) -> Result<Trajectory, FitError> {
+    let samples: Vec<f64> = (0..=steps).map(|k| k as f64 * dt).collect();
+    simulate(model, p, x0, samples[samples.len() - 1], &samples, opts).map_err(|source| {
+        FitError::Sim {
+            stage: "free run".into(),
+            source,
+        }
+    })
+}
+
 /// Simulate `model` at `p` from the measured state at the start of `block` and compare.
 pub fn free_run(
     model: &dyn Model,
@@ -364,19 +381,7 @@ pub fn free_run(
     let (a, b) = sample_range(data, block, block.1, name, 11)?;
     let h = ((opts.smooth / dt).round() as usize).max(3);
     let x0 = measured_state(model, p, data, off, a, h)?;
-    let samples: Vec<f64> = (0..=b - a).map(|k| k as f64 * dt).collect();
-    let traj = simulate(
-        model,
-        p,
-        &x0,
-        samples[samples.len() - 1],
-        &samples,
-        &opts.sim,
-    )
-    .map_err(|source| FitError::Sim {
-        stage: name.into(),
-        source,
-    })?;
+    let traj = simulate_steps(model, p, &x0, (b - a, dt), &opts.sim)?;
     let meas: Vec<(String, Vec<f64>)> = ch
         .iter()
         .map(|c| (c.name.clone(), c.data[a..=b].to_vec()))
