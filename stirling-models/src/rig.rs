@@ -9,7 +9,7 @@ use std::path::{Path, PathBuf};
 
 use rand::{rngs::StdRng, Rng, SeedableRng};
 use serde::Serialize;
-use stirling_dsl::Closure;
+use stirling_dsl::{Closure, Model};
 
 use crate::data::{write_csv, Measured};
 use crate::effects::{augmented, EffectSettings};
@@ -216,17 +216,26 @@ fn check_pressure(p: &[f64], cfg: &RigConfig) -> Result<(), RigError> {
     Ok(())
 }
 
-/// Run the rig.
-pub fn run(cfg: &RigConfig) -> Result<RigOutput, RigError> {
-    validate(cfg)?;
+/// The engine of `cfg`: the augmented model with its effects and parameters.
+fn engine(cfg: &RigConfig) -> Result<(Box<dyn Model>, EffectSettings, Vec<f64>), RigError> {
     let model = augmented(&cfg.model, cfg.n, Closure::Full)?;
     let fx = EffectSettings::parse(&cfg.model, &cfg.effects)?;
     let mut p = crate::params::load(model.as_ref(), cfg.params.as_deref(), &cfg.set)?;
     fx.apply(model.as_ref(), &mut p)?;
+    Ok((model, fx, p))
+}
+
+/// The clean run: from equilibrium with the displacer kicked by `x0`, sampled at `rate`
+/// after `settle` (rows: the `count + 1` samples).
+fn clean_run(
+    model: &dyn Model,
+    p: &[f64],
+    cfg: &RigConfig,
+    count: usize,
+) -> Result<Vec<Vec<f64>>, RigError> {
     let mut x0 = vec![0.0; model.n_states()];
-    model.equilibrium_guess(&p, &mut x0);
+    model.equilibrium_guess(p, &mut x0);
     x0[0] += cfg.x0;
-    let count = (cfg.t_end * cfg.rate).round() as usize;
     let dt = 1.0 / cfg.rate;
     let samples: Vec<f64> = (0..=count).map(|k| cfg.settle + k as f64 * dt).collect();
     let opts = SimOptions {
@@ -235,21 +244,34 @@ pub fn run(cfg: &RigConfig) -> Result<RigOutput, RigError> {
         ..Default::default()
     };
     let traj = simulate(
-        model.as_ref(),
-        &p,
+        model,
+        p,
         &x0,
         cfg.settle + count as f64 * dt,
         &samples,
         &opts,
     )?;
-    let ps = StateLayout::of(model.as_ref()).pressures;
-    let (Some(&ic), Some(&ih)) = (ps.last(), ps.first()) else {
-        return Err(RigError::NoGas {
-            model: cfg.model.clone(),
-        });
-    };
-    let ncv = ps.len();
-    let col = |i: usize| traj.x.iter().map(|r| r[i]).collect::<Vec<f64>>();
+    Ok(traj.x)
+}
+
+/// The sensor readings of a clean run: cold and hot pressure, `x`, `y`.
+struct Readings {
+    pc: Vec<f64>,
+    ph: Option<Vec<f64>>,
+    x: Vec<f64>,
+    y: Vec<f64>,
+}
+
+/// What the sensors read from the clean `rows`: lag, gain, offset and seeded noise (cold
+/// pressure state `ic`, hot `ih` when there are several CVs).
+fn read_sensors(
+    rows: &[Vec<f64>],
+    (ic, ih, ncv): (usize, usize, usize),
+    fx: &EffectSettings,
+    cfg: &RigConfig,
+) -> Result<Readings, RigError> {
+    let dt = 1.0 / cfg.rate;
+    let col = |i: usize| rows.iter().map(|r| r[i]).collect::<Vec<f64>>();
     let tau = fx.sensor_value("tau_p");
     let (gx, gy) = (fx.sensor_value("gain_x"), fx.sensor_value("gain_y"));
     let mut g = Gauss(StdRng::seed_from_u64(cfg.seed));
@@ -277,27 +299,13 @@ pub fn run(cfg: &RigConfig) -> Result<RigOutput, RigError> {
     check_pressure(&col(ic), cfg)?;
     let x = noisy(col(0), gx, cfg.offset_x, cfg.noise_x);
     let y = noisy(col(2), gy, cfg.offset_y, cfg.noise_x);
-    let t: Vec<f64> = (0..=count).map(|k| k as f64 * dt).collect();
+    Ok(Readings { pc, ph, x, y })
+}
+
+/// The truth record: what generated the data.
+fn truth(cfg: &RigConfig, model: &dyn Model, p: &[f64], fx: EffectSettings) -> Truth {
     let want = |c: &str| cfg.channels.iter().any(|k| k == c);
-    if want("p_hot") && ph.is_none() {
-        return Err(RigError::NoHotSide {
-            model: cfg.model.clone(),
-        });
-    }
-    let data = Measured {
-        source: format!("rig:{}", model.name()),
-        t,
-        p: Some(pc).filter(|_| want("p")),
-        p_hot: ph.filter(|_| want("p_hot")),
-        x: Some(x).filter(|_| want("x")),
-        y: Some(y).filter(|_| want("y")),
-    };
-    let parameters = model
-        .params()
-        .iter()
-        .zip(&p)
-        .map(|(i, v)| (i.name.to_string(), *v))
-        .collect();
+    let parameters = crate::params::named(model, p).into_iter().collect();
     let offsets = [
         ("p", cfg.offset_p),
         ("p_hot", cfg.offset_p),
@@ -308,7 +316,7 @@ pub fn run(cfg: &RigConfig) -> Result<RigOutput, RigError> {
     .filter(|(k, _)| want(k))
     .map(|(k, v)| (k.to_string(), v))
     .collect();
-    let truth = Truth {
+    Truth {
         model: model.name().to_string(),
         base: cfg.model.clone(),
         n: model.n(),
@@ -325,7 +333,39 @@ pub fn run(cfg: &RigConfig) -> Result<RigOutput, RigError> {
         t_end: cfg.t_end,
         settle: cfg.settle,
         x0: cfg.x0,
+    }
+}
+
+/// Run the rig.
+pub fn run(cfg: &RigConfig) -> Result<RigOutput, RigError> {
+    validate(cfg)?;
+    let (model, fx, p) = engine(cfg)?;
+    let count = (cfg.t_end * cfg.rate).round() as usize;
+    let dt = 1.0 / cfg.rate;
+    let rows = clean_run(model.as_ref(), &p, cfg, count)?;
+    let ps = StateLayout::of(model.as_ref()).pressures;
+    let (Some(&ic), Some(&ih)) = (ps.last(), ps.first()) else {
+        return Err(RigError::NoGas {
+            model: cfg.model.clone(),
+        });
     };
+    let r = read_sensors(&rows, (ic, ih, ps.len()), &fx, cfg)?;
+    let t: Vec<f64> = (0..=count).map(|k| k as f64 * dt).collect();
+    let want = |c: &str| cfg.channels.iter().any(|k| k == c);
+    if want("p_hot") && r.ph.is_none() {
+        return Err(RigError::NoHotSide {
+            model: cfg.model.clone(),
+        });
+    }
+    let data = Measured {
+        source: format!("rig:{}", model.name()),
+        t,
+        p: Some(r.pc).filter(|_| want("p")),
+        p_hot: r.ph.filter(|_| want("p_hot")),
+        x: Some(r.x).filter(|_| want("x")),
+        y: Some(r.y).filter(|_| want("y")),
+    };
+    let truth = truth(cfg, model.as_ref(), &p, fx);
     Ok(RigOutput { data, truth })
 }
 

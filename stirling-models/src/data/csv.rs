@@ -50,82 +50,80 @@ fn text<'a>(file: &str, bytes: &'a [u8]) -> Result<&'a str, DataError> {
     })
 }
 
-fn parse(file: &str, text: &str) -> Result<(Measured, Vec<usize>), DataError> {
-    let err = |row: usize, column: &str, message: String| DataError {
-        file: file.to_string(),
-        row,
-        column: column.to_string(),
-        message,
-    };
-    // an invisible byte-order mark would otherwise glue itself to the first column name
-    let body = text.strip_prefix('\u{feff}').unwrap_or(text);
-    let mut lines = body
-        .lines()
-        .enumerate()
-        .map(|(i, l)| (i + 1, l.trim()))
-        .filter(|(_, l)| !l.is_empty() && !l.starts_with('#'));
-    let Some((hrow, header)) = lines.next() else {
-        return Err(err(
-            1,
-            "t",
-            "the file is empty: expected a header line with `t` and at least one of p, p_hot, x, y"
-                .into(),
-        ));
-    };
-    let names: Vec<String> = header
-        .split(',')
-        .map(|s| s.trim().trim_matches('"').to_string())
-        .collect();
-    for (i, n) in names.iter().enumerate() {
-        if names[..i].contains(n) && (n == "t" || CHANNELS.contains(&n.as_str())) {
-            return Err(err(
-                hrow,
-                n,
-                format!("column `{n}` appears twice in the header"),
-            ));
+/// Builds the errors of one file.
+struct Errors<'a> {
+    file: &'a str,
+}
+
+impl Errors<'_> {
+    fn err(&self, row: usize, column: &str, message: String) -> DataError {
+        DataError {
+            file: self.file.to_string(),
+            row,
+            column: column.to_string(),
+            message,
         }
     }
-    let Some(it) = names.iter().position(|n| n == "t") else {
-        return Err(err(
-            hrow,
-            "t",
-            format!(
-                "missing column `t` (time in s); the header has: {}{}",
-                list(&names),
-                format_hint(file, body)
-            ),
-        ));
-    };
-    let cols: Vec<(usize, &str)> = CHANNELS
-        .iter()
-        .filter_map(|c| names.iter().position(|n| n == c).map(|i| (i, *c)))
-        .collect();
-    if cols.is_empty() {
-        return Err(err(hrow, "p", format!("no measured channel: expected at least one of the columns p, p_hot, x, y; the header has: {}{}", list(&names), format_hint(file, body))));
-    }
-    let mut t = Vec::new();
-    let mut data: Vec<Vec<f64>> = vec![Vec::new(); cols.len()];
-    let mut rows = Vec::new();
-    for (row, line) in lines {
-        let fields: Vec<&str> = line.split(',').map(str::trim).collect();
-        let get = |i: usize, name: &str| -> Result<f64, DataError> {
-            let Some(s) = fields.get(i) else {
-                return Err(err(
-                    row,
-                    name,
-                    format!(
-                        "the row has {} fields, the header {}: value of `{name}` missing",
-                        fields.len(),
-                        names.len()
-                    ),
-                ));
-            };
-            number(s).map_err(|m| err(row, name, m))
+
+    /// The header line's row and column names (no column `t` or channel twice).
+    fn header<'t>(
+        &self,
+        lines: &mut impl Iterator<Item = (usize, &'t str)>,
+    ) -> Result<(usize, Vec<String>), DataError> {
+        let Some((hrow, header)) = lines.next() else {
+            return Err(self.err(
+                1,
+                "t",
+                "the file is empty: expected a header line with `t` and at least one of p, p_hot, x, y"
+                    .into(),
+            ));
         };
-        let tv = get(it, "t")?;
-        if let Some(&prev) = t.last() {
+        let names: Vec<String> = header
+            .split(',')
+            .map(|s| s.trim().trim_matches('"').to_string())
+            .collect();
+        for (i, n) in names.iter().enumerate() {
+            if names[..i].contains(n) && (n == "t" || CHANNELS.contains(&n.as_str())) {
+                return Err(self.err(hrow, n, format!("column `{n}` appears twice in the header")));
+            }
+        }
+        Ok((hrow, names))
+    }
+
+    /// The position of column `t` and of each measured channel present.
+    fn columns(
+        &self,
+        hrow: usize,
+        names: &[String],
+        body: &str,
+    ) -> Result<(usize, Vec<(usize, &'static str)>), DataError> {
+        let file = self.file;
+        let Some(it) = names.iter().position(|n| n == "t") else {
+            return Err(self.err(
+                hrow,
+                "t",
+                format!(
+                    "missing column `t` (time in s); the header has: {}{}",
+                    list(names),
+                    format_hint(file, body)
+                ),
+            ));
+        };
+        let cols: Vec<(usize, &str)> = CHANNELS
+            .iter()
+            .filter_map(|c| names.iter().position(|n| n == c).map(|i| (i, *c)))
+            .collect();
+        if cols.is_empty() {
+            return Err(self.err(hrow, "p", format!("no measured channel: expected at least one of the columns p, p_hot, x, y; the header has: {}{}", list(names), format_hint(file, body))));
+        }
+        Ok((it, cols))
+    }
+
+    /// Time `tv` on `row` must come strictly after the previous sample's `prev`.
+    fn check_time(&self, row: usize, tv: f64, prev: Option<f64>) -> Result<(), DataError> {
+        if let Some(prev) = prev {
             if tv == prev {
-                return Err(err(
+                return Err(self.err(
                     row,
                     "t",
                     format!(
@@ -135,7 +133,7 @@ fn parse(file: &str, text: &str) -> Result<(Measured, Vec<usize>), DataError> {
                 ));
             }
             if tv < prev {
-                return Err(err(
+                return Err(self.err(
                     row,
                     "t",
                     format!(
@@ -146,44 +144,100 @@ fn parse(file: &str, text: &str) -> Result<(Measured, Vec<usize>), DataError> {
                 ));
             }
         }
+        Ok(())
+    }
+
+    /// The value of column `i` (named `name`) in a row's `fields`.
+    fn field(
+        &self,
+        row: usize,
+        fields: &[&str],
+        n_names: usize,
+        (i, name): (usize, &str),
+    ) -> Result<f64, DataError> {
+        let Some(s) = fields.get(i) else {
+            return Err(self.err(
+                row,
+                name,
+                format!(
+                    "the row has {} fields, the header {}: value of `{name}` missing",
+                    fields.len(),
+                    n_names
+                ),
+            ));
+        };
+        number(s).map_err(|m| self.err(row, name, m))
+    }
+
+    /// The record from the columns read: each channel checked for its units.
+    fn record(
+        &self,
+        t: Vec<f64>,
+        cols: &[(usize, &str)],
+        mut data: Vec<Vec<f64>>,
+        rows: &[usize],
+    ) -> Result<Measured, DataError> {
+        let mut m = Measured {
+            source: self.file.to_string(),
+            t,
+            ..Default::default()
+        };
+        for (k, (_, name)) in cols.iter().enumerate() {
+            let v = std::mem::take(&mut data[k]);
+            check_units(name, &v).map_err(|(at, msg)| match at {
+                Some(i) => self.err(rows[i], name, msg),
+                None => self.err(
+                    rows[0],
+                    name,
+                    format!("{msg} (rows {}-{})", rows[0], rows[rows.len() - 1]),
+                ),
+            })?;
+            *match *name {
+                "p" => &mut m.p,
+                "p_hot" => &mut m.p_hot,
+                "x" => &mut m.x,
+                _ => &mut m.y,
+            } = Some(v);
+        }
+        Ok(m)
+    }
+}
+
+fn parse(file: &str, text: &str) -> Result<(Measured, Vec<usize>), DataError> {
+    let e = Errors { file };
+    // an invisible byte-order mark would otherwise glue itself to the first column name
+    let body = text.strip_prefix('\u{feff}').unwrap_or(text);
+    let mut lines = body
+        .lines()
+        .enumerate()
+        .map(|(i, l)| (i + 1, l.trim()))
+        .filter(|(_, l)| !l.is_empty() && !l.starts_with('#'));
+    let (hrow, names) = e.header(&mut lines)?;
+    let (it, cols) = e.columns(hrow, &names, body)?;
+    let mut t = Vec::new();
+    let mut data: Vec<Vec<f64>> = vec![Vec::new(); cols.len()];
+    let mut rows = Vec::new();
+    for (row, line) in lines {
+        let fields: Vec<&str> = line.split(',').map(str::trim).collect();
+        let tv = e.field(row, &fields, names.len(), (it, "t"))?;
+        e.check_time(row, tv, t.last().copied())?;
         t.push(tv);
-        for (k, (i, name)) in cols.iter().enumerate() {
-            data[k].push(get(*i, name)?);
+        for (k, &col) in cols.iter().enumerate() {
+            data[k].push(e.field(row, &fields, names.len(), col)?);
         }
         rows.push(row);
     }
     if t.is_empty() {
-        return Err(err(hrow + 1, "t", "no data rows after the header".into()));
+        return Err(e.err(hrow + 1, "t", "no data rows after the header".into()));
     }
     if t.len() < 2 {
-        return Err(err(
+        return Err(e.err(
             rows[0],
             "t",
             "only one data row: a record needs at least two samples".into(),
         ));
     }
-    let mut m = Measured {
-        source: file.to_string(),
-        t,
-        ..Default::default()
-    };
-    for (k, (_, name)) in cols.iter().enumerate() {
-        let v = std::mem::take(&mut data[k]);
-        check_units(name, &v).map_err(|(at, msg)| match at {
-            Some(i) => err(rows[i], name, msg),
-            None => err(
-                rows[0],
-                name,
-                format!("{msg} (rows {}-{})", rows[0], rows[rows.len() - 1]),
-            ),
-        })?;
-        *match *name {
-            "p" => &mut m.p,
-            "p_hot" => &mut m.p_hot,
-            "x" => &mut m.x,
-            _ => &mut m.y,
-        } = Some(v);
-    }
+    let m = e.record(t, &cols, data, &rows)?;
     Ok((m, rows))
 }
 

@@ -68,6 +68,74 @@ struct Prepared {
     col_of: Vec<Option<usize>>,
 }
 
+impl Prepared {
+    /// Give variable `k` the next sensitivity column, `c`.
+    fn column(&mut self, k: usize, c: Column) {
+        self.col_of[k] = Some(self.columns.len());
+        self.columns.push(c);
+    }
+}
+
+/// A positive parameter far below its start (a regenerator resistance near zero) makes the
+/// model arbitrarily stiff: refuse the trial point instead of integrating it for minutes
+/// (checked on optimizer steps only: they are the runs with sensitivities).
+fn check_floor(v: &Var, val: f64) -> Result<(), FitError> {
+    if v.initial > 0.0 && val < MIN_RATIO * v.initial {
+        return Err(FitError::ParamRange {
+            name: v.name.clone(),
+            value: val,
+            floor: MIN_RATIO * v.initial,
+        });
+    }
+    Ok(())
+}
+
+/// Set variable `v` to `val` in `pr`; its sensitivity column, if it has one.
+fn set_var(pr: &mut Prepared, v: &Var, val: f64, sens: bool) -> Result<Option<Column>, FitError> {
+    Ok(match &v.kind {
+        VarKind::Param(i) => {
+            if sens {
+                check_floor(v, val)?;
+            }
+            pr.p[*i] = val;
+            Some(Column::Param {
+                index: *i,
+                scale: v.scale,
+            })
+        }
+        VarKind::Initial(pos) => {
+            pr.z0[*pos] = val;
+            Some(Column::Initial {
+                pos: *pos,
+                scale: v.scale,
+            })
+        }
+        VarKind::Offset { du, .. } => {
+            if du.is_empty() {
+                None
+            } else {
+                for (g, d) in pr.given.iter_mut().zip(du) {
+                    g.constant += d * val;
+                }
+                Some(Column::Input {
+                    du: du.clone(),
+                    scale: v.scale,
+                })
+            }
+        }
+        VarKind::Sensor(_) => None,
+        VarKind::Linked(pairs) => {
+            for &(g, s) in pairs {
+                pr.given[g].terms.push((s, val - v.initial, false));
+            }
+            Some(Column::Signals {
+                pairs: pairs.clone(),
+                scale: v.scale,
+            })
+        }
+    })
+}
+
 /// Simulated outputs (rows: samples of the window) and their derivatives.
 pub struct StageRun {
     /// Sample indices of the window.
@@ -106,15 +174,7 @@ impl Stage<'_> {
         if !sens {
             columns.clear();
         }
-        let t_start = self.t0 + first as f64 * self.dt;
-        let mut signals: Vec<Signal> = self
-            .signals
-            .iter()
-            .map(|s| Signal {
-                t0: s.t0 - t_start,
-                ..s.clone()
-            })
-            .collect();
+        let mut signals = self.signals_from(first);
         let (gain, lag) = self.apply_sensors(&th, &mut given, &mut signals);
         let zscale: Vec<f64> = {
             let s = state_scale(self.model, &p);
@@ -130,22 +190,8 @@ impl Stage<'_> {
             columns,
             zscale,
         };
-        let x0 = sys.initial(&z0);
-        let samples: Vec<f64> = (0..=last - first).map(|k| k as f64 * self.dt).collect();
-        let t_end = samples[samples.len() - 1].max(self.dt);
-        let mut sim = self.sim;
-        if sim.linear_solver == LinearSolverKind::Auto && sys.columns.len() >= 2 {
-            // block-diagonal Newton matrix: the sparse LU factors the blocks one by one
-            sim.linear_solver = LinearSolverKind::Sparse;
-        }
-        let traj =
-            integrate(&sys, &x0, t_end, &samples, &sim, Hooks::default()).map_err(|source| {
-                FitError::Sim {
-                    stage: self.name.to_string(),
-                    source,
-                }
-            })?;
-        let (mut yhat, mut dyhat) = self.outputs_of(&traj.x, &th, &gain, &col_of, sens);
+        let rows = self.integrate_window(&sys, &z0, last - first)?;
+        let (mut yhat, mut dyhat) = self.outputs_of(&rows, &th, &gain, &col_of, sens);
         for (o, &tau) in lag.iter().enumerate() {
             if tau > 0.0 {
                 yhat[o] = crate::signal::first_order_lag(&yhat[o], self.dt, tau);
@@ -158,75 +204,59 @@ impl Stage<'_> {
         Ok(StageRun { first, yhat, dyhat })
     }
 
+    /// The prescribed signals with their time origin moved to sample `first`.
+    fn signals_from(&self, first: usize) -> Vec<Signal> {
+        let t_start = self.t0 + first as f64 * self.dt;
+        self.signals
+            .iter()
+            .map(|s| Signal {
+                t0: s.t0 - t_start,
+                ..s.clone()
+            })
+            .collect()
+    }
+
+    /// Integrate `sys` from the free states `z0` over `steps` samples; the rows at the samples.
+    fn integrate_window(
+        &self,
+        sys: &Driven,
+        z0: &[f64],
+        steps: usize,
+    ) -> Result<Vec<Vec<f64>>, FitError> {
+        let x0 = sys.initial(z0);
+        let samples: Vec<f64> = (0..=steps).map(|k| k as f64 * self.dt).collect();
+        let t_end = samples[samples.len() - 1].max(self.dt);
+        let mut sim = self.sim;
+        if sim.linear_solver == LinearSolverKind::Auto && sys.columns.len() >= 2 {
+            // block-diagonal Newton matrix: the sparse LU factors the blocks one by one
+            sim.linear_solver = LinearSolverKind::Sparse;
+        }
+        let traj =
+            integrate(sys, &x0, t_end, &samples, &sim, Hooks::default()).map_err(|source| {
+                FitError::Sim {
+                    stage: self.name.to_string(),
+                    source,
+                }
+            })?;
+        Ok(traj.x)
+    }
+
     /// The model parameters, initial free states, prescribed states and sensitivity columns
     /// at the variable values `th` (with the column of each variable, if it has one).
     fn prepare(&self, th: &[f64], sens: bool) -> Result<Prepared, FitError> {
-        let mut p = self.p.clone();
-        let mut z0 = self.z0.clone();
-        let mut given = self.given.clone();
-        let mut columns = Vec::new();
-        let mut col_of = vec![None; self.vars.len()];
+        let mut pr = Prepared {
+            p: self.p.clone(),
+            z0: self.z0.clone(),
+            given: self.given.clone(),
+            columns: Vec::new(),
+            col_of: vec![None; self.vars.len()],
+        };
         for (k, (v, &val)) in self.vars.iter().zip(th).enumerate() {
-            match &v.kind {
-                VarKind::Param(i) => {
-                    if sens && v.initial > 0.0 && val < MIN_RATIO * v.initial {
-                        // a positive parameter far below its start (a regenerator resistance
-                        // near zero) makes the model arbitrarily stiff: refuse the trial
-                        // point instead of integrating it for minutes (optimizer steps only:
-                        // they are the runs with sensitivities)
-                        return Err(FitError::ParamRange {
-                            name: v.name.clone(),
-                            value: val,
-                            floor: MIN_RATIO * v.initial,
-                        });
-                    }
-                    p[*i] = val;
-                    col_of[k] = Some(columns.len());
-                    columns.push(Column::Param {
-                        index: *i,
-                        scale: v.scale,
-                    });
-                }
-                VarKind::Initial(pos) => {
-                    z0[*pos] = val;
-                    col_of[k] = Some(columns.len());
-                    columns.push(Column::Initial {
-                        pos: *pos,
-                        scale: v.scale,
-                    });
-                }
-                VarKind::Offset { du, .. } => {
-                    if !du.is_empty() {
-                        for (g, d) in given.iter_mut().zip(du) {
-                            g.constant += d * val;
-                        }
-                        col_of[k] = Some(columns.len());
-                        columns.push(Column::Input {
-                            du: du.clone(),
-                            scale: v.scale,
-                        });
-                    }
-                }
-                VarKind::Sensor(_) => {}
-                VarKind::Linked(pairs) => {
-                    for &(g, s) in pairs {
-                        given[g].terms.push((s, val - v.initial, false));
-                    }
-                    col_of[k] = Some(columns.len());
-                    columns.push(Column::Signals {
-                        pairs: pairs.clone(),
-                        scale: v.scale,
-                    });
-                }
+            if let Some(c) = set_var(&mut pr, v, val, sens)? {
+                pr.column(k, c);
             }
         }
-        Ok(Prepared {
-            p,
-            z0,
-            given,
-            columns,
-            col_of,
-        })
+        Ok(pr)
     }
 
     /// Outputs (gain and offsets applied) and their sensitivities from the rows of a run.

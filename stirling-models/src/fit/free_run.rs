@@ -23,13 +23,13 @@ use std::time::Instant;
 use serde::Serialize;
 use stirling_dsl::Model;
 
-use super::report::{fit_percent, ChannelFit};
+use super::report::ChannelFit;
 use super::static_shift::cold_weight;
 use super::{FitError, Series};
 use crate::data::Measured;
 use crate::layout::StateLayout;
 use crate::signal::{crossing_frequency, fundamental, savitzky_golay, wrap};
-use crate::sim::{simulate, SimOptions};
+use crate::sim::{simulate, SimOptions, Trajectory};
 
 /// Additive sensor offsets: measured = model + offset.
 #[derive(Clone, Debug, Default, Serialize, PartialEq)]
@@ -154,13 +154,20 @@ pub fn measured_state(
         let wc = cold_weight(i, ps.len(), have_hot);
         x[s] = wc * pc + (1.0 - wc) * ph;
     }
-    let masses = &layout.masses;
+    mass_states(model, p, &layout, &eq, &mut x);
+    Ok(x)
+}
+
+/// The mass states of `x` (if any): the equilibrium total shared in proportion to `p V / T`
+/// of each CV at the pressures already set in `x`.
+fn mass_states(model: &dyn Model, p: &[f64], layout: &StateLayout, eq: &[f64], x: &mut [f64]) {
+    let (ps, masses) = (&layout.pressures, &layout.masses);
     if !masses.is_empty() {
         let nv = model.vessel_names().len();
         let (mut pr, mut vol) = (vec![0.0; nv], vec![0.0; nv]);
-        model.pv(p, &x, &mut pr, &mut vol);
+        model.pv(p, x, &mut pr, &mut vol);
         let mut t_rest = vec![0.0; ps.len()];
-        model.temperatures(p, &eq, &mut t_rest);
+        model.temperatures(p, eq, &mut t_rest);
         let total: f64 = masses.iter().map(|&i| eq[i]).sum();
         let share: Vec<f64> = (0..ps.len())
             .map(|i| x[ps[i]] * vol[i] / t_rest[i])
@@ -170,7 +177,6 @@ pub fn measured_state(
             x[mi] = total * share[j] / ssum;
         }
     }
-    Ok(x)
 }
 
 /// Fundamental-harmonic features of a periodic motion.
@@ -262,6 +268,103 @@ impl FreeRun {
     }
 }
 
+/// The sample range `[a, b]` from `block.0` to `end`, at least `need` samples (the error
+/// names the block and `stage`).
+pub(super) fn sample_range(
+    data: &Measured,
+    block: (f64, f64),
+    end: f64,
+    stage: &str,
+    need: usize,
+) -> Result<(usize, usize), FitError> {
+    let (t0, dt) = (data.t[0], data.dt());
+    let nt = data.t.len();
+    let idx = |t: f64| (((t - t0) / dt).round().max(0.0) as usize).min(nt - 1);
+    let (a, b) = (idx(block.0), idx(end));
+    if b + 1 < a + need {
+        return Err(FitError::ShortBlock {
+            stage: stage.into(),
+            from: block.0,
+            to: block.1,
+            samples: b + 1 - a.min(b + 1),
+            need,
+        });
+    }
+    Ok((a, b))
+}
+
+/// The channels as the model outputs them along the trajectory `x` (offsets added).
+fn model_outputs(ch: &[Channel], x: &[Vec<f64>], off: &SensorOffsets) -> Vec<(String, Vec<f64>)> {
+    ch.iter()
+        .map(|c| {
+            (
+                c.name.clone(),
+                x.iter().map(|r| r[c.state] + off.get(&c.name)).collect(),
+            )
+        })
+        .collect()
+}
+
+/// Fits per channel over the first `len` samples of each block `(label, len)`.
+fn block_fits(
+    meas: &[(String, Vec<f64>)],
+    sim: &[(String, Vec<f64>)],
+    blocks: [(&str, usize); 2],
+) -> Vec<ChannelFit> {
+    let mut fits = Vec::new();
+    for (label, len) in blocks {
+        for ((n, y), (_, yh)) in meas.iter().zip(sim) {
+            fits.push(ChannelFit::plain(n, label, &y[..len], &yh[..len]));
+        }
+    }
+    fits
+}
+
+/// Measured and simulated series of each channel over the samples `a..=b`.
+fn block_series(
+    meas: &[(String, Vec<f64>)],
+    sim: &[(String, Vec<f64>)],
+    t: &[f64],
+    (a, b): (usize, usize),
+) -> Vec<Series> {
+    meas.iter()
+        .zip(sim)
+        .map(|((n, y), (_, yh))| Series {
+            channel: n.clone(),
+            t: (a..=b).map(|i| t[i]).collect(),
+            measured: y.clone(),
+            model: yh.clone(),
+        })
+        .collect()
+}
+
+/// Phase of the simulated `x` relative to the measured one over the last `cycles` of `len`
+/// samples at frequency `f`.
+fn phase_lag(meas: &[f64], sim: &[f64], dt: f64, f: f64, cycles: f64, len: usize) -> f64 {
+    let m = ((cycles / f / dt).round() as usize).clamp(10, len);
+    let k = len - m;
+    let (_, pm) = fundamental(&meas[k..], dt, f);
+    let (_, ps) = fundamental(&sim[k..], dt, f);
+    wrap(ps - pm)
+}
+
+/// Simulate `model` at `p` from `x0` over `steps` samples `dt` apart.
+fn simulate_steps(
+    model: &dyn Model,
+    p: &[f64],
+    x0: &[f64],
+    (steps, dt): (usize, f64),
+    opts: &SimOptions,
+) -> Result<Trajectory, FitError> {
+    let samples: Vec<f64> = (0..=steps).map(|k| k as f64 * dt).collect();
+    simulate(model, p, x0, samples[samples.len() - 1], &samples, opts).map_err(|source| {
+        FitError::Sim {
+            stage: "free run".into(),
+            source,
+        }
+    })
+}
+
 /// Simulate `model` at `p` from the measured state at the start of `block` and compare.
 pub fn free_run(
     model: &dyn Model,
@@ -274,50 +377,16 @@ pub fn free_run(
     let clock = Instant::now();
     let name = "free run";
     let ch = channels(model, data)?;
-    let (t0, dt) = (data.t[0], data.dt());
-    let nt = data.t.len();
-    let idx = |t: f64| (((t - t0) / dt).round().max(0.0) as usize).min(nt - 1);
-    let (a, b) = (idx(block.0), idx(block.1));
-    if b < a + 10 {
-        return Err(FitError::ShortBlock {
-            stage: name.into(),
-            from: block.0,
-            to: block.1,
-            samples: b + 1 - a.min(b + 1),
-            need: 11,
-        });
-    }
+    let dt = data.dt();
+    let (a, b) = sample_range(data, block, block.1, name, 11)?;
     let h = ((opts.smooth / dt).round() as usize).max(3);
     let x0 = measured_state(model, p, data, off, a, h)?;
-    let samples: Vec<f64> = (0..=b - a).map(|k| k as f64 * dt).collect();
-    let traj = simulate(
-        model,
-        p,
-        &x0,
-        samples[samples.len() - 1],
-        &samples,
-        &opts.sim,
-    )
-    .map_err(|source| FitError::Sim {
-        stage: name.into(),
-        source,
-    })?;
+    let traj = simulate_steps(model, p, &x0, (b - a, dt), &opts.sim)?;
     let meas: Vec<(String, Vec<f64>)> = ch
         .iter()
         .map(|c| (c.name.clone(), c.data[a..=b].to_vec()))
         .collect();
-    let sim: Vec<(String, Vec<f64>)> = ch
-        .iter()
-        .map(|c| {
-            (
-                c.name.clone(),
-                traj.x
-                    .iter()
-                    .map(|r| r[c.state] + off.get(&c.name))
-                    .collect(),
-            )
-        })
-        .collect();
+    let sim = model_outputs(&ch, &traj.x, off);
     let measured = cycle_features(&meas, dt);
     let simulated = cycle_features(&sim, dt);
     let f_meas = measured
@@ -329,49 +398,17 @@ pub fn free_run(
         .unwrap_or(block.1 - block.0)
         .min(block.1 - block.0);
     let ns = ((short / dt).round() as usize).clamp(10, b - a + 1);
-    let mut fits = Vec::new();
-    for (label, len) in [("free_run", b - a + 1), ("free_run_short", ns)] {
-        for ((n, y), (_, yh)) in meas.iter().zip(&sim) {
-            let (y, yh) = (&y[..len], &yh[..len]);
-            let fp = fit_percent(y, yh);
-            let rms = (y
-                .iter()
-                .zip(yh)
-                .map(|(u, v)| (u - v) * (u - v))
-                .sum::<f64>()
-                / len as f64)
-                .sqrt();
-            fits.push(ChannelFit {
-                channel: n.clone(),
-                block: label.into(),
-                fit_percent: fp,
-                fit_percent_raw: fp,
-                rms,
-                samples: len,
-            });
-        }
-    }
-    let series = meas
-        .iter()
-        .zip(&sim)
-        .map(|((n, y), (_, yh))| Series {
-            channel: n.clone(),
-            t: (a..=b).map(|i| data.t[i]).collect(),
-            measured: y.clone(),
-            model: yh.clone(),
-        })
-        .collect();
+    let fits = block_fits(
+        &meas,
+        &sim,
+        [("free_run", b - a + 1), ("free_run_short", ns)],
+    );
     let frequency_error = match (&measured, &simulated) {
         (Some(m), Some(s)) => Some(s.frequency / m.frequency - 1.0),
         _ => None,
     };
-    let x_phase_lag = f_meas.map(|f| {
-        let m = ((opts.cycles / f / dt).round() as usize).clamp(10, b - a + 1);
-        let k = b - a + 1 - m;
-        let (_, pm) = fundamental(&meas[0].1[k..], dt, f);
-        let (_, ps) = fundamental(&sim[0].1[k..], dt, f);
-        wrap(ps - pm)
-    });
+    let x_phase_lag =
+        f_meas.map(|f| phase_lag(&meas[0].1, &sim[0].1, dt, f, opts.cycles, b - a + 1));
     Ok(FreeRun {
         x_phase_lag,
         block,
@@ -382,6 +419,6 @@ pub fn free_run(
         simulated,
         frequency_error,
         seconds: clock.elapsed().as_secs_f64(),
-        series,
+        series: block_series(&meas, &sim, &data.t, (a, b)),
     })
 }

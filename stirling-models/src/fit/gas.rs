@@ -48,7 +48,7 @@ pub fn stage<'a>(
     opts: &FitOptions,
 ) -> Result<GasStage<'a>, FitError> {
     let data = rec.data;
-    let (Some(xm), Some(ym), Some(pm)) = (data.x.as_ref(), data.y.as_ref(), data.p.as_ref()) else {
+    let (Some(xm), Some(ym), Some(_)) = (data.x.as_ref(), data.y.as_ref(), data.p.as_ref()) else {
         return Err(FitError::MissingColumns {
             file: data.source.clone(),
             stage: "stage 2 (gas)",
@@ -61,26 +61,9 @@ pub fn stage<'a>(
     let shift = static_shift(model, p, have_hot)?;
     let (sx, sy) = rec.pos.clone().expect("checked");
     let used = [0, 1].map(|k| shift[0][k] * p_off0 + shift[1][k] * ph_off0);
-    let (pos, vel) = (&layout.positions, &layout.velocities);
-    let given = vec![
-        Given::signal(pos[0], 0, false, -x_off[0] + used[0]),
-        Given::signal(vel[0], 0, true, 0.0),
-        Given::signal(pos[1], 1, false, -x_off[1] + used[1]),
-        Given::signal(vel[1], 1, true, 0.0),
-    ];
-    let du = |ch: usize| vec![-shift[ch][0], 0.0, -shift[ch][1], 0.0];
-    let ps = &layout.pressures;
-    let pmean = ps.first().map(|&i| eq[i]).unwrap_or(0.0);
-    let cold_pos = layout.gas_pos(*ps.last().expect("CVs")).expect("gas state");
-    let hot_pos = layout.gas_pos(ps[0]).expect("gas state");
+    let given = given_bodies(layout, x_off, used);
     let mut vars = Var::params(model, p, free, opts.prior);
-    vars.push(Var::offset("p_offset", p_off0, 100.0, 0, du(0)));
-    let mut outputs = vec![Output::new("p", cold_pos, pm, 1e-6 * pmean)];
-    if have_hot {
-        let ph = data.p_hot.as_ref().expect("have_hot");
-        vars.push(Var::offset("p_hot_offset", ph_off0, 100.0, 1, du(1)));
-        outputs.push(Output::new("p_hot", hot_pos, ph, 1e-6 * pmean));
-    }
+    let outputs = pressure_outputs(layout, rec, &eq, &shift, &mut vars);
     let x_start = initial_state(model, layout, rec, p, &eq, x_off);
     let z0: Vec<f64> = layout.gas.iter().map(|&i| x_start[i]).collect();
     let (tr, dt) = (rec.tr, rec.dt);
@@ -109,6 +92,44 @@ pub fn stage<'a>(
         used,
         burn,
     })
+}
+
+/// The body states prescribed from the measured positions (offsets `x_off` less the static
+/// shift `used`) and their derivatives.
+fn given_bodies(layout: &StateLayout, x_off: [f64; 2], used: [f64; 2]) -> Vec<Given> {
+    let (pos, vel) = (&layout.positions, &layout.velocities);
+    vec![
+        Given::signal(pos[0], 0, false, -x_off[0] + used[0]),
+        Given::signal(vel[0], 0, true, 0.0),
+        Given::signal(pos[1], 1, false, -x_off[1] + used[1]),
+        Given::signal(vel[1], 1, true, 0.0),
+    ]
+}
+
+/// The measured pressure outputs, pushing their offset variables (whose input term is the
+/// static `shift`) onto `vars`.
+fn pressure_outputs(
+    layout: &StateLayout,
+    rec: &Record,
+    eq: &[f64],
+    shift: &[Vec<f64>; 2],
+    vars: &mut Vec<Var>,
+) -> Vec<Output> {
+    let data = rec.data;
+    let pm = data.p.as_ref().expect("checked");
+    let du = |ch: usize| vec![-shift[ch][0], 0.0, -shift[ch][1], 0.0];
+    let ps = &layout.pressures;
+    let pmean = ps.first().map(|&i| eq[i]).unwrap_or(0.0);
+    let cold_pos = layout.gas_pos(*ps.last().expect("CVs")).expect("gas state");
+    let hot_pos = layout.gas_pos(ps[0]).expect("gas state");
+    vars.push(Var::offset("p_offset", rec.p_off0, 100.0, 0, du(0)));
+    let mut outputs = vec![Output::new("p", cold_pos, pm, 1e-6 * pmean)];
+    if rec.have_hot {
+        let ph = data.p_hot.as_ref().expect("have_hot");
+        vars.push(Var::offset("p_hot_offset", rec.ph_off0, 100.0, 1, du(1)));
+        outputs.push(Output::new("p_hot", hot_pos, ph, 1e-6 * pmean));
+    }
+    outputs
 }
 
 /// The initial gas state at the window start: measured pressures, masses sharing the

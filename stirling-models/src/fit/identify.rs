@@ -20,7 +20,7 @@ use super::sensitivity::Signal;
 use super::stage_fit::{fit_stage, stats, FittedStage, Solved};
 use super::vars::VarKind;
 use super::{free_run, multiple_shooting, unmeasured};
-use super::{FitError, FitOptions, Identification};
+use super::{FitError, FitOptions, Identification, StageFit};
 use crate::data::Measured;
 use crate::layout::StateLayout;
 
@@ -111,6 +111,179 @@ fn apply(stage: &Stage, values: &[f64], p: &mut [f64]) -> Vec<(usize, f64)> {
     offs
 }
 
+/// The estimates as the stages update them.
+struct Progress<'a> {
+    p: Vec<f64>,
+    x_off: [f64; 2],
+    p_off: f64,
+    ph_off: f64,
+    stage1: Option<StageFit>,
+    stage2: Option<StageFit>,
+    fitted: Vec<FittedStage<'a>>,
+}
+
+impl Progress<'_> {
+    /// Before any stage: `p0` and the record's starting offsets.
+    fn start(p0: &[f64], rec: &Record) -> Self {
+        Progress {
+            p: p0.to_vec(),
+            x_off: rec.x_off0,
+            p_off: rec.p_off0,
+            ph_off: rec.ph_off0,
+            stage1: None,
+            stage2: None,
+            fitted: Vec::new(),
+        }
+    }
+
+    /// The sensor offsets reached so far.
+    fn offsets(&self, have_hot: bool) -> free_run::SensorOffsets {
+        free_run::SensorOffsets {
+            x: self.x_off[0],
+            y: self.x_off[1],
+            p: self.p_off,
+            p_hot: have_hot.then_some(self.ph_off),
+        }
+    }
+}
+
+impl<'a> Run<'a, '_> {
+    /// Stage 1 on the measured pressures alone; kept unless it is rerun with `dp` later.
+    fn first_mechanics(
+        &self,
+        st: &mut Progress<'a>,
+        mech: &[usize],
+        rerun: bool,
+    ) -> Result<(), FitError> {
+        let (stage, solved) = self.mechanics(&st.p, mech, st.x_off, (st.p_off, st.ph_off), None)?;
+        for (out, v) in apply(&stage, &solved.values, &mut st.p) {
+            st.x_off[out] = v;
+        }
+        if !rerun {
+            st.stage1 = Some(solved.fit.clone());
+            st.fitted.push(self.fitted(stage, &solved));
+        }
+        Ok(())
+    }
+
+    /// Stage 2 (with no free parameters unless `opts.stage2`: then it only fits the offsets).
+    fn gas_stage(
+        &self,
+        st: &mut Progress<'a>,
+        gas_free: &[usize],
+    ) -> Result<(GasStage<'a>, Solved), FitError> {
+        let free2 = if self.opts.stage2 {
+            gas_free.to_vec()
+        } else {
+            Vec::new()
+        };
+        let (gs, solved) = self.gas(&st.p, &free2, st.x_off)?;
+        for (out, v) in apply(&gs.stage, &solved.values, &mut st.p) {
+            if out == 0 {
+                st.p_off = v;
+            } else {
+                st.ph_off = v;
+            }
+        }
+        st.x_off = gs.position_offsets(st.x_off, st.p_off, st.ph_off);
+        if self.opts.stage2 {
+            st.stage2 = Some(solved.fit.clone());
+        }
+        Ok((gs, solved))
+    }
+
+    /// Stage 1 again from `p0`, on `p` plus stage 2's pressure differences, with the covariance
+    /// stage 2's uncertainty carries in.
+    fn mechanics_with_dp(
+        &self,
+        st: &mut Progress<'a>,
+        mech: &[usize],
+        (gs, s2): &(GasStage<'a>, Solved),
+    ) -> Result<(), FitError> {
+        let rec = &self.rec;
+        let dp = unmeasured::pressure_differences(&gs.stage, &s2.lm.x, &self.layout, rec)?;
+        for &j in mech {
+            st.p[j] = self.p0[j];
+        }
+        let (stage, mut solved) =
+            self.mechanics(&st.p, mech, st.x_off, (st.p_off, st.ph_off), Some(&dp))?;
+        let carried = unmeasured::carried_covariance(
+            &stage,
+            &solved.lm.x,
+            &solved.lm.jacobian,
+            &solved.keep,
+            &gs.stage,
+            &s2.lm.x,
+            &s2.fit.stats,
+            &self.layout,
+            rec,
+        )?;
+        let extra = match (&solved.noise_cov, carried) {
+            (Some(a), Some(b)) => Some(a + b),
+            (a, b) => a.clone().or(b),
+        };
+        solved.fit.stats = stats(&stage, &solved.lm, extra.as_ref());
+        for (out, v) in apply(&stage, &solved.values, &mut st.p) {
+            st.x_off[out] = v;
+        }
+        st.stage1 = Some(solved.fit.clone());
+        st.fitted.push(self.fitted(stage, &solved));
+        Ok(())
+    }
+
+    /// The optional multiple-shooting refinement; updates `p` and `offsets` when it succeeds.
+    fn refine(
+        &self,
+        data: &Measured,
+        idx_free: &[usize],
+        p: &mut [f64],
+        offsets: &mut free_run::SensorOffsets,
+        notes: &mut Vec<String>,
+    ) -> Option<multiple_shooting::MultipleShooting> {
+        let mo = self.opts.multiple_shooting.as_ref()?;
+        match multiple_shooting::multiple_shooting(
+            self.model,
+            p,
+            idx_free,
+            data,
+            offsets,
+            self.rec.train,
+            mo,
+        ) {
+            Ok(r) => {
+                for (k, (_, v)) in r.params.iter().enumerate() {
+                    p[k] = *v;
+                }
+                *offsets = r.offsets.clone();
+                Some(r)
+            }
+            Err(e) => {
+                notes.push(format!("multiple shooting: {e}"));
+                None
+            }
+        }
+    }
+
+    /// The optional free-run validation on the holdout block (else the training block).
+    fn validate(
+        &self,
+        data: &Measured,
+        p: &[f64],
+        offsets: &free_run::SensorOffsets,
+        notes: &mut Vec<String>,
+    ) -> Option<free_run::FreeRun> {
+        let fo = self.opts.free_run.as_ref()?;
+        let block = self.rec.holdout.unwrap_or(self.rec.train);
+        match free_run::free_run(self.model, p, data, offsets, block, fo) {
+            Ok(r) => Some(r),
+            Err(e) => {
+                notes.push(format!("free run: {e}"));
+                None
+            }
+        }
+    }
+}
+
 /// [`identify`], also returning the fitted stages (stage 1, then stage 2, those that ran).
 pub fn identify_stages<'a>(
     model: &'a dyn Model,
@@ -131,116 +304,37 @@ pub fn identify_stages<'a>(
         p0: p0.to_vec(),
     };
     let rec = &run.rec;
-    let mut p = p0.to_vec();
-    let mut x_off = rec.x_off0;
-    let (mut p_off, mut ph_off) = (rec.p_off0, rec.ph_off0);
+    let mut st = Progress::start(p0, rec);
     let run1 = opts.stage1 && !mech.is_empty();
     let estimate_dp = run1 && !rec.have_hot && run.layout.pressures.len() > 1;
     let run2 = (opts.stage2 && !gas_free.is_empty()) || estimate_dp;
-    let mut fitted = Vec::new();
-    let (mut stage1, mut stage2) = (None, None);
-
     if run1 {
-        let (st, solved) = run.mechanics(&p, &mech, x_off, (p_off, ph_off), None)?;
-        for (out, v) in apply(&st, &solved.values, &mut p) {
-            x_off[out] = v;
-        }
-        if !estimate_dp {
-            stage1 = Some(solved.fit.clone());
-            fitted.push(run.fitted(st, &solved));
-        }
+        run.first_mechanics(&mut st, &mech, estimate_dp)?;
     }
-    let mut gas_fit = None;
-    if run2 {
-        let free2 = if opts.stage2 {
-            gas_free.clone()
-        } else {
-            Vec::new()
-        };
-        let (gs, solved) = run.gas(&p, &free2, x_off)?;
-        for (out, v) in apply(&gs.stage, &solved.values, &mut p) {
-            if out == 0 {
-                p_off = v;
-            } else {
-                ph_off = v;
-            }
-        }
-        x_off = gs.position_offsets(x_off, p_off, ph_off);
-        if opts.stage2 {
-            stage2 = Some(solved.fit.clone());
-        }
-        gas_fit = Some((gs, solved));
-    }
+    let gas_fit = if run2 {
+        Some(run.gas_stage(&mut st, &gas_free)?)
+    } else {
+        None
+    };
     if estimate_dp {
-        let (gs, s2) = gas_fit.as_ref().expect("stage 2 ran");
-        let dp = unmeasured::pressure_differences(&gs.stage, &s2.lm.x, &run.layout, rec)?;
-        for &j in &mech {
-            p[j] = run.p0[j];
-        }
-        let (st, mut solved) = run.mechanics(&p, &mech, x_off, (p_off, ph_off), Some(&dp))?;
-        let carried = unmeasured::carried_covariance(
-            &st,
-            &solved.lm.x,
-            &solved.lm.jacobian,
-            &solved.keep,
-            &gs.stage,
-            &s2.lm.x,
-            &s2.fit.stats,
-            &run.layout,
-            rec,
-        )?;
-        let extra = match (&solved.noise_cov, carried) {
-            (Some(a), Some(b)) => Some(a + b),
-            (a, b) => a.clone().or(b),
-        };
-        solved.fit.stats = stats(&st, &solved.lm, extra.as_ref());
-        for (out, v) in apply(&st, &solved.values, &mut p) {
-            x_off[out] = v;
-        }
-        stage1 = Some(solved.fit.clone());
-        fitted.push(run.fitted(st, &solved));
+        let gf = gas_fit.as_ref().expect("stage 2 ran");
+        run.mechanics_with_dp(&mut st, &mech, gf)?;
     }
     if let Some((gs, s2)) = gas_fit.filter(|_| opts.stage2) {
-        fitted.push(run.fitted(gs.stage, &s2));
+        st.fitted.push(run.fitted(gs.stage, &s2));
     }
-    let mut offsets = free_run::SensorOffsets {
-        x: x_off[0],
-        y: x_off[1],
-        p: p_off,
-        p_hot: rec.have_hot.then_some(ph_off),
-    };
+    let mut offsets = st.offsets(rec.have_hot);
     let mut notes = Vec::new();
-    let mut ms = None;
-    if let Some(mo) = &opts.multiple_shooting {
-        let mut idx_free: Vec<usize> = mech.clone();
-        idx_free.extend(gas_free.iter().filter(|j| !mech.contains(j)));
-        match multiple_shooting::multiple_shooting(
-            model, &p, &idx_free, data, &offsets, rec.train, mo,
-        ) {
-            Ok(r) => {
-                for (k, (_, v)) in r.params.iter().enumerate() {
-                    p[k] = *v;
-                }
-                offsets = r.offsets.clone();
-                ms = Some(r);
-            }
-            Err(e) => notes.push(format!("multiple shooting: {e}")),
-        }
-    }
-    let mut fr = None;
-    if let Some(fo) = &opts.free_run {
-        let block = rec.holdout.unwrap_or(rec.train);
-        match free_run::free_run(model, &p, data, &offsets, block, fo) {
-            Ok(r) => fr = Some(r),
-            Err(e) => notes.push(format!("free run: {e}")),
-        }
-    }
+    let mut idx_free: Vec<usize> = mech.clone();
+    idx_free.extend(gas_free.iter().filter(|j| !mech.contains(j)));
+    let ms = run.refine(data, &idx_free, &mut st.p, &mut offsets, &mut notes);
+    let fr = run.validate(data, &st.p, &offsets, &mut notes);
     let id = Identification {
         model: model.name().into(),
         n: model.n(),
-        params: crate::params::named(model, &p),
-        stage1,
-        stage2,
+        params: crate::params::named(model, &st.p),
+        stage1: st.stage1,
+        stage2: st.stage2,
         train: rec.train,
         holdout: rec.holdout,
         seconds: clock.elapsed().as_secs_f64(),
@@ -249,5 +343,5 @@ pub fn identify_stages<'a>(
         free_run: fr,
         notes,
     };
-    Ok((id, fitted))
+    Ok((id, st.fitted))
 }

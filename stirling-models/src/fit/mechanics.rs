@@ -33,6 +33,98 @@ pub struct MechInputs<'s> {
     pub dp: Option<&'s [Signal]>,
 }
 
+/// The CV pressures prescribed from `p` plus the gas stage's differences `dp` (pushed onto
+/// `signals`).
+fn given_with_dp(ps: &[usize], dp: &[Signal], p_off: f64, signals: &mut Vec<Signal>) -> Vec<Given> {
+    let cold = ps.len() - 1;
+    ps.iter()
+        .enumerate()
+        .map(|(i, &s)| {
+            let mut terms = vec![(0, 1.0, false)];
+            if i != cold {
+                terms.push((signals.len(), 1.0, false));
+                signals.push(dp[i].clone());
+            }
+            Given {
+                state: s,
+                terms,
+                constant: -p_off,
+            }
+        })
+        .collect()
+}
+
+/// The CV pressures prescribed from the measured `p` (and `p_hot`), interpolated between.
+fn given_measured(ps: &[usize], inp: &MechInputs, have_hot: bool) -> Vec<Given> {
+    ps.iter()
+        .enumerate()
+        .map(|(i, &s)| {
+            let wc = cold_weight(i, ps.len(), have_hot);
+            let mut terms = vec![(0, wc, false)];
+            if have_hot {
+                terms.push((1, 1.0 - wc, false));
+            }
+            let hot = if have_hot {
+                (1.0 - wc) * inp.ph_off
+            } else {
+                0.0
+            };
+            Given {
+                state: s,
+                terms,
+                constant: -wc * inp.p_off - hot,
+            }
+        })
+        .collect()
+}
+
+/// The cycle frequency on the training block `tr` (from `y`, else `x`; 0 if neither cycles).
+fn training_frequency(xm: &[f64], ym: &[f64], tr: (usize, usize), dt: f64) -> f64 {
+    cycle_frequency(&ym[tr.0..=tr.1], dt)
+        .or_else(|| cycle_frequency(&xm[tr.0..=tr.1], dt))
+        .unwrap_or(0.0)
+}
+
+/// The body states `[x, v, y, w]` at the window start from the smoothed measured positions.
+fn body_start(rec: &Record, x_off: [f64; 2]) -> Vec<f64> {
+    let (sx, sy) = rec.pos.as_ref().expect("checked");
+    let ta = rec.tr.0;
+    vec![
+        sx.val[ta] - x_off[0],
+        sx.der[ta],
+        sy.val[ta] - x_off[1],
+        sy.der[ta],
+    ]
+}
+
+/// The fit variables: free parameters, the four body initial states `z0`, the position offsets.
+fn variables(model: &dyn Model, inp: &MechInputs, z0: &[f64], opts: &FitOptions) -> Vec<Var> {
+    let x_off = inp.x_off;
+    let mut vars = Var::params(model, inp.p, inp.free, opts.prior);
+    for (k, nm) in ["x(0)", "v(0)", "y(0)", "w(0)"].iter().enumerate() {
+        vars.push(Var::initial(
+            nm,
+            z0[k],
+            if k % 2 == 0 { 1e-3 } else { 0.05 },
+            k,
+        ));
+    }
+    vars.push(Var::offset("x_offset", x_off[0], 1e-3, 0, vec![]));
+    vars.push(Var::offset("y_offset", x_off[1], 1e-3, 1, vec![]));
+    vars
+}
+
+/// The noise on the prescribed pressure signals: `(signal, sigma, smoothing half-width)`.
+fn input_noise(rec: &Record) -> Vec<(usize, f64, usize)> {
+    let data = rec.data;
+    let hp = (rec.h / 2).max(3);
+    let mut input_noise = vec![(0, noise_sigma(data.p.as_ref().expect("checked")), hp)];
+    if let Some(v) = data.p_hot.as_ref().filter(|_| rec.have_hot) {
+        input_noise.push((1, noise_sigma(v), hp));
+    }
+    input_noise
+}
+
 /// Build stage 1.
 pub fn stage<'a>(
     model: &'a dyn Model,
@@ -63,82 +155,20 @@ pub fn stage<'a>(
     }
     let ps = &layout.pressures;
     let given: Vec<Given> = match inp.dp {
-        Some(dp) => {
-            let cold = ps.len() - 1;
-            ps.iter()
-                .enumerate()
-                .map(|(i, &s)| {
-                    let mut terms = vec![(0, 1.0, false)];
-                    if i != cold {
-                        terms.push((signals.len(), 1.0, false));
-                        signals.push(dp[i].clone());
-                    }
-                    Given {
-                        state: s,
-                        terms,
-                        constant: -inp.p_off,
-                    }
-                })
-                .collect()
-        }
-        None => ps
-            .iter()
-            .enumerate()
-            .map(|(i, &s)| {
-                let wc = cold_weight(i, ps.len(), have_hot);
-                let mut terms = vec![(0, wc, false)];
-                if have_hot {
-                    terms.push((1, 1.0 - wc, false));
-                }
-                let hot = if have_hot {
-                    (1.0 - wc) * inp.ph_off
-                } else {
-                    0.0
-                };
-                Given {
-                    state: s,
-                    terms,
-                    constant: -wc * inp.p_off - hot,
-                }
-            })
-            .collect(),
+        Some(dp) => given_with_dp(ps, dp, inp.p_off, &mut signals),
+        None => given_measured(ps, inp, have_hot),
     };
-    let (sx, sy) = rec.pos.as_ref().expect("checked");
-    let ta = rec.tr.0;
-    let x_off = inp.x_off;
-    let z0 = vec![
-        sx.val[ta] - x_off[0],
-        sx.der[ta],
-        sy.val[ta] - x_off[1],
-        sy.der[ta],
-    ];
-    let mut vars = Var::params(model, inp.p, inp.free, opts.prior);
-    for (k, nm) in ["x(0)", "v(0)", "y(0)", "w(0)"].iter().enumerate() {
-        vars.push(Var::initial(
-            nm,
-            z0[k],
-            if k % 2 == 0 { 1e-3 } else { 0.05 },
-            k,
-        ));
-    }
-    vars.push(Var::offset("x_offset", x_off[0], 1e-3, 0, vec![]));
-    vars.push(Var::offset("y_offset", x_off[1], 1e-3, 1, vec![]));
+    let z0 = body_start(rec, inp.x_off);
+    let vars = variables(model, inp, &z0, opts);
     let outputs = vec![Output::new("x", 0, xm, 1e-9), Output::new("y", 2, ym, 1e-9)];
     let (tr, dt) = (rec.tr, rec.dt);
-    let f0 = cycle_frequency(&ym[tr.0..=tr.1], dt)
-        .or_else(|| cycle_frequency(&xm[tr.0..=tr.1], dt))
-        .unwrap_or(0.0);
-    let hp = (rec.h / 2).max(3);
-    let mut input_noise = vec![(0, noise_sigma(data.p.as_ref().expect("checked")), hp)];
-    if let Some(v) = data.p_hot.as_ref().filter(|_| have_hot) {
-        input_noise.push((1, noise_sigma(v), hp));
-    }
+    let f0 = training_frequency(xm, ym, tr, dt);
     let mut base = vec![0.0; model.n_states()];
     model.equilibrium_guess(inp.p, &mut base);
     let measured = if have_hot { 2 } else { 1 };
     Ok(Stage {
         drift: drift_count(tr.1 - tr.0 + 1, dt, opts.drift_cut * f0),
-        input_noise,
+        input_noise: input_noise(rec),
         derived: (measured..signals.len()).collect(),
         name: "stage 1 (mechanics driven by measured pressure)",
         model,

@@ -24,8 +24,8 @@ use nalgebra::DMatrix;
 use serde::Serialize;
 use stirling_dsl::{Model, StateKind};
 
-use super::free_run::{channels, measured_state, SensorOffsets};
-use super::report::{self, fit_percent, ChannelFit, FitStats};
+use super::free_run::{channels, measured_state, sample_range, Channel, SensorOffsets};
+use super::report::{self, ChannelFit, FitStats};
 use super::sensitivity::{Column, Driven};
 use super::{lm, FitError};
 use crate::data::Measured;
@@ -131,6 +131,14 @@ struct Eval {
     ends: Vec<Vec<f64>>,
 }
 
+/// Where one segment's rows go: segment `s` covers samples `a..a + used`, from row `row0`.
+struct SegRows {
+    s: usize,
+    a: usize,
+    used: usize,
+    row0: usize,
+}
+
 impl Problem<'_> {
     fn values(&self, u: &[f64]) -> Vec<f64> {
         self.vars
@@ -140,131 +148,234 @@ impl Problem<'_> {
             .collect()
     }
 
-    fn eval(&self, u: &[f64], sens: bool) -> Result<Eval, FitError> {
-        let th = self.values(u);
-        let (np, no, n) = (self.free.len(), self.n_off, self.model.n_states());
+    /// All model parameters with the free ones taken from `th`.
+    fn params_with(&self, th: &[f64]) -> Vec<f64> {
         let mut p = self.p.clone();
         for (k, &j) in self.free.iter().enumerate() {
             p[j] = th[k];
         }
+        p
+    }
+
+    /// The sensitivity columns: every initial state, then the free parameters.
+    fn columns(&self) -> Vec<Column> {
+        let (np, no, n) = (self.free.len(), self.n_off, self.model.n_states());
         let mut columns: Vec<Column> = Vec::new();
-        if sens {
-            for s in 0..n {
-                columns.push(Column::Initial {
-                    pos: s,
-                    scale: self.vars[np + no + s].scale,
-                });
-            }
-            for (k, &j) in self.free.iter().enumerate() {
-                columns.push(Column::Param {
-                    index: j,
-                    scale: self.vars[k].scale,
-                });
-            }
+        for s in 0..n {
+            columns.push(Column::Initial {
+                pos: s,
+                scale: self.vars[np + no + s].scale,
+            });
         }
-        let nvar = self.vars.len();
+        for (k, &j) in self.free.iter().enumerate() {
+            columns.push(Column::Param {
+                index: j,
+                scale: self.vars[k].scale,
+            });
+        }
+        columns
+    }
+
+    fn eval(&self, u: &[f64], sens: bool) -> Result<Eval, FitError> {
+        let th = self.values(u);
+        let n = self.model.n_states();
+        let p = self.params_with(&th);
+        let columns = if sens { self.columns() } else { Vec::new() };
         let rows: usize = self.segs.iter().map(|(a, b)| b - a).sum::<usize>() + 1;
         let rows = rows * self.outs.len();
-        let mut r = vec![0.0; rows];
-        let mut jm = DMatrix::zeros(if sens { rows } else { 0 }, nvar);
-        let mut yhat = vec![Vec::new(); self.outs.len()];
-        let mut ends = Vec::new();
+        let mut ev = Eval {
+            r: vec![0.0; rows],
+            j: DMatrix::zeros(if sens { rows } else { 0 }, self.vars.len()),
+            yhat: vec![Vec::new(); self.outs.len()],
+            ends: Vec::new(),
+        };
         let nseg = self.segs.len();
-        let total = rows / self.outs.len();
         let mut row0 = 0;
         for (s, &(a, b)) in self.segs.iter().enumerate() {
-            let base = np + no + s * n;
-            let z0 = th[base..base + n].to_vec();
-            let sys = Driven {
-                model: self.model,
-                p: p.clone(),
-                base: z0.clone(),
-                free: self.free_states(),
-                given: Vec::new(),
-                signals: Vec::new(),
-                columns: columns.clone(),
-                zscale: self.zscale.clone(),
-            };
-            let x0 = sys.initial(&z0);
-            let samples: Vec<f64> = (0..=b - a).map(|k| k as f64 * self.dt).collect();
-            let traj = integrate(
-                &sys,
-                &x0,
-                samples[samples.len() - 1],
-                &samples,
-                &self.sim,
-                Hooks::default(),
-            )
-            .map_err(|source| FitError::Sim {
-                stage: "multiple shooting".into(),
-                source,
-            })?;
-            ends.push(traj.x[traj.x.len() - 1][..n].to_vec());
+            let x = self.simulate_segment(s, b - a, &th, &p, &columns)?;
+            ev.ends.push(x[x.len() - 1][..n].to_vec());
             // the last sample belongs to the next segment, except in the last one
             let used = if s + 1 == nseg { b - a + 1 } else { b - a };
-            for (o, (_, st, data, sig, ov)) in self.outs.iter().enumerate() {
-                let off = ov.map(|k| th[np + k]).unwrap_or(self.off0[o]);
-                for k in 0..used {
-                    let row = o * total + row0 + k;
-                    let xr = &traj.x[k];
-                    let y = xr[*st] + off;
-                    yhat[o].push(y);
-                    r[row] = (y - data[a + k]) / sig;
-                    if sens {
-                        for c in 0..n {
-                            jm[(row, base + c)] = xr[n + c * n + st] / sig;
-                        }
-                        for c in 0..np {
-                            jm[(row, c)] = xr[n + (n + c) * n + st] / sig;
-                        }
-                        if let Some(kv) = ov {
-                            jm[(row, np + kv)] = self.vars[np + kv].scale / sig;
-                        }
+            let at = SegRows { s, a, used, row0 };
+            self.fill_rows(&mut ev, &x, &at, &th, sens);
+            row0 += used;
+        }
+        Ok(ev)
+    }
+
+    /// Integrate segment `s` (`len` sample steps) freely from its initial state in `th`.
+    fn simulate_segment(
+        &self,
+        s: usize,
+        len: usize,
+        th: &[f64],
+        p: &[f64],
+        columns: &[Column],
+    ) -> Result<Vec<Vec<f64>>, FitError> {
+        let n = self.model.n_states();
+        let base = self.free.len() + self.n_off + s * n;
+        let z0 = th[base..base + n].to_vec();
+        let sys = Driven {
+            model: self.model,
+            p: p.to_vec(),
+            base: z0.clone(),
+            free: self.free_states(),
+            given: Vec::new(),
+            signals: Vec::new(),
+            columns: columns.to_vec(),
+            zscale: self.zscale.clone(),
+        };
+        let x0 = sys.initial(&z0);
+        let samples: Vec<f64> = (0..=len).map(|k| k as f64 * self.dt).collect();
+        let traj = integrate(
+            &sys,
+            &x0,
+            samples[samples.len() - 1],
+            &samples,
+            &self.sim,
+            Hooks::default(),
+        )
+        .map_err(|source| FitError::Sim {
+            stage: "multiple shooting".into(),
+            source,
+        })?;
+        Ok(traj.x)
+    }
+
+    /// Write one segment's residuals, model outputs and (with `sens`) Jacobian rows.
+    fn fill_rows(&self, ev: &mut Eval, x: &[Vec<f64>], at: &SegRows, th: &[f64], sens: bool) {
+        let (np, no, n) = (self.free.len(), self.n_off, self.model.n_states());
+        let base = np + no + at.s * n;
+        let total = ev.r.len() / self.outs.len();
+        for (o, (_, st, data, sig, ov)) in self.outs.iter().enumerate() {
+            let off = ov.map(|k| th[np + k]).unwrap_or(self.off0[o]);
+            for k in 0..at.used {
+                let row = o * total + at.row0 + k;
+                let xr = &x[k];
+                let y = xr[*st] + off;
+                ev.yhat[o].push(y);
+                ev.r[row] = (y - data[at.a + k]) / sig;
+                if sens {
+                    for c in 0..n {
+                        ev.j[(row, base + c)] = xr[n + c * n + st] / sig;
+                    }
+                    for c in 0..np {
+                        ev.j[(row, c)] = xr[n + (n + c) * n + st] / sig;
+                    }
+                    if let Some(kv) = ov {
+                        ev.j[(row, np + kv)] = self.vars[np + kv].scale / sig;
                     }
                 }
             }
-            row0 += used;
         }
-        Ok(Eval {
-            r,
-            j: jm,
-            yhat,
-            ends,
-        })
     }
 
     fn free_states(&self) -> Vec<usize> {
         (0..self.model.n_states()).collect()
     }
+
+    /// The sensor offsets at `th`: fitted ones from `th`, the others as given.
+    fn offsets_at(&self, th: &[f64], given: &SensorOffsets) -> SensorOffsets {
+        let np = self.free.len();
+        let mut offsets = given.clone();
+        for (o, out) in self.outs.iter().enumerate() {
+            let v = out.4.map(|k| th[np + k]).unwrap_or(self.off0[o]);
+            match out.0.as_str() {
+                "x" => offsets.x = v,
+                "y" => offsets.y = v,
+                "p" => offsets.p = v,
+                "p_hot" => offsets.p_hot = Some(v),
+                _ => {}
+            }
+        }
+        offsets
+    }
+
+    /// Each segment with its defect: the largest scaled jump from the previous segment's end.
+    fn segments(&self, fin: &Eval, th: &[f64], t: &[f64]) -> Vec<Segment> {
+        let (np, n) = (self.free.len(), self.model.n_states());
+        self.segs
+            .iter()
+            .enumerate()
+            .map(|(s, &(sa, sb))| {
+                let defect = if s == 0 {
+                    0.0
+                } else {
+                    let base = np + self.n_off + s * n;
+                    (0..n)
+                        .map(|i| ((fin.ends[s - 1][i] - th[base + i]) / self.zscale[i]).abs())
+                        .fold(0.0, f64::max)
+                };
+                Segment {
+                    t0: t[sa],
+                    t1: t[sb],
+                    defect,
+                }
+            })
+            .collect()
+    }
+
+    /// Fit per channel over the segments, from the block's first sample `a`.
+    fn fits(&self, fin: &Eval, a: usize) -> Vec<ChannelFit> {
+        self.outs
+            .iter()
+            .zip(&fin.yhat)
+            .map(|((name, _, d, _, _), yh)| {
+                ChannelFit::plain(name, "segments", &d[a..a + yh.len()], yh)
+            })
+            .collect()
+    }
+
+    /// Statistics of the estimates at the optimum.
+    fn stats(&self, res: &lm::LmResult) -> FitStats {
+        let np = self.free.len();
+        let vnames: Vec<(String, bool)> = self
+            .vars
+            .iter()
+            .enumerate()
+            .map(|(k, v)| (v.name.clone(), k < np))
+            .collect();
+        let init: Vec<f64> = self.vars.iter().map(|v| v.initial).collect();
+        let scale: Vec<f64> = self.vars.iter().map(|v| v.scale).collect();
+        report::stats_full(
+            &vnames,
+            &init,
+            &scale,
+            &res.x,
+            &res.residuals,
+            &res.jacobian,
+            0,
+            None,
+        )
+    }
+
+    /// Minimise the output error over all variables (scaled, from 0).
+    fn solve(&self, opts: &lm::LmOptions) -> Result<lm::LmResult, FitError> {
+        let mut last_err = None;
+        let mut eval = |u: &[f64]| match self.eval(u, true) {
+            Ok(e) => Some((e.r, e.j)),
+            Err(e) => {
+                last_err = Some(e);
+                None
+            }
+        };
+        let u0 = vec![0.0; self.vars.len()];
+        lm::minimize(&mut eval, &u0, opts).ok_or_else(|| {
+            last_err
+                .clone()
+                .unwrap_or(FitError::Start("multiple shooting".into()))
+        })
+    }
 }
 
-/// Refine the parameters `free` (indices) of `model` from `p0` and the offsets `off` by multiple
-/// shooting over the training block `block` of `data`.
-pub fn multiple_shooting(
-    model: &dyn Model,
-    p0: &[f64],
-    free: &[usize],
-    data: &Measured,
-    off: &SensorOffsets,
+/// Cut `[a, b]` into segments of about `opts.cycles` cycles of the measured frequency.
+fn cut_segments(
+    ch: &[Channel],
+    (a, b): (usize, usize),
+    dt: f64,
     block: (f64, f64),
-    opts: &MsOptions,
-) -> Result<MultipleShooting, FitError> {
-    let clock = Instant::now();
-    let ch = channels(model, data)?;
-    let (t0, dt) = (data.t[0], data.dt());
-    let nt = data.t.len();
-    let idx = |t: f64| (((t - t0) / dt).round().max(0.0) as usize).min(nt - 1);
-    let a = idx(block.0);
-    let b = idx(block.1.min(block.0 + opts.span));
-    if b < a + 20 {
-        return Err(FitError::ShortBlock {
-            stage: "multiple shooting".into(),
-            from: block.0,
-            to: block.1,
-            samples: b + 1 - a.min(b + 1),
-            need: 21,
-        });
-    }
+    cycles: f64,
+) -> Result<Vec<(usize, usize)>, FitError> {
     let f = crate::signal::cycle_frequency(&ch[0].data[a..=b], dt)
         .or_else(|| crate::signal::cycle_frequency(&ch[1].data[a..=b], dt))
         .ok_or_else(|| FitError::BlockCycles {
@@ -272,31 +383,47 @@ pub fn multiple_shooting(
             from: block.0,
             to: block.1,
         })?;
-    let seg_len = ((opts.cycles / f / dt).round() as usize).max(10);
+    let seg_len = ((cycles / f / dt).round() as usize).max(10);
     let nseg = ((b - a) as f64 / seg_len as f64).round().max(1.0) as usize;
-    let segs: Vec<(usize, usize)> = (0..nseg)
+    Ok((0..nseg)
         .map(|s| (a + s * (b - a) / nseg, a + (s + 1) * (b - a) / nseg))
-        .collect();
-    let h = ((opts.smooth / dt).round() as usize).max(3);
-    let n = model.n_states();
-    let names = model.state_names();
-    let sscale = state_scale(model, p0);
-    let mut vars: Vec<Var> = free
-        .iter()
+        .collect())
+}
+
+/// The free model parameters as variables, scaled by their starting values.
+fn param_vars(model: &dyn Model, p0: &[f64], free: &[usize]) -> Vec<Var> {
+    free.iter()
         .map(|&j| Var {
             name: model.params()[j].name.into(),
             initial: p0[j],
             scale: p0[j].abs().max(1e-12),
         })
-        .collect();
+        .collect()
+}
+
+/// What [`output_vars`] builds: the outputs, their given offsets, how many offsets are fitted.
+struct Outputs {
+    outs: Vec<(String, usize, Vec<f64>, f64, Option<usize>)>,
+    off0: Vec<f64>,
+    n_off: usize,
+}
+
+/// The measured outputs with their noise levels; with `fit_offsets`, one offset variable each.
+fn output_vars(
+    ch: &[Channel],
+    off: &SensorOffsets,
+    sscale: &[f64],
+    fit_offsets: bool,
+    vars: &mut Vec<Var>,
+) -> Outputs {
     let mut outs = Vec::new();
     let mut off0 = Vec::new();
     let mut n_off = 0;
-    for c in &ch {
+    for c in ch {
         let o = off.get(&c.name);
         let is_p = c.name.starts_with('p');
         let sig = noise_sigma(&c.data).max(if is_p { 1e-6 * sscale[c.state] } else { 1e-9 });
-        let ov = if opts.offsets {
+        let ov = if fit_offsets {
             vars.push(Var {
                 name: format!("{}_offset", c.name),
                 initial: o,
@@ -310,6 +437,21 @@ pub fn multiple_shooting(
         outs.push((c.name.clone(), c.state, c.data.clone(), sig, ov));
         off0.push(o);
     }
+    Outputs { outs, off0, n_off }
+}
+
+/// Every segment's initial state as variables, started from the smoothed measurements.
+fn segment_vars(
+    model: &dyn Model,
+    p0: &[f64],
+    data: &Measured,
+    off: &SensorOffsets,
+    segs: &[(usize, usize)],
+    (h, sscale): (usize, &[f64]),
+    vars: &mut Vec<Var>,
+) -> Result<(), FitError> {
+    let n = model.n_states();
+    let names = model.state_names();
     let states = model.states();
     for (s, &(sa, _)) in segs.iter().enumerate() {
         let x0 = measured_state(model, p0, data, off, sa, h)?;
@@ -328,118 +470,54 @@ pub fn multiple_shooting(
             });
         }
     }
+    Ok(())
+}
+
+/// Refine the parameters `free` (indices) of `model` from `p0` and the offsets `off` by multiple
+/// shooting over the training block `block` of `data`.
+pub fn multiple_shooting(
+    model: &dyn Model,
+    p0: &[f64],
+    free: &[usize],
+    data: &Measured,
+    off: &SensorOffsets,
+    block: (f64, f64),
+    opts: &MsOptions,
+) -> Result<MultipleShooting, FitError> {
+    let clock = Instant::now();
+    let ch = channels(model, data)?;
+    let dt = data.dt();
+    let end = block.1.min(block.0 + opts.span);
+    let (a, b) = sample_range(data, block, end, "multiple shooting", 21)?;
+    let segs = cut_segments(&ch, (a, b), dt, block, opts.cycles)?;
+    let h = ((opts.smooth / dt).round() as usize).max(3);
+    let sscale = state_scale(model, p0);
+    let mut vars = param_vars(model, p0, free);
+    let outputs = output_vars(&ch, off, &sscale, opts.offsets, &mut vars);
+    segment_vars(model, p0, data, off, &segs, (h, &sscale), &mut vars)?;
     let prob = Problem {
         model,
         p: p0.to_vec(),
         free: free.to_vec(),
-        outs,
-        off0,
-        segs: segs.clone(),
+        outs: outputs.outs,
+        off0: outputs.off0,
+        segs,
         vars,
-        n_off,
+        n_off: outputs.n_off,
         dt,
-        zscale: sscale.clone(),
+        zscale: sscale,
         sim: opts.sim,
     };
-    let mut last_err = None;
-    let mut eval = |u: &[f64]| match prob.eval(u, true) {
-        Ok(e) => Some((e.r, e.j)),
-        Err(e) => {
-            last_err = Some(e);
-            None
-        }
-    };
-    let u0 = vec![0.0; prob.vars.len()];
-    let res = lm::minimize(&mut eval, &u0, &opts.lm).ok_or_else(|| {
-        last_err
-            .clone()
-            .unwrap_or(FitError::Start("multiple shooting".into()))
-    })?;
-    let np = free.len();
-    let vnames: Vec<(String, bool)> = prob
-        .vars
-        .iter()
-        .enumerate()
-        .map(|(k, v)| (v.name.clone(), k < np))
-        .collect();
-    let init: Vec<f64> = prob.vars.iter().map(|v| v.initial).collect();
-    let scale: Vec<f64> = prob.vars.iter().map(|v| v.scale).collect();
-    let stats = report::stats_full(
-        &vnames,
-        &init,
-        &scale,
-        &res.x,
-        &res.residuals,
-        &res.jacobian,
-        0,
-        None,
-    );
+    let res = prob.solve(&opts.lm)?;
+    let stats = prob.stats(&res);
     let fin = prob.eval(&res.x, false)?;
     let th = prob.values(&res.x);
-    let mut p = p0.to_vec();
-    for (k, &j) in free.iter().enumerate() {
-        p[j] = th[k];
-    }
-    let mut offsets = off.clone();
-    for (o, out) in prob.outs.iter().enumerate() {
-        let v = out.4.map(|k| th[np + k]).unwrap_or(prob.off0[o]);
-        match out.0.as_str() {
-            "x" => offsets.x = v,
-            "y" => offsets.y = v,
-            "p" => offsets.p = v,
-            "p_hot" => offsets.p_hot = Some(v),
-            _ => {}
-        }
-    }
-    let segments = segs
-        .iter()
-        .enumerate()
-        .map(|(s, &(sa, sb))| {
-            let defect = if s == 0 {
-                0.0
-            } else {
-                let base = np + n_off + s * n;
-                (0..n)
-                    .map(|i| ((fin.ends[s - 1][i] - th[base + i]) / sscale[i]).abs())
-                    .fold(0.0, f64::max)
-            };
-            Segment {
-                t0: data.t[sa],
-                t1: data.t[sb],
-                defect,
-            }
-        })
-        .collect();
-    let fits = prob
-        .outs
-        .iter()
-        .zip(&fin.yhat)
-        .map(|((name, _, d, _, _), yh)| {
-            let y = &d[a..a + yh.len()];
-            let fp = fit_percent(y, yh);
-            let rms = (y
-                .iter()
-                .zip(yh)
-                .map(|(u, v)| (u - v) * (u - v))
-                .sum::<f64>()
-                / y.len() as f64)
-                .sqrt();
-            ChannelFit {
-                channel: name.clone(),
-                block: "segments".into(),
-                fit_percent: fp,
-                fit_percent_raw: fp,
-                rms,
-                samples: y.len(),
-            }
-        })
-        .collect();
     Ok(MultipleShooting {
         stats,
-        params: crate::params::named(model, &p),
-        offsets,
-        segments,
-        fits,
+        params: crate::params::named(model, &prob.params_with(&th)),
+        offsets: prob.offsets_at(&th, off),
+        segments: prob.segments(&fin, &th, &data.t),
+        fits: prob.fits(&fin, a),
         iterations: res.iterations,
         evaluations: res.evaluations,
         converged: res.converged,

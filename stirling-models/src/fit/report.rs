@@ -39,6 +39,28 @@ pub struct ChannelFit {
     pub samples: usize,
 }
 
+impl ChannelFit {
+    /// The fit of the model output `yhat` to `y` (no drift band removed).
+    pub fn plain(channel: &str, block: &str, y: &[f64], yhat: &[f64]) -> Self {
+        let fp = fit_percent(y, yhat);
+        let rms = (y
+            .iter()
+            .zip(yhat)
+            .map(|(u, v)| (u - v) * (u - v))
+            .sum::<f64>()
+            / y.len() as f64)
+            .sqrt();
+        ChannelFit {
+            channel: channel.to_string(),
+            block: block.into(),
+            fit_percent: fp,
+            fit_percent_raw: fp,
+            rms,
+            samples: y.len(),
+        }
+    }
+}
+
 /// The statistics of a least-squares fit.
 #[derive(Clone, Debug, Serialize)]
 pub struct FitStats {
@@ -118,20 +140,9 @@ pub fn stats_full(
     let cov = DMatrix::from_fn(k, k, |a, b| {
         sigma2 * inv[(a, b)] / (d[a] * d[b]) + extra.map_or(0.0, |e| e[(a, b)])
     });
-    let mut estimates = Vec::new();
-    for i in 0..k {
-        let se = cov[(i, i)].max(0.0).sqrt() * scale[i].abs();
-        let v = initial[i] + scale[i] * u[i];
-        estimates.push(Estimate {
-            name: names[i].0.clone(),
-            initial: initial[i],
-            value: v,
-            std_error: se,
-            ci_low: v - 1.96 * se,
-            ci_high: v + 1.96 * se,
-            model_param: names[i].1,
-        });
-    }
+    let estimates = (0..k)
+        .map(|i| estimate(&names[i], initial[i], scale[i], u[i], cov[(i, i)]))
+        .collect();
     let correlation: Vec<Vec<f64>> = (0..k)
         .map(|a| {
             (0..k)
@@ -139,6 +150,35 @@ pub fn stats_full(
                 .collect()
         })
         .collect();
+    let mut warnings = collinear_warnings(names, &correlation);
+    warnings.extend(conditioning_warning(scaled));
+    FitStats {
+        estimates,
+        correlation,
+        warnings,
+        sigma2,
+        samples: nr,
+    }
+}
+
+/// One estimate from its scaled value `u` and variance `var` (95 % interval).
+fn estimate(name: &(String, bool), initial: f64, scale: f64, u: f64, var: f64) -> Estimate {
+    let se = var.max(0.0).sqrt() * scale.abs();
+    let v = initial + scale * u;
+    Estimate {
+        name: name.0.clone(),
+        initial,
+        value: v,
+        std_error: se,
+        ci_low: v - 1.96 * se,
+        ci_high: v + 1.96 * se,
+        model_param: name.1,
+    }
+}
+
+/// A warning for each pair of estimates correlated beyond 0.95.
+fn collinear_warnings(names: &[(String, bool)], correlation: &[Vec<f64>]) -> Vec<String> {
+    let k = correlation.len();
     let mut warnings = Vec::new();
     for a in 0..k {
         for b in a + 1..k {
@@ -150,18 +190,14 @@ pub fn stats_full(
             }
         }
     }
+    warnings
+}
+
+/// A warning when the scaled information matrix is ill-conditioned.
+fn conditioning_warning(scaled: DMatrix<f64>) -> Option<String> {
     let ev = scaled.symmetric_eigen().eigenvalues;
     let (lo, hi) = ev
         .iter()
         .fold((f64::INFINITY, 0.0f64), |(l, h), &e| (l.min(e), h.max(e)));
-    if lo <= hi * 1e-10 {
-        warnings.push(format!("the scaled information matrix is ill-conditioned (condition number {:.2e}): some combination of the free parameters is not identifiable", hi / lo.max(1e-300)));
-    }
-    FitStats {
-        estimates,
-        correlation,
-        warnings,
-        sigma2,
-        samples: nr,
-    }
+    (lo <= hi * 1e-10).then(|| format!("the scaled information matrix is ill-conditioned (condition number {:.2e}): some combination of the free parameters is not identifiable", hi / lo.max(1e-300)))
 }

@@ -7,6 +7,18 @@ use plotters::prelude::*;
 
 use super::DrawError;
 
+/// The top of the value axis: 10 % above the highest finite bar or the floor.
+fn top(groups: &[(String, Vec<f64>)], floor: Option<f64>) -> f64 {
+    groups
+        .iter()
+        .flat_map(|g| g.1.iter())
+        .copied()
+        .filter(|v| v.is_finite())
+        .fold(floor.unwrap_or(0.0), f64::max)
+        .max(1e-12)
+        * 1.1
+}
+
 /// One bar group per `(name, values)`, side by side at each index; `floor` draws a line.
 pub fn bars(
     path: &Path,
@@ -21,14 +33,7 @@ pub fn bars(
     root.fill(&WHITE).map_err(|e| err(&e))?;
     let nb = groups.iter().map(|g| g.1.len()).max().unwrap_or(1);
     let ng = groups.len().max(1);
-    let hi = groups
-        .iter()
-        .flat_map(|g| g.1.iter())
-        .copied()
-        .filter(|v| v.is_finite())
-        .fold(floor.unwrap_or(0.0), f64::max)
-        .max(1e-12)
-        * 1.1;
+    let hi = top(groups, floor);
     let mut c = ChartBuilder::on(&root)
         .caption(title, ("sans-serif", 20))
         .margin(10)

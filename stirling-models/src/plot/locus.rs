@@ -5,6 +5,7 @@
 
 use std::path::Path;
 
+use plotters::coord::Shift;
 use plotters::prelude::*;
 
 use super::axes;
@@ -29,20 +30,8 @@ fn crossing(locus: &Locus) -> Option<usize> {
     (1..locus.points.len()).find(|&i| rhp(i) != rhp(i - 1))
 }
 
-/// Draw the root locus to an SVG file; `unit` is the parameter's unit (`-` if none).
-pub fn root_locus(path: &Path, locus: &Locus, unit: &str) -> Result<(), DrawError> {
-    let err = DrawError::at(path);
-    let e = |x: &dyn std::fmt::Display| err(x.to_string());
-    let unit = if unit.is_empty() { "-" } else { unit };
-    let ((x0, x1, y1), out) = frame(locus.points.iter().flat_map(|p| p.poles.iter()));
-    let root = SVGBackend::new(path, (920, 600)).into_drawing_area();
-    root.fill(&WHITE).map_err(|x| e(&x))?;
-    let (main, bar) = root.split_horizontally(790);
-    let (first, last) = (
-        locus.points.first().map_or(0.0, |p| p.value),
-        locus.points.last().map_or(0.0, |p| p.value),
-    );
-    let cross = crossing(locus);
+/// The title: model, parameter, the stability crossing `cross` if any, poles off frame.
+fn title(locus: &Locus, unit: &str, cross: Option<usize>, out: usize) -> String {
     let mut title = format!("{}: root locus over {}", locus.model, locus.param);
     if let Some(i) = cross {
         let (a, b) = (locus.points[i - 1].value, locus.points[i].value);
@@ -55,6 +44,20 @@ pub fn root_locus(path: &Path, locus: &Locus, unit: &str) -> Result<(), DrawErro
     if out > 0 {
         title.push_str(&format!(", {out} stiff poles off frame"));
     }
+    title
+}
+
+/// Draw the root locus to an SVG file; `unit` is the parameter's unit (`-` if none).
+pub fn root_locus(path: &Path, locus: &Locus, unit: &str) -> Result<(), DrawError> {
+    let err = DrawError::at(path);
+    let e = |x: &dyn std::fmt::Display| err(x.to_string());
+    let unit = if unit.is_empty() { "-" } else { unit };
+    let ((x0, x1, y1), out) = frame(locus.points.iter().flat_map(|p| p.poles.iter()));
+    let root = SVGBackend::new(path, (920, 600)).into_drawing_area();
+    root.fill(&WHITE).map_err(|x| e(&x))?;
+    let (main, bar) = root.split_horizontally(790);
+    let cross = crossing(locus);
+    let title = title(locus, unit, cross, out);
     let mut chart = splane_chart(&main, title, 16, (x0, x1, y1), &err)?;
     let k = locus.points.len().max(2) - 1;
     for (i, pt) in locus.points.iter().enumerate() {
@@ -75,7 +78,22 @@ pub fn root_locus(path: &Path, locus: &Locus, unit: &str) -> Result<(), DrawErro
             )
             .map_err(|x| e(&x))?;
     }
-    // The colour bar: the parameter's values top (last) to bottom (first).
+    color_bar(path, &bar, locus, unit)?;
+    root.present().map_err(|x| e(&x))
+}
+
+/// The colour bar on `bar`: the parameter's values top (last) to bottom (first).
+fn color_bar(
+    path: &Path,
+    bar: &DrawingArea<SVGBackend, Shift>,
+    locus: &Locus,
+    unit: &str,
+) -> Result<(), DrawError> {
+    let e = |x: &dyn std::fmt::Display| DrawError::on(path, x);
+    let (first, last) = (
+        locus.points.first().map_or(0.0, |p| p.value),
+        locus.points.last().map_or(0.0, |p| p.value),
+    );
     let (lo, hi) = if last > first {
         (first, last)
     } else if first > last {
@@ -83,7 +101,7 @@ pub fn root_locus(path: &Path, locus: &Locus, unit: &str) -> Result<(), DrawErro
     } else {
         (first - 0.5, first + 0.5)
     };
-    let mut cb = ChartBuilder::on(&bar)
+    let mut cb = ChartBuilder::on(bar)
         .margin_top(45)
         .margin_bottom(60)
         .margin_left(20)
@@ -115,5 +133,5 @@ pub fn root_locus(path: &Path, locus: &Locus, unit: &str) -> Result<(), DrawErro
         Rectangle::new([(0.0, v(a)), (1.0, v(b))], color(t).filled())
     }))
     .map_err(|x| e(&x))?;
-    root.present().map_err(|x| e(&x))
+    Ok(())
 }

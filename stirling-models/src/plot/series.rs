@@ -3,6 +3,7 @@
 
 use std::path::Path;
 
+use plotters::coord::Shift;
 use plotters::prelude::*;
 
 use super::axes;
@@ -23,6 +24,15 @@ fn span<'a>(v: impl Iterator<Item = &'a f64>) -> (f64, f64) {
     (lo - pad, hi + pad)
 }
 
+/// The finite points `(t, v)`.
+fn finite(t: &[f64], v: &[f64]) -> Vec<(f64, f64)> {
+    t.iter()
+        .copied()
+        .zip(v.iter().copied())
+        .filter(|p| p.1.is_finite())
+        .collect()
+}
+
 /// Draw `measured` (dots) and `model` (line) of `channel` against `t` [s], the residual below.
 pub fn measured_vs_model(
     path: &Path,
@@ -32,8 +42,7 @@ pub fn measured_vs_model(
     measured: &[f64],
     model: &[f64],
 ) -> Result<(), DrawError> {
-    let err = DrawError::at(path);
-    let e = |x: &dyn std::fmt::Display| err(x.to_string());
+    let e = |x: &dyn std::fmt::Display| DrawError::on(path, x);
     let root = SVGBackend::new(path, (900, 560)).into_drawing_area();
     root.fill(&WHITE).map_err(|x| e(&x))?;
     let (top, bottom) = root.split_vertically(360);
@@ -42,8 +51,24 @@ pub fn measured_vs_model(
         t.last().copied().unwrap_or(1.0),
     );
     let t1 = if t1 > t0 { t1 } else { t0 + 1.0 };
+    let labels = (title, channel);
+    values_panel(path, &top, labels, (t0, t1), (t, measured, model))?;
+    let res: Vec<f64> = measured.iter().zip(model).map(|(m, s)| m - s).collect();
+    residual_panel(path, &bottom, channel, (t0, t1), (t, &res))?;
+    root.present().map_err(|x| e(&x))
+}
+
+/// The top panel: `measured` (grey dots) and `model` (red line) over `t0..t1`, a legend.
+fn values_panel(
+    path: &Path,
+    top: &DrawingArea<SVGBackend, Shift>,
+    (title, channel): (&str, &str),
+    (t0, t1): (f64, f64),
+    (t, measured, model): (&[f64], &[f64], &[f64]),
+) -> Result<(), DrawError> {
+    let e = |x: &dyn std::fmt::Display| DrawError::on(path, x);
     let (lo, hi) = span(measured.iter().chain(model));
-    let mut c = ChartBuilder::on(&top)
+    let mut c = ChartBuilder::on(top)
         .caption(title, ("sans-serif", 18))
         .margin(10)
         .x_label_area_size(35)
@@ -56,22 +81,15 @@ pub fn measured_vs_model(
         .draw()
         .map_err(|x| e(&x))?;
     let grey = RGBColor(120, 120, 120);
-    let finite = |v: &[f64]| -> Vec<(f64, f64)> {
-        t.iter()
-            .copied()
-            .zip(v.iter().copied())
-            .filter(|p| p.1.is_finite())
-            .collect()
-    };
     c.draw_series(
-        finite(measured)
+        finite(t, measured)
             .into_iter()
             .map(|p| Circle::new(p, 1, grey.filled())),
     )
     .map_err(|x| e(&x))?
     .label("measured")
     .legend(move |(x, y)| Circle::new((x + 10, y), 3, grey.filled()));
-    c.draw_series(LineSeries::new(finite(model), RED.stroke_width(2)))
+    c.draw_series(LineSeries::new(finite(t, model), RED.stroke_width(2)))
         .map_err(|x| e(&x))?
         .label("model")
         .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], RED.stroke_width(2)));
@@ -81,10 +99,21 @@ pub fn measured_vs_model(
         .border_style(BLACK)
         .draw()
         .map_err(|x| e(&x))?;
-    let res: Vec<f64> = measured.iter().zip(model).map(|(m, s)| m - s).collect();
+    Ok(())
+}
+
+/// The bottom panel: the residual `res` (blue dots) around a zero line, symmetric range.
+fn residual_panel(
+    path: &Path,
+    bottom: &DrawingArea<SVGBackend, Shift>,
+    channel: &str,
+    (t0, t1): (f64, f64),
+    (t, res): (&[f64], &[f64]),
+) -> Result<(), DrawError> {
+    let e = |x: &dyn std::fmt::Display| DrawError::on(path, x);
     let (r0, r1) = span(res.iter());
     let r = r0.abs().max(r1.abs());
-    let mut c = ChartBuilder::on(&bottom)
+    let mut c = ChartBuilder::on(bottom)
         .margin(10)
         .x_label_area_size(35)
         .y_label_area_size(80)
@@ -98,10 +127,10 @@ pub fn measured_vs_model(
     c.draw_series(LineSeries::new([(t0, 0.0), (t1, 0.0)], BLACK.mix(0.5)))
         .map_err(|x| e(&x))?;
     c.draw_series(
-        finite(&res)
+        finite(t, res)
             .into_iter()
             .map(|p| Circle::new(p, 1, BLUE.filled())),
     )
     .map_err(|x| e(&x))?;
-    root.present().map_err(|x| e(&x))
+    Ok(())
 }

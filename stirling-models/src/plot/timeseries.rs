@@ -35,6 +35,9 @@ fn legend<DB: DrawingBackend>(
     Ok(())
 }
 
+/// A drawing area of the SVG figure.
+type Area<'b> = DrawingArea<SVGBackend<'b>, Shift>;
+
 /// Plot `x`, `y` (state columns `ix`, `iy`) and the `pressures` columns of `states` against `t`.
 pub fn startup_svg(
     path: &Path,
@@ -52,8 +55,6 @@ pub fn startup_svg(
         .titled(&format!("{title}: start-up"), ("sans-serif", 20))
         .map_err(|e| err(&e))?;
     let (top, bottom) = root.split_vertically(340);
-    let (top, top_strip) = top.split_horizontally(900);
-    let (bottom, bottom_strip) = bottom.split_horizontally(900);
     let t1 = t.last().copied().unwrap_or(1.0).max(1e-12);
     let col = |k: usize, scale: f64| -> Vec<(f64, f64)> {
         t.iter()
@@ -62,7 +63,21 @@ pub fn startup_svg(
             .filter(|p| p.1.is_finite())
             .collect()
     };
-    let (xs, ys) = (col(ix, 1e3), col(iy, 1e3));
+    positions_panel(path, &top, t1, (col(ix, 1e3), col(iy, 1e3)))?;
+    let series: Vec<Vec<(f64, f64)>> = pressures.iter().map(|(_, k)| col(*k, 1e-3)).collect();
+    pressure_panel(path, &bottom, t1, series, pressures)?;
+    root.present().map_err(|e| err(&e))
+}
+
+/// The top panel (with its legend strip): `x` and `y` [mm] over `0..t1`.
+fn positions_panel(
+    path: &Path,
+    top: &Area,
+    t1: f64,
+    (xs, ys): (Vec<(f64, f64)>, Vec<(f64, f64)>),
+) -> Result<(), DrawError> {
+    let err = |e: &dyn std::fmt::Display| DrawError::on(path, e);
+    let (top, top_strip) = top.split_horizontally(900);
     let lim = xs.iter().chain(&ys).map(|p| p.1.abs()).fold(1e-9, f64::max) * 1.05;
     let mut c = ChartBuilder::on(&top)
         .margin(10)
@@ -86,19 +101,35 @@ pub fn startup_svg(
             ("piston y".into(), RED.to_rgba(), 1),
         ],
     )
-    .map_err(|e| err(&e))?;
-    let series: Vec<Vec<(f64, f64)>> = pressures.iter().map(|(_, k)| col(*k, 1e-3)).collect();
+    .map_err(|e| err(&e))
+}
+
+/// The pressure axis range: the traces' span padded by 5 % (a flat trace: +-1 kPa).
+fn pressure_range(series: &[Vec<(f64, f64)>]) -> (f64, f64) {
     let (lo, hi) = series
         .iter()
         .flatten()
         .fold((f64::MAX, f64::MIN), |(l, h), p| (l.min(p.1), h.max(p.1)));
-    let (lo, hi) = if lo < hi {
+    if lo < hi {
         (lo - 0.05 * (hi - lo), hi + 0.05 * (hi - lo))
     } else if lo == hi {
         (lo - 1.0, lo + 1.0)
     } else {
         (0.0, 1.0)
-    };
+    }
+}
+
+/// The bottom panel (with its legend strip): the pressure traces [kPa] over `0..t1`.
+fn pressure_panel(
+    path: &Path,
+    bottom: &Area,
+    t1: f64,
+    series: Vec<Vec<(f64, f64)>>,
+    pressures: &[(String, usize)],
+) -> Result<(), DrawError> {
+    let err = |e: &dyn std::fmt::Display| DrawError::on(path, e);
+    let (bottom, bottom_strip) = bottom.split_horizontally(900);
+    let (lo, hi) = pressure_range(&series);
     let mut c = ChartBuilder::on(&bottom)
         .margin(10)
         .x_label_area_size(35)
@@ -121,6 +152,5 @@ pub fn startup_svg(
             .map_err(|e| err(&e))?;
         entries.push((name.clone(), color, width));
     }
-    legend(&bottom_strip, &entries).map_err(|e| err(&e))?;
-    root.present().map_err(|e| err(&e))
+    legend(&bottom_strip, &entries).map_err(|e| err(&e))
 }
