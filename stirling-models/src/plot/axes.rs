@@ -38,6 +38,24 @@ pub fn pow10(v: &f64) -> String {
     s
 }
 
+/// Tick labels for a linear axis spanning `span`: as many decimals as its ticks (about ten
+/// to the span) need, and never `-0`.
+pub fn linear_ticks(span: f64) -> impl Fn(&f64) -> String {
+    let step = (span / 10.0).abs().max(1e-300);
+    let decimals = (-step.log10().floor()).clamp(0.0, 9.0) as usize;
+    move |v: &f64| {
+        let s = format!("{v:.decimals$}");
+        if s.trim_start_matches('-')
+            .chars()
+            .all(|c| c == '0' || c == '.')
+        {
+            s.trim_start_matches('-').to_string()
+        } else {
+            s
+        }
+    }
+}
+
 /// `(lo, hi)` widened to whole decades.
 pub fn decades(lo: f64, hi: f64) -> (f64, f64) {
     (
@@ -58,6 +76,16 @@ mod tests {
         assert_eq!(pow10(&1e12), "10¹²");
         assert_eq!(pow10(&20.0), "");
         assert_eq!(decades(6.3, 941.0), (1.0, 1000.0));
+    }
+
+    #[test]
+    fn linear_ticks_have_the_decimals_of_their_step_and_no_negative_zero() {
+        let f = linear_ticks(0.2);
+        assert_eq!(f(&-0.0), "0.00");
+        assert_eq!(f(&-1e-17), "0.00");
+        assert_eq!(f(&0.05), "0.05");
+        assert_eq!(f(&-0.1), "-0.10");
+        assert_eq!(linear_ticks(2000.0)(&-500.0), "-500");
         assert_eq!(channel_label("p_hot"), "p_hot [Pa]");
     }
 }

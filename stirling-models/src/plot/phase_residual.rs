@@ -54,6 +54,7 @@ pub fn phase_residual(path: &Path, title: &str, panels: &[Panel]) -> Result<(), 
             .map_err(|e| err(&e))?;
         c.configure_mesh()
             .y_labels(7)
+            .y_label_formatter(&axes::linear_ticks(top + lim))
             .x_desc(axes::label("phase of the cycle", "deg"))
             .y_desc(axes::label(
                 &format!("{} measured - model", panel.channel),
