@@ -8,6 +8,7 @@ mod cmd_locus;
 mod cmd_models;
 mod cmd_rig;
 mod cmd_simulate;
+mod cmd_sweep;
 mod common;
 
 use clap::{Parser, Subcommand};
@@ -42,6 +43,10 @@ enum Command {
     Simulate(cmd_simulate::SimulateArgs),
     /// States, parameters and generated equations of a model, or its bond graph (--graph)
     Info(cmd_info::InfoArgs),
+    /// Design sweep over a parameter grid: poles, whether the engine runs, its cycle and power
+    Sweep(cmd_sweep::SweepArgs),
+    /// Join the sweep.json files of `stirling sweep --shard` slices into one sweep
+    SweepMerge(cmd_sweep::MergeArgs),
 }
 
 fn main() {
@@ -55,6 +60,8 @@ fn main() {
         Command::Locus(a) => cmd_locus::run(&a),
         Command::Simulate(a) => cmd_simulate::run(&a),
         Command::Info(a) => cmd_info::run(&a),
+        Command::Sweep(a) => cmd_sweep::run(&a),
+        Command::SweepMerge(a) => cmd_sweep::merge(&a),
     };
     if let Err(e) = result {
         // a reader that stopped early (`| head`) is the end of the output, not an error

@@ -140,6 +140,8 @@ pub mod rig;
 pub mod signal;
 /// Nonlinear simulation, limit cycles, Floquet multipliers and cycle work.
 pub mod sim;
+/// Design sweeps: poles, whether the engine runs, and its cycle over a parameter grid.
+pub mod sweep;
 
 pub use model::{effects, family, params, registry};
 pub use registry::{build, RegistryError, FAMILY};

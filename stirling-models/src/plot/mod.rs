@@ -21,5 +21,7 @@ pub mod poles;
 pub mod pv;
 /// Measured against model, with the residual below (fit figures).
 pub mod series;
+/// A two-parameter sweep as a map of power with the stability boundary.
+pub mod sweep_map;
 /// Start-up time response (x, y, pressures against time).
 pub mod timeseries;
