@@ -173,9 +173,15 @@ pub struct LinkDecl {
 }
 
 impl LinkDecl {
-    /// Whether the link repeats along an array.
+    /// Whether the link repeats along an array between neighbouring sections.
     pub fn is_chain(&self) -> bool {
-        matches!(self.from.at, At::Rel(_)) || matches!(self.to.at, At::Rel(_))
+        matches!(self.from.at, At::Rel(_)) && matches!(self.to.at, At::Rel(_))
+    }
+
+    /// Whether the link joins every section of an array to one scalar CV or space
+    /// (`link regen[j] -> bounce for j in 0..n`).
+    pub fn is_per_section(&self) -> bool {
+        matches!(self.from.at, At::Rel(_)) != matches!(self.to.at, At::Rel(_))
     }
 }
 
