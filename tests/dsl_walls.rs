@@ -96,7 +96,7 @@ fn energy_budget_holds_with_walls() {
                     let gap = (de - terms).abs() / scale;
                     worst = worst.max(gap);
                     assert!(
-                        gap < 1e-14,
+                        gap < 1e-15,
                         "{} n={n}: dE/dt {de:e} vs terms {terms:e}",
                         m.name()
                     );

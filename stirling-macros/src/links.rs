@@ -71,6 +71,15 @@ impl Lower {
             let scalar = if rf.is_some() { to.1 } else { from.1 };
             return self.per_section_ok(l, scalar);
         }
+        if rf.is_some() && rt.is_some() && from.0 != to.0 {
+            // `link a[j] -> b[j + k] for j in 0..n`: sections of two arrays
+            let (a, b) = (self.vessel_name(from.0), self.vessel_name(to.0));
+            self.cx.error(
+                l.to.name.span(),
+                format!("`{b}` is an array: a per-section link (`for j in 0..n`) joins every section of `{a}` to one CV or space, not to the sections of another array (whose index would run over another length); write `link {a}[j] -> name for j in 0..n` with a single CV or space"),
+            );
+            return false;
+        }
         let (Some(rf), Some(rt)) = (rf, rt) else {
             self.cx.error(range.span, "a `for` link must index both ends with the range variable, e.g. `a[j] -> a[j + 1]`");
             return false;
