@@ -1,6 +1,6 @@
-#![allow(dead_code)]
+#![allow(dead_code, unused_macros)]
 //! Test topologies with per-section links: every regenerator section leaks into one bounce
-//! space (given pressure) or one closed bounce CV.
+//! space (given pressure) or one closed bounce CV; and orifice leaks.
 
 use stirling::stirling_model;
 
@@ -53,6 +53,10 @@ macro_rules! leak_engine {
                     Gl: 1.0e-8 "kg/(s Pa)",
                     /// leak resistance of the whole regenerator into a closed bounce space
                     Rl: 1.0e8 "Pa s/kg",
+                    /// orifice coefficient of a leak, `mdot = Co sign(dP) sqrt|dP|` above `dP0`
+                    Co: 1.0e-7 "kg/(s Pa^(1/2))",
+                    /// width of the orifice's linear core
+                    dP0: 100.0 "Pa",
                     Vb0: 2.0e-3 "m^3",
                     hb: 20.0 "W/(m^2 K)",
                     Awb: 0.06 "m^2",
@@ -111,5 +115,44 @@ leak_engine! {
             port wall { h: hr, area: Awr / n, wall: Th - (j + 0.5) * (Th - Tk) / n },
         }
         link r[j] -> bounce for j in 0..n { resistance: Rl * n }
+    }
+}
+
+leak_engine! {
+    /// The cold space leaks into the bounce space held at `Pb` through an orifice,
+    /// `mdot = Co dP / (dP^2 + dP0^2)^(1/4)`.
+    model OrificeToSpace {
+        space bounce { pressure: Pb, temperature: Tk, faces { displacer: Ar, piston: A - Ar } }
+        cv hot {
+            volume: Vh0,
+            faces { displacer: -A },
+            port hot { h: hh, area: Awh0 - pi * D * x, wall: Th },
+        }
+        cv r[n] {
+            volume: Vr / n,
+            port wall { h: hr, area: Awr / n, wall: Th - (j + 0.5) * (Th - Tk) / n },
+        }
+        link cold -> bounce { orifice: Co, dp0: dP0 }
+    }
+}
+
+leak_engine! {
+    /// Every section leaks into a closed bounce CV through its own orifice (`Co / n` each).
+    model OrificeToCv {
+        cv bounce {
+            volume: Vb0,
+            faces { displacer: Ar, piston: A - Ar },
+            port wall { h: hb, area: Awb, wall: Tk },
+        }
+        cv hot {
+            volume: Vh0,
+            faces { displacer: -A },
+            port hot { h: hh, area: Awh0 - pi * D * x, wall: Th },
+        }
+        cv r[n] {
+            volume: Vr / n,
+            port wall { h: hr, area: Awr / n, wall: Th - (j + 0.5) * (Th - Tk) / n },
+        }
+        link r[j] -> bounce for j in 0..n { orifice: Co / n, dp0: dP0 }
     }
 }

@@ -13,7 +13,7 @@
 
 use super::decl::{LinkDecl, Topology, Vessel};
 use super::frame::{place, Place};
-use super::links::{end_name, end_place, enthalpy, quadratic_flow, rel_min, touches};
+use super::links::{end_name, end_place, enthalpy, orifice_flow, quadratic_flow, rel_min, touches};
 use super::system::{BlockInfo, BlockKind, Row, System, Variant, VesselTerms, VARIANTS};
 use super::walls::PortHeat;
 use crate::expr::{At, Func, Id, Sym};
@@ -470,11 +470,18 @@ impl<'t> Assembler<'t> {
         let r = self.placed(l.resistance, shift);
         let rq = l.quadratic.map(|q| self.placed(q, shift));
         let g = l.conductance.map(|g| self.placed(g, shift));
+        let orifice = l
+            .orifice
+            .map(|(c, dp0)| (self.placed(c, shift), self.placed(dp0, shift)));
         let name = format!("{from_name}_{to_name}");
         let gas = self.t.gas.clone().expect("checked");
         let a = &mut self.t.arena;
         let dp = a.sub(p_from, p_to);
         let mdot_raw = match (g, rq) {
+            _ if orifice.is_some() => {
+                let (c, dp0) = orifice.expect("checked");
+                orifice_flow(a, dp, c, dp0)
+            }
             (Some(g), _) => a.mul(g, dp),
             (None, None) => a.div(dp, r),
             (None, Some(rq)) => quadratic_flow(a, dp, r, rq),
