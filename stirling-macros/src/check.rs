@@ -610,10 +610,11 @@ impl Lower {
                 self.cx.error(field.name.span(), format!("an orifice link (`orifice: C, dp0: dP0`, mdot = C dP / (dP^2 + dP0^2)^(1/4)) takes no `{other}`"));
             }
         }
+        let at = f.get("orifice").map_or(l.span, |field| field.name.span());
         let dp0 = self.required(
             f,
             "dp0",
-            l.span,
+            at,
             "an orifice `link` (`orifice: C, dp0: dP0`: the pressure difference below which the flow is linear)",
             var,
         );
