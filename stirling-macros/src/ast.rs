@@ -16,6 +16,8 @@
 //!     link hot -> regen[0] { resistance: Rf / (2.0 * n) }
 //!     link regen[j] -> regen[j + 1] for j in 0..n - 1 { resistance: Rf / n, quadratic: Rq / n }
 //!     link cold -> bounce { conductance: Gleak }            // mdot = G dP, exact zero at G = 0
+//!     link cold -> bounce { orifice: Co, dp0: dP0 }         // mdot = Co dP / (dP^2 + dP0^2)^(1/4)
+//!     link regen[j] -> bounce for j in 0..n { resistance: Rl * n }  // every section to one CV
 //!     wall head { capacity: Ch, rest: Th, input: Qin }      // a thermal mass: Tw_head is a state
 //!     wall matrix[n] { capacity: Cm / n, rest: Th - (j + 0.5) * (Th - Tk) / n }
 //!     // a CV port names a wall instead of a fixed temperature: `wall: head`, `wall: matrix[j]`

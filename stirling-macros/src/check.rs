@@ -539,27 +539,31 @@ impl Lower {
         let to = self.end(&l.to, var.as_deref());
         let f = self.fields(
             &l.fields,
-            &["resistance", "conductance", "quadratic"],
+            &["resistance", "conductance", "quadratic", "orifice", "dp0"],
             "`link`",
         );
+        let orifice = self.orifice(l, &f, var.as_deref());
         let conductance = self.optional(&f, "conductance", var.as_deref());
-        let resistance = match conductance {
-            Some(g) => {
-                if f.contains_key("resistance") || f.contains_key("quadratic") {
-                    self.cx.error(l.span, "a `link` takes either `conductance: G` (mdot = G dP) or `resistance: R` with optional `quadratic: Rq`, not both");
+        let resistance = match (orifice, conductance) {
+            (Some((_, _, r)), _) => r,
+            (None, conductance) => match conductance {
+                Some(g) => {
+                    if f.contains_key("resistance") || f.contains_key("quadratic") {
+                        self.cx.error(l.span, "a `link` takes either `conductance: G` (mdot = G dP) or `resistance: R` with optional `quadratic: Rq`, not both");
+                    }
+                    let one = self.topo.arena.num(1.0);
+                    self.topo.arena.div(one, g)
                 }
-                let one = self.topo.arena.num(1.0);
-                self.topo.arena.div(one, g)
-            }
-            None => self.required(
-                &f,
-                "resistance",
-                l.span,
-                "`link` (or `conductance: G`)",
-                var.as_deref(),
-            ),
+                None => self.required(
+                    &f,
+                    "resistance",
+                    l.span,
+                    "`link` (or `conductance: G`, or `orifice: C` with `dp0: dP0`)",
+                    var.as_deref(),
+                ),
+            },
         };
-        let quadratic = if conductance.is_some() {
+        let quadratic = if conductance.is_some() || orifice.is_some() {
             None
         } else {
             self.optional(&f, "quadratic", var.as_deref())
@@ -573,6 +577,7 @@ impl Lower {
             resistance,
             quadratic,
             conductance,
+            orifice: orifice.map(|(c, dp0, _)| (c, dp0)),
         };
         if self.link_shape_ok(
             l,
@@ -581,6 +586,42 @@ impl Lower {
         ) {
             self.topo.links.push(link);
         }
+    }
+
+    /// `orifice: C, dp0: dP0`: `(C, dP0, sqrt(dP0)/C)`, the last the small-`dP` resistance
+    /// shown for the link; `None` without `orifice`.
+    fn orifice(
+        &mut self,
+        l: &LinkAst,
+        f: &HashMap<String, &Field>,
+        var: Option<&str>,
+    ) -> Option<(Id, Id, Id)> {
+        let Some(c) = self.optional(f, "orifice", var) else {
+            if let Some(field) = f.get("dp0") {
+                self.cx.error(
+                    field.name.span(),
+                    "`dp0` is the regularization width of an orifice: it goes with `orifice: C`",
+                );
+            }
+            return None;
+        };
+        for other in ["resistance", "conductance", "quadratic"] {
+            if let Some(field) = f.get(other) {
+                self.cx.error(field.name.span(), format!("an orifice link (`orifice: C, dp0: dP0`, mdot = C dP / (dP^2 + dP0^2)^(1/4)) takes no `{other}`"));
+            }
+        }
+        let at = f.get("orifice").map_or(l.span, |field| field.name.span());
+        let dp0 = self.required(
+            f,
+            "dp0",
+            at,
+            "an orifice `link` (`orifice: C, dp0: dP0`: the pressure difference below which the flow is linear)",
+            var,
+        );
+        let a = &mut self.topo.arena;
+        let root = a.func(stirling_dsl::expr::Func::Sqrt, dp0);
+        let r = a.div(root, c);
+        Some((c, dp0, r))
     }
 
     fn end(&mut self, e: &EndAst, var: Option<&str>) -> Option<End> {

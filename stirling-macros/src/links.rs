@@ -67,6 +67,19 @@ impl Lower {
             }
             return true;
         };
+        if let (Some(0), None) | (None, Some(0)) = (rf, rt) {
+            let scalar = if rf.is_some() { to.1 } else { from.1 };
+            return self.per_section_ok(l, scalar);
+        }
+        if rf.is_some() && rt.is_some() && from.0 != to.0 {
+            // `link a[j] -> b[j + k] for j in 0..n`: sections of two arrays
+            let (a, b) = (self.vessel_name(from.0), self.vessel_name(to.0));
+            self.cx.error(
+                l.to.name.span(),
+                format!("`{b}` is an array: a per-section link (`for j in 0..n`) joins every section of `{a}` to one CV or space, not to the sections of another array (whose index would run over another length); write `link {a}[j] -> name for j in 0..n` with a single CV or space"),
+            );
+            return false;
+        }
         let (Some(rf), Some(rt)) = (rf, rt) else {
             self.cx.error(range.span, "a `for` link must index both ends with the range variable, e.g. `a[j] -> a[j + 1]`");
             return false;
@@ -110,6 +123,26 @@ impl Lower {
         }
         if s != 0.0 || lo != 0 || hi != 1 || e_off != -1.0 {
             self.cx.error(range.span, "unsupported chain: expected `a[j] -> a[j + 1] for j in 0..n - 1` (or the reverse direction)");
+            return false;
+        }
+        true
+    }
+
+    /// `link a[j] -> b for j in 0..n`: every section of `a` to one CV or space `b`.
+    fn per_section_ok(&mut self, l: &LinkAst, other: At) -> bool {
+        let range = l.range.as_ref().expect("a `for` link");
+        if other != At::Scalar {
+            self.cx.error(l.to.name.span(), "a per-section link joins every section of an array to one CV or space, not to a section of an array");
+            return false;
+        }
+        let start = self.expr(&range.start, None);
+        let end = self.expr(&range.end, None);
+        let (s, e) = (sample(self, start, 0.0, 10.0), sample(self, end, 0.0, 10.0));
+        if s != 0.0 || e != 10.0 || sample(self, end, 0.0, 11.0) != 11.0 {
+            self.cx.error(
+                range.span,
+                "a per-section link runs over every section: expected `for j in 0..n`",
+            );
             return false;
         }
         true

@@ -97,6 +97,40 @@ const WALL_ARRAY: &str = r#"
     }
 "#;
 
+/// A regenerator chain `r[n]` whose every section leaks into one closed bounce CV: the
+/// bounce's rows hold the sum over the sections (`S0`, `S1`).
+const PER_SECTION: &str = r#"
+    /// A hot CV and a regenerator chain leaking section by section into a closed bounce.
+    pub model PerSection {
+        params {
+            R: 287.05 "J/(kg K)",
+            gamma: 1.4 "-",
+            P0: 101325.0 "Pa",
+            m: 0.3 "kg",
+            k: 60.0 "N/m",
+            A: 2.6e-3 "m^2",
+            V0: 1.5e-4 "m^3",
+            Vr: 4.0e-5 "m^3",
+            Vb: 2.0e-3 "m^3",
+            Th: 600.0 "K",
+            Tk: 300.0 "K",
+            h: 100.0 "W/(m^2 K)",
+            Aw: 0.0377 "m^2",
+            Rf: 1.0e5 "Pa s/kg",
+            Rl: 1.0e8 "Pa s/kg",
+            eps: 1.0e-5 "kg/s",
+        }
+        gas { R: R, gamma: gamma, charge: P0, mdot_eps: eps }
+        body piston(y, w) { mass: m, spring: k }
+        cv bounce { volume: Vb, faces { piston: A }, port wall { h: h, area: Aw, wall: Tk } }
+        cv hot { volume: V0, faces { piston: -A }, port heater { h: h, area: Aw, wall: Th } }
+        cv r[n] { volume: Vr / n, port wall { h: h, area: Aw / n, wall: Tk } }
+        link hot -> r[0] { resistance: Rf / n }
+        link r[j] -> r[j + 1] for j in 0..n - 1 { resistance: Rf / n }
+        link r[j] -> bounce for j in 0..n { resistance: Rl * n }
+    }
+"#;
+
 fn parse(src: &str) -> ModelAst {
     syn::parse_str(src).expect("the test model parses")
 }
@@ -179,4 +213,19 @@ fn expansion_wall_array() {
 #[test]
 fn equations_wall_array_full() {
     insta::assert_snapshot!(equations(WALL_ARRAY, "model wallarray, closure full"));
+}
+
+/// The generated Rust of a per-section link: the sums' prologue loop, and the chain-rule
+/// loops of the bounce's rows (the arrow) in the Jacobians.
+#[test]
+fn expansion_per_section() {
+    insta::assert_snapshot!(methods(
+        PER_SECTION,
+        &["__rhs_full", "__jac_full", "__pjac_full"]
+    ));
+}
+
+#[test]
+fn equations_per_section_full() {
+    insta::assert_snapshot!(equations(PER_SECTION, "model persection, closure full"));
 }

@@ -227,6 +227,11 @@ impl Lower {
             HeatEnd::Wall(end) => (end.vessel, end.at),
             HeatEnd::Fixed(_) => (Vessel::Space(usize::MAX), At::Scalar),
         };
+        let rel = |e: HeatEnd| matches!(e, HeatEnd::Wall(End { at: At::Rel(_), .. }));
+        if rel(from) != rel(to) {
+            self.cx.error(l.span, "per-section conduction links (`for j in 0..n` from every section to one wall or temperature) are not supported yet");
+            return;
+        }
         if self.link_shape_ok(l, key(from), key(to)) {
             self.topo.conductions.push(ConductionDecl {
                 from,

@@ -124,7 +124,7 @@ pub fn fd_steps(model: &dyn Model, p: &[f64], x: &[f64]) -> Vec<f64> {
 /// output keeping the estimate with the smallest error estimate. `h_j` is an upper step:
 /// below the scale on which `f` varies nonlinearly in input `j`, so the tableau converges.
 pub fn fd_jacobian(f: &dyn Fn(&[f64], &mut [f64]), x: &[f64], m: usize, steps: &[f64]) -> Vec<f64> {
-    ridders(f, x, m, steps).0
+    ridders(f, x, m, steps, false).0
 }
 
 /// As [`fd_jacobian`], starting from each of `starts` (factors of `steps`) and keeping, per
@@ -137,10 +137,29 @@ pub fn fd_jacobian_multi(
     steps: &[f64],
     starts: &[f64],
 ) -> Vec<f64> {
+    let sets: Vec<Vec<f64>> = starts
+        .iter()
+        .map(|s| steps.iter().map(|h| h * s).collect())
+        .collect();
+    fd_jacobian_best(f, x, m, &sets, false)
+}
+
+/// As [`fd_jacobian`] from each set of upper steps, keeping per entry the estimate with the
+/// smallest error estimate. With `roundoff`, an estimate's error estimate is at least the
+/// round-off of its smallest central difference, `4 eps max(|f(x+h)|, |f(x-h)|) / 2h`: in a row
+/// whose value is large next to the entry, successive central differences can agree exactly
+/// (their round-off is quantized), which Ridders' tableau reads as zero error at a step where
+/// the round-off is 1e-6 of the entry; the floor makes the larger steps win there.
+pub fn fd_jacobian_best(
+    f: &dyn Fn(&[f64], &mut [f64]),
+    x: &[f64],
+    m: usize,
+    step_sets: &[Vec<f64>],
+    roundoff: bool,
+) -> Vec<f64> {
     let mut best: Option<(Vec<f64>, Vec<f64>)> = None;
-    for s in starts {
-        let h: Vec<f64> = steps.iter().map(|h| h * s).collect();
-        let (est, err) = ridders(f, x, m, &h);
+    for h in step_sets {
+        let (est, err) = ridders(f, x, m, h, roundoff);
         best = Some(match best {
             None => (est, err),
             Some((mut be, mut berr)) => {
@@ -162,6 +181,7 @@ fn ridders(
     x: &[f64],
     m: usize,
     steps: &[f64],
+    roundoff: bool,
 ) -> (Vec<f64>, Vec<f64>) {
     const CON: f64 = 1.4;
     const NTAB: usize = 14;
@@ -171,7 +191,9 @@ fn ridders(
     let (mut fp, mut fm) = (vec![0.0; m], vec![0.0; m]);
     let mut xx = x.to_vec();
     for j in 0..x.len() {
-        let mut central = |h: f64| -> Vec<f64> {
+        // the round-off of the latest central difference, per output
+        let mut noise = vec![0.0; m];
+        let mut central = |h: f64, noise: &mut Vec<f64>| -> Vec<f64> {
             xx[j] = x[j] + h;
             f(&xx, &mut fp);
             xx[j] = x[j] - h;
@@ -179,18 +201,23 @@ fn ridders(
             xx[j] = x[j];
             // the step actually taken, after rounding of x +- h
             let dx = (x[j] + h) - (x[j] - h);
+            if roundoff {
+                for r in 0..m {
+                    noise[r] = 4.0 * f64::EPSILON * fp[r].abs().max(fm[r].abs()) / dx;
+                }
+            }
             fp.iter().zip(&fm).map(|(a, b)| (a - b) / dx).collect()
         };
         let mut h = steps[j];
         // tableau[k][i]: extrapolation order k at step level i, one value per output
         let mut tab: Vec<Vec<Vec<f64>>> = vec![vec![Vec::new(); NTAB]; NTAB];
-        tab[0][0] = central(h);
+        tab[0][0] = central(h, &mut noise);
         let mut best = tab[0][0].clone();
         let mut err = vec![f64::INFINITY; m];
         let mut done = vec![false; m];
         for i in 1..NTAB {
             h /= CON;
-            tab[0][i] = central(h);
+            tab[0][i] = central(h, &mut noise);
             let mut fac = CON * CON;
             for k in 1..=i {
                 tab[k][i] = (0..m)
@@ -200,7 +227,8 @@ fn ridders(
                 for r in (0..m).filter(|&r| !done[r]) {
                     let e = (tab[k][i][r] - tab[k - 1][i][r])
                         .abs()
-                        .max((tab[k][i][r] - tab[k - 1][i - 1][r]).abs());
+                        .max((tab[k][i][r] - tab[k - 1][i - 1][r]).abs())
+                        .max(noise[r]);
                     if e <= err[r] {
                         err[r] = e;
                         best[r] = tab[k][i][r];
@@ -297,14 +325,59 @@ pub const TINY: f64 = 1e-8;
 /// Check `jacobian_dense` and `param_jacobian_dense` of `model` against Richardson-extrapolated
 /// central differences at `x`; returns the mismatches of both, labelled.
 pub fn check_jacobians(model: &dyn Model, p: &[f64], x: &[f64]) -> Vec<Mismatch> {
+    check_jacobians_from(model, p, x, &[1.0], REL)
+}
+
+/// As [`check_jacobians`], differencing the state columns other than pressures from each of
+/// the upper steps `starts` times [`fd_steps`] and keeping per entry the estimate with the
+/// smallest error estimate, and comparing to `rel`. Large steps matter in rows whose value is
+/// large next to their entry: at wide pressure spreads a regenerator row reaches `|P'| ~ 5e8
+/// Pa/s` while `dP'/dx` (through another CV's temperature in an upwind enthalpy) is ~ 300 Pa/(s
+/// m), so a central difference at the default 1e-5 m step carries a round-off of `eps |P'| /
+/// h ~ 1e-2`, 4e-5 of the entry, which Ridders' tableau cannot remove; these rows are smooth
+/// in the positions on the scale of a volume over an area (centimetres), so upper steps 10 and
+/// 100 times larger resolve them.
+pub fn check_jacobians_from(
+    model: &dyn Model,
+    p: &[f64],
+    x: &[f64],
+    starts: &[f64],
+    rel: f64,
+) -> Vec<Mismatch> {
     let n = model.n_states();
     let names = model.state_names();
     let scales = state_scales(model, p);
     // states
     let f = |xx: &[f64], out: &mut [f64]| model.rhs(p, xx, 0.0, out);
-    let fd = fd_jacobian(&f, x, n, &fd_steps(model, p, x));
+    let base = fd_steps(model, p, x);
     let jac = model.jacobian_dense(p, x, 0.0);
-    let mut bad = compare(&jac, &fd, &names, &names, &scales, &scales, REL, TINY);
+    let states = model.states();
+    let is_p = |k: usize| matches!(states[k].kind, StateKind::Pressure(_));
+    // a pressure's step stays below 5 % of its gap to every pressure whose row it enters (the
+    // pressures it is linked to), so that no central difference straddles a flow law's kink
+    let cap: Vec<f64> = (0..n)
+        .map(|j| {
+            let near = (0..n)
+                .filter(|&k| k != j && is_p(k) && jac[k + n * j] != 0.0)
+                .map(|k| (x[j] - x[k]).abs())
+                .fold(f64::INFINITY, f64::min);
+            0.05 * near
+        })
+        .collect();
+    let sets: Vec<Vec<f64>> = starts
+        .iter()
+        .map(|&s| {
+            (0..n)
+                .map(|j| match states[j].kind {
+                    _ if s == 1.0 => base[j],
+                    StateKind::Pressure(_) => (base[j] * s).min(cap[j]).max(base[j]),
+                    _ => base[j] * s,
+                })
+                .collect()
+        })
+        .collect();
+    let fd = fd_jacobian_best(&f, x, n, &sets, starts.len() > 1);
+    let mut bad = compare(&jac, &fd, &names, &names, &scales, &scales, rel, TINY);
     // parameters
     let pnames: Vec<String> = model
         .params()
@@ -316,21 +389,58 @@ pub fn check_jacobians(model: &dyn Model, p: &[f64], x: &[f64]) -> Vec<Mismatch>
         .iter()
         .map(|v| if *v == 0.0 { 1.0 } else { v.abs() })
         .collect();
-    let pfd = fd_jacobian_multi(&g, p, n, &pscales, &[0.5, 0.1]);
+    // a per-section leak's upwind switch is 1 % of the bounce pressure wide (`mdot_eps n / Gl`):
+    // start below it too; the small starts need the round-off floor of the error estimate (a
+    // start of 1e-3 of `mdot_eps` on a row of 1e7 Pa/s otherwise wins with a spurious zero
+    // error estimate and misses by 1e-6)
+    let psets: Vec<Vec<f64>> = [0.5, 0.1, 0.01, 0.001]
+        .iter()
+        .map(|s| pscales.iter().map(|h| h * s).collect())
+        .collect();
+    let pfd = fd_jacobian_best(&g, p, n, &psets, true);
     let pjac = model.param_jacobian_dense(p, x, 0.0);
     bad.extend(compare(
-        &pjac, &pfd, &names, &pnames, &scales, &pscales, REL, TINY,
+        &pjac, &pfd, &names, &pnames, &scales, &pscales, rel, TINY,
     ));
     bad
+}
+
+/// The largest relative disagreement over the significant entries of both Jacobians at `x`
+/// (as [`check_jacobians_from`] compares them), with its entry.
+pub fn worst_jacobian_error(
+    model: &dyn Model,
+    p: &[f64],
+    x: &[f64],
+    starts: &[f64],
+) -> (f64, String) {
+    let mut worst = (0.0, String::new());
+    for b in check_jacobians_from(model, p, x, starts, 0.0) {
+        let e = (b.analytic - b.fd).abs() / b.analytic.abs().max(b.fd.abs());
+        if e > worst.0 {
+            worst = (e, format!("d {}/d {}", b.row, b.col));
+        }
+    }
+    worst
 }
 
 /// Run [`check_jacobians`] at `count` seeded random states of each spread; panic with a
 /// readable list if any entry disagrees.
 pub fn assert_jacobians(model: &dyn Model, label: &str, seed: u64, count: usize) {
+    assert_jacobians_at(model, label, seed, count, &[Spread::Wide, Spread::Balanced]);
+}
+
+/// As [`assert_jacobians`], at the given spreads only.
+pub fn assert_jacobians_at(
+    model: &dyn Model,
+    label: &str,
+    seed: u64,
+    count: usize,
+    spreads: &[Spread],
+) {
     let p = model.default_params();
     let mut rng = rng(seed);
     let mut report = Vec::new();
-    for spread in [Spread::Wide, Spread::Balanced] {
+    for &spread in spreads {
         for k in 0..count {
             let x = random_state(model, &p, spread, &mut rng);
             for b in check_jacobians(model, &p, &x) {
@@ -354,10 +464,12 @@ pub fn assert_jacobians(model: &dyn Model, label: &str, seed: u64, count: usize)
 }
 
 /// The energy budget of docs/physics.md section 10 at one state: `(dE/dt, heat + boundary +
-/// mechanical)`. `E` (gas `P V/(gamma-1)` with `V` affine in the positions, kinetic, spring and
-/// wall `C Tw` energies) is a quadratic polynomial of the states, so the central difference
-/// along the right-hand side is exact up to round-off: the check holds to round-off.
-pub fn energy_rate(model: &dyn Model, p: &[f64], x: &[f64]) -> (f64, f64) {
+/// mechanical, round-off scale)`. `E` (gas `P V/(gamma-1)` with `V` affine in the positions,
+/// kinetic, spring and wall `C Tw` energies) is a quadratic polynomial of the states, so the
+/// central difference along the right-hand side is exact up to round-off, whose scale is
+/// `E/h + sum |P_i' V_i|`: the internal enthalpy flows cancel in the sum, and at wide pressure
+/// spreads on short links they reach 1e5 W per section against a budget of 100 W.
+pub fn energy_rate(model: &dyn Model, p: &[f64], x: &[f64]) -> (f64, f64, f64) {
     let n = model.n_states();
     let mut f = vec![0.0; n];
     model.rhs(p, x, 0.0, &mut f);
@@ -365,7 +477,20 @@ pub fn energy_rate(model: &dyn Model, p: &[f64], x: &[f64]) -> (f64, f64) {
     let at = |s: f64| -> Vec<f64> { x.iter().zip(&f).map(|(xi, fi)| xi + s * fi).collect() };
     let de = (model.energy(p, &at(h)) - model.energy(p, &at(-h))) / (2.0 * h);
     let w = model.power(p, x);
-    (de, w.heat + w.boundary + w.mechanical)
+    let names = model.vessel_names();
+    let (mut pr, mut vol) = (vec![0.0; names.len()], vec![0.0; names.len()]);
+    model.pv(p, x, &mut pr, &mut vol);
+    let flows: f64 = model
+        .states()
+        .iter()
+        .zip(&f)
+        .filter_map(|(s, fi)| match s.kind {
+            StateKind::Pressure(k) => Some((fi * vol[k]).abs()),
+            _ => None,
+        })
+        .sum();
+    let scale = model.energy(p, x).abs() / h + flows;
+    (de, w.heat + w.boundary + w.mechanical, scale)
 }
 
 /// `(sum m_i', sum |m_i'|)` over the mass states: the closed gas's mass rate, which must

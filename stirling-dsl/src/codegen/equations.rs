@@ -35,8 +35,16 @@ fn lines(lay: &Layout, p: &Printer, rows: &[Row]) -> Vec<(String, String, Option
 pub fn equations(arena: &Arena, lay: &Layout, model: &str, style: Style) -> String {
     let namer = |s| lay.name(s);
     let p = Printer::new(arena, style, &namer);
-    let roots: Vec<Id> = lay.sys.rows.iter().flat_map(|r| r.ids()).collect();
-    let defs = p.definitions(&roots);
+    let mut roots: Vec<Id> = lay.sys.rows.iter().flat_map(|r| r.ids()).collect();
+    roots.extend(&lay.sys.sums);
+    let mut defs = p.definitions(&roots);
+    for (k, &s) in lay.sys.sums.iter().enumerate() {
+        let body = match style {
+            Style::Text => format!("sum over j = 0..n-1 of {}", p.expr(s)),
+            Style::Latex => format!("\\sum_{{j=0}}^{{n-1}} \\left({}\\right)", p.expr(s)),
+        };
+        defs.push((format!("S{k}"), body));
+    }
     let eqs = lines(lay, &p, &lay.sys.rows);
     match style {
         Style::Text => text(lay, model, &defs, &eqs),

@@ -41,6 +41,8 @@ pub fn closure_methods(
     let f = |what: &str| format_ident!("__{}_{}", what, tag);
     let sink = quote!(sink: &mut #krate::JacSink);
     let xp = quote!(p: &[f64], x: &[f64]);
+    // the sums over the sections, for every function of the state
+    let s = super::sums::prologue(arena, lay, private);
     let rhs = rows_body(arena, lay, &lay.sys.rows, Output::Value, private);
     let jac = rows_body(arena, lay, &lay.sys.rows, Output::StateJacobian, private);
     let pjac = rows_body(arena, lay, &lay.sys.rows, Output::ParamJacobian, private);
@@ -49,6 +51,8 @@ pub fn closure_methods(
     let init = terms::init(arena, lay, private);
     let vessels = terms::vessels(arena, lay, private);
     let mech = terms::mech(arena, lay, private);
+    let [rhs, jac, pjac, forces, grads, vessels, mech] =
+        [rhs, jac, pjac, forces, grads, vessels, mech].map(|b| quote!(#s #b));
     let masses = terms::masses(arena, lay, private);
     let n_states = n_states(lay);
     let items = [
@@ -101,6 +105,7 @@ pub fn closure_methods(
     let ns = f("n_states");
     let walls = (!lay.topo.walls.is_empty()).then(|| {
         let body = terms::walls(arena, lay, private);
+        let body = quote!(#s #body);
         method(&f("walls"), xp.clone(), quote!(-> [f64; 2]), lay, body)
     });
     let items = quote! {

@@ -135,7 +135,12 @@ pub fn topology(topo: &Topology, lay: &Layout, krate: &TokenStream) -> TokenStre
             Vessel::Space(s) => topo.spaces[s].name.clone(),
             Vessel::Wall(w) => topo.walls[w].name.clone(),
         };
-        let (f, t, r, chain) = (end(&l.from), end(&l.to), p.expr(l.resistance), l.is_chain());
+        let (f, t, r, chain) = (
+            end(&l.from),
+            end(&l.to),
+            p.expr(l.resistance),
+            l.is_chain() || l.is_per_section(),
+        );
         quote! { #krate::LinkInfo { from: #f, to: #t, resistance: #r, chain: #chain } }
     });
     let bodies = topo.bodies.iter().map(|b| &b.name);

@@ -95,6 +95,10 @@ impl Layout<'_> {
                 let i = Literal::u32_unsuffixed(i);
                 quote!(u[#i])
             }
+            Sym::Sum(k) => {
+                let id = format_ident!("__sum{}", k);
+                quote!(#id)
+            }
         }
     }
 
@@ -118,6 +122,7 @@ impl Layout<'_> {
             Sym::Index => "j".into(),
             Sym::Count => "n".into(),
             Sym::Input(i) => format!("u{i}"),
+            Sym::Sum(k) => format!("S{k}"),
         }
     }
 }

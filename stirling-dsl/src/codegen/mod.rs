@@ -6,6 +6,7 @@ mod functions;
 mod info;
 mod layout;
 mod rows;
+mod sums;
 mod terms;
 
 use proc_macro2::{Ident, Span, TokenStream};

@@ -48,7 +48,14 @@ pub fn rows_body(
         })
         .collect();
     let entries = entries(arena, lay, &scalar, what, false);
-    let scalar_code = block(arena, lay, &entries, what, private);
+    let mut scalar_code = block(arena, lay, &entries, what, private);
+    if what != Output::Value && !lay.sys.sums.is_empty() {
+        let rows: Vec<(TokenStream, Id)> = scalar
+            .iter()
+            .map(|&(b, id)| (lay.index(lay.sys.blocks[b].sym, At::Scalar), id))
+            .collect();
+        scalar_code.extend(super::sums::jacobian(arena, lay, &rows, what, private));
+    }
     let arrays: Vec<(usize, [Id; 4])> = rows
         .iter()
         .enumerate()

@@ -40,6 +40,9 @@ pub enum Sym {
     Count,
     /// An external input channel (e.g. a force injected where the loop is broken).
     Input(u32),
+    /// Reduction `k`: the sum over the sections `j = 0..n-1` of a template in an array's
+    /// frame (a per-section link seen from its scalar end).
+    Sum(u32),
 }
 
 /// Scalar functions of one argument.

@@ -13,7 +13,7 @@
 
 use super::decl::{LinkDecl, Topology, Vessel};
 use super::frame::{place, Place};
-use super::links::{end_name, end_place, enthalpy, quadratic_flow, rel_min, touches};
+use super::links::{end_name, end_place, enthalpy, orifice_flow, quadratic_flow, rel_min, touches};
 use super::system::{BlockInfo, BlockKind, Row, System, Variant, VesselTerms, VARIANTS};
 use super::walls::PortHeat;
 use crate::expr::{At, Func, Id, Sym};
@@ -50,6 +50,8 @@ pub(super) struct Assembler<'t> {
     pub(super) cv: Vec<CvTemplate>,
     /// Per CV, the heat of each port that names a declared wall, in the CV's frame.
     pub(super) port_heat: Vec<Vec<PortHeat>>,
+    /// Templates summed over the sections (`Sym::Sum(k)`), from per-section links.
+    pub(super) sums: Vec<Id>,
 }
 
 impl<'t> Assembler<'t> {
@@ -69,6 +71,7 @@ impl<'t> Assembler<'t> {
             array_blocks,
             cv: Vec::new(),
             port_heat: Vec::new(),
+            sums: Vec::new(),
         }
     }
 
@@ -116,6 +119,7 @@ impl<'t> Assembler<'t> {
         let (mech_energy, mech_power) = (self.mech_energy(), self.mech_power());
         let (walls, wall_boundary_heat) = self.wall_terms();
         let array_blocks = self.array_blocks.clone();
+        let sums = std::mem::take(&mut self.sums);
         System {
             closure: self.closure,
             blocks,
@@ -127,6 +131,7 @@ impl<'t> Assembler<'t> {
             mech_power,
             walls,
             wall_boundary_heat,
+            sums,
             array_blocks,
         }
     }
@@ -403,26 +408,26 @@ impl<'t> Assembler<'t> {
 
     /// `P'` (`want_p`) or `m'` of CV `i` at `row`.
     fn balance(&mut self, i: usize, row: RowAt, want_p: bool) -> Id {
-        let flows = self.flows_of(i, row);
+        let (summed, flows): (Vec<Flow>, Vec<Flow>) =
+            self.flows_of(i, row).into_iter().partition(|f| f.summed);
         let tpl = self.cv[i];
         let gas = self.t.gas.clone().expect("checked");
+        let pick = |f: &Flow| if want_p { f.h } else { f.mdot };
+        let start = if want_p { tpl.q } else { self.t.arena.num(0.0) };
+        let mut total = signed(&mut self.t.arena, start, &flows, &pick);
+        if !summed.is_empty() {
+            let zero = self.t.arena.num(0.0);
+            let template = signed(&mut self.t.arena, zero, &summed, &pick);
+            let sum = self.reduce(template);
+            total = self.t.arena.add(total, sum);
+        }
         let a = &mut self.t.arena;
-        let signed = |a: &mut crate::expr::Arena, start: Id, pick: &dyn Fn(&Flow) -> Id| {
-            flows.iter().fold(start, |acc, f| {
-                if f.into {
-                    a.add(acc, pick(f))
-                } else {
-                    a.sub(acc, pick(f))
-                }
-            })
-        };
         if !want_p {
-            let zero = a.num(0.0);
-            return signed(a, zero, &|f| f.mdot);
+            return total;
         }
         let one = a.num(1.0);
         let gm1 = a.sub(gas.gamma, one);
-        let qh = signed(a, tpl.q, &|f| f.h);
+        let qh = total;
         let e = a.mul(gm1, qh);
         let gp = a.mul(gas.gamma, tpl.p);
         let w = a.mul(gp, tpl.vdot);
@@ -439,7 +444,13 @@ impl<'t> Assembler<'t> {
                 if end.vessel != Vessel::Cv(i) {
                     continue;
                 }
-                if let Some(base) = touches(end.at, row, rel_min(l.from.at, l.to.at)) {
+                let base = if l.is_per_section() && matches!(end.at, At::Rel(_)) {
+                    // the array end of a per-section link: every section
+                    matches!(row, RowAt::Array(..)).then_some(0)
+                } else {
+                    touches(end.at, row, rel_min(l.from.at, l.to.at))
+                };
+                if let Some(base) = base {
                     out.push(self.flow(l, row, base, into));
                 }
             }
@@ -459,11 +470,18 @@ impl<'t> Assembler<'t> {
         let r = self.placed(l.resistance, shift);
         let rq = l.quadratic.map(|q| self.placed(q, shift));
         let g = l.conductance.map(|g| self.placed(g, shift));
+        let orifice = l
+            .orifice
+            .map(|(c, dp0)| (self.placed(c, shift), self.placed(dp0, shift)));
         let name = format!("{from_name}_{to_name}");
         let gas = self.t.gas.clone().expect("checked");
         let a = &mut self.t.arena;
         let dp = a.sub(p_from, p_to);
         let mdot_raw = match (g, rq) {
+            _ if orifice.is_some() => {
+                let (c, dp0) = orifice.expect("checked");
+                orifice_flow(a, dp, c, dp0)
+            }
             (Some(g), _) => a.mul(g, dp),
             (None, None) => a.div(dp, r),
             (None, Some(rq)) => quadratic_flow(a, dp, r, rq),
@@ -471,7 +489,25 @@ impl<'t> Assembler<'t> {
         let mdot = a.named(&format!("mdot_{name}"), mdot_raw);
         let h_raw = enthalpy(a, mdot, t_from, t_to, &gas);
         let h = a.named(&format!("H_{name}"), h_raw);
-        Flow { mdot, h, into }
+        let summed = l.is_per_section() && row == RowAt::Scalar;
+        Flow {
+            mdot,
+            h,
+            into,
+            summed,
+        }
+    }
+
+    /// `Sym::Sum(k)`: the sum of `template` (in an array's frame) over the sections.
+    pub(super) fn reduce(&mut self, template: Id) -> Id {
+        let k = match self.sums.iter().position(|&s| s == template) {
+            Some(k) => k,
+            None => {
+                self.sums.push(template);
+                self.sums.len() - 1
+            }
+        };
+        self.t.arena.sym(Sym::Sum(k as u32))
     }
 
     /// Pressure, temperature and display name of a link end seen from `row`.
@@ -512,4 +548,17 @@ pub(super) struct Flow {
     pub(super) mdot: Id,
     pub(super) h: Id,
     pub(super) into: bool,
+    /// A per-section link seen from its scalar end: the flow is a template to sum over `j`.
+    pub(super) summed: bool,
+}
+
+/// `start + sum(into) - sum(out)` of the picked quantity of `flows`.
+fn signed(a: &mut crate::expr::Arena, start: Id, flows: &[Flow], pick: &dyn Fn(&Flow) -> Id) -> Id {
+    flows.iter().fold(start, |acc, f| {
+        if f.into {
+            a.add(acc, pick(f))
+        } else {
+            a.sub(acc, pick(f))
+        }
+    })
 }

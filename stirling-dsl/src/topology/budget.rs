@@ -74,8 +74,9 @@ impl Assembler<'_> {
                 continue;
             }
             let f = self.flow(l, RowAt::Scalar, 0, true);
+            let h = if f.summed { self.reduce(f.h) } else { f.h };
             let a = &mut self.t.arena;
-            terms.push(if into_space { f.h } else { a.neg(f.h) });
+            terms.push(if into_space { h } else { a.neg(h) });
         }
         self.t.arena.sum(terms)
     }

@@ -170,12 +170,23 @@ pub struct LinkDecl {
     /// `resistance:`: the flow law is then `mdot = G dP` (exactly zero at `G = 0`, e.g. a
     /// seal leak at its null value) and `resistance` holds `1/G` for display only.
     pub conductance: Option<Id>,
+    /// `(C, dP0)` if declared with `orifice: C, dp0: dP0`: the flow law is then the
+    /// regularized square-root law `mdot = C dP / (dP^2 + dP0^2)^(1/4)` (`C sign(dP)
+    /// sqrt|dP|` for `|dP| >> dP0`, `C dP / sqrt(dP0)` below), and `resistance` holds the
+    /// small-`dP` resistance `sqrt(dP0)/C` for display only.
+    pub orifice: Option<(Id, Id)>,
 }
 
 impl LinkDecl {
-    /// Whether the link repeats along an array.
+    /// Whether the link repeats along an array between neighbouring sections.
     pub fn is_chain(&self) -> bool {
-        matches!(self.from.at, At::Rel(_)) || matches!(self.to.at, At::Rel(_))
+        matches!(self.from.at, At::Rel(_)) && matches!(self.to.at, At::Rel(_))
+    }
+
+    /// Whether the link joins every section of an array to one scalar CV or space
+    /// (`link regen[j] -> bounce for j in 0..n`).
+    pub fn is_per_section(&self) -> bool {
+        matches!(self.from.at, At::Rel(_)) != matches!(self.to.at, At::Rel(_))
     }
 }
 

@@ -78,6 +78,20 @@ pub(super) fn quadratic_flow(a: &mut crate::expr::Arena, dp: Id, r: Id, rq: Id) 
     a.div(num, den)
 }
 
+/// The orifice law `mdot = C sign(dP) sqrt|dP|` regularized so that it is smooth at `dP = 0`:
+/// `C dP / (dP^2 + dP0^2)^(1/4)`, written `C dP / sqrt(sqrt(dP^2 + dP0^2))`. For `|dP| >> dP0`
+/// it is the square-root law to a relative `(dP0/dP)^2 / 4`; for `|dP| << dP0` it is linear,
+/// `C dP / sqrt(dP0)`; it is infinitely differentiable for `dP0 > 0`.
+pub(super) fn orifice_flow(a: &mut crate::expr::Arena, dp: Id, c: Id, dp0: Id) -> Id {
+    let dp2 = a.powi(dp, 2);
+    let w2 = a.powi(dp0, 2);
+    let s = a.add(dp2, w2);
+    let root = a.func(Func::Sqrt, s);
+    let root = a.func(Func::Sqrt, root);
+    let num = a.mul(c, dp);
+    a.div(num, root)
+}
+
 /// `H = cp mdot (s T_from + (1 - s) T_to)`, `s = (1 + tanh(mdot/eps))/2`, `cp = gamma R/(gamma-1)`.
 pub(super) fn enthalpy(
     a: &mut crate::expr::Arena,

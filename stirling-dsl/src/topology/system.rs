@@ -127,6 +127,8 @@ pub struct System {
     pub walls: Vec<WallTerms>,
     /// Heat from fixed temperatures into walls through conduction links (a scalar sum).
     pub wall_boundary_heat: Id,
+    /// The templates (array frame) whose sums over the sections `Sym::Sum(k)` stands for.
+    pub sums: Vec<Id>,
     /// Whether each symbol block number is an array block.
     pub array_blocks: Vec<bool>,
 }
