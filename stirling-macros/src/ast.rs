@@ -209,7 +209,7 @@ impl Parse for ModelAst {
     }
 }
 
-fn item(input: ParseStream) -> syn::Result<Item> {
+pub(crate) fn item(input: ParseStream) -> syn::Result<Item> {
     if input.peek(Token![let]) {
         input.parse::<Token![let]>()?;
         let name = input.parse()?;

@@ -6,6 +6,7 @@
 
 mod ast;
 mod check;
+mod compose;
 mod expand;
 mod expr;
 mod links;
@@ -34,8 +35,8 @@ use proc_macro::TokenStream;
 /// ```
 #[proc_macro]
 pub fn stirling_model(input: TokenStream) -> TokenStream {
-    let ast = syn::parse_macro_input!(input as ast::ModelAst);
-    expand::expand(ast)
+    compose::parse(input.into())
+        .and_then(compose::expand)
         .unwrap_or_else(syn::Error::into_compile_error)
         .into()
 }

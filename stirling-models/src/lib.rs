@@ -124,10 +124,13 @@
 pub mod data;
 /// The sim-to-real gap diagnosis: where, which effect, how far.
 pub mod diagnose;
+/// The seed's model family (`schmidt`, `cv1`, `cv2`, `nsection`) on the default engine
+/// (declared first: it declares the bases `default_engine` and `nsection_engine` that
+/// [`effects`] extends).
+#[macro_use]
+pub mod family;
 /// Effects the nominal models leave out, as DSL-declared model augmentations.
 pub mod effects;
-/// The seed's model family (`schmidt`, `cv1`, `cv2`, `nsection`) on the default engine.
-pub mod family;
 /// Identification: driven subsystems, forward sensitivities, Levenberg-Marquardt, report.
 pub mod fit;
 /// Which state of a model is what (positions, velocities, pressures, masses).
@@ -150,3 +153,6 @@ pub mod sim;
 
 pub use registry::{build, RegistryError, FAMILY};
 pub use stirling_dsl as dsl;
+/// The macro at this crate's root: the exported bases (`default_engine`, `nsection_engine`)
+/// call it back as `$crate::stirling_model!` when another crate extends them.
+pub use stirling_macros::stirling_model;
