@@ -63,6 +63,29 @@ impl Key {
         }
     }
 
+    /// Its name alone, for the lists of what a base declares.
+    fn short(&self) -> String {
+        match self {
+            Key::Name => "name".into(),
+            Key::Gas => "gas".into(),
+            Key::Let(n) | Key::Body(n) | Key::Vessel(n) | Key::Param(n) => format!("`{n}`"),
+            Key::Coupling(a, b) => format!("`{a}, {b}`"),
+            Key::Link(a, b) => format!("`{a} -> {b}`"),
+        }
+    }
+
+    /// How to replace or change it, for the hints.
+    fn hint(&self) -> String {
+        let k = self.keyword();
+        match self {
+            Key::Let(n) => format!("write `replace let {n} = ..;` to replace it"),
+            Key::Param(n) => format!("write `replace params {{ {n}: .. }}` to change its default"),
+            _ => format!(
+                "write `replace {k} {{ .. }}` to replace it or `modify {k} {{ .. }}` to change its fields"
+            ),
+        }
+    }
+
     /// How to write a change of it, for the hints.
     fn keyword(&self) -> String {
         match self {
@@ -471,10 +494,9 @@ fn merge(base: &Ident, base_items: TokenStream, body: TokenStream) -> syn::Resul
                     err(
                         c.span,
                         format!(
-                            "{} is already declared by `{base}`: write `replace {} {{ .. }}` to replace it or `modify {} {{ .. }}` to change its fields",
+                            "{} is already declared by `{base}`: {}",
                             c.key.describe(),
-                            c.key.keyword(),
-                            c.key.keyword()
+                            c.key.hint()
                         ),
                     );
                     continue;
@@ -488,8 +510,9 @@ fn merge(base: &Ident, base_items: TokenStream, body: TokenStream) -> syn::Resul
                         err(
                             p.name.span(),
                             format!(
-                                "parameter `{}` is already declared by `{base}`: write `replace params {{ {}: .. }}` to change its default",
-                                p.name, p.name
+                                "parameter `{}` is already declared by `{base}`: {}",
+                                p.name,
+                                Key::Param(p.name.to_string()).hint()
                             ),
                         );
                     } else {
@@ -586,7 +609,7 @@ fn find_one(items: &[Entry], key: &Key, base: &Ident) -> Result<usize, String> {
                     Entry::Item(c)
                         if std::mem::discriminant(&c.key) == std::mem::discriminant(key) =>
                     {
-                        Some(c.key.describe())
+                        Some(c.key.short())
                     }
                     _ => None,
                 })
