@@ -1,7 +1,7 @@
 //! # stirling-macros: the `stirling_model!` macro
 //!
-//! Parse ([`ast`](self)) -> check and lower to a topology -> assemble and
-//! differentiate with `stirling_dsl` -> emit. The generated code refers to
+//! Compose (bases and `extends`, merged token by token) -> parse ([`ast`](self)) -> check
+//! and lower to a topology -> assemble and differentiate with `stirling_dsl` -> emit. The generated code refers to
 //! `::stirling_dsl`, so a crate using the macro depends on `stirling-dsl` too.
 
 mod ast;
@@ -33,6 +33,11 @@ use proc_macro::TokenStream;
 ///     }
 /// }
 /// ```
+///
+/// Composition (`compose`, docs/custom-topologies.md section 8): `pub base name { items }`
+/// declares no model but a macro `name!` holding its items; `pub model X extends path { .. }`
+/// is that base plus changes: added items, `replace <item>`, `remove <kind> <name>;`,
+/// `modify <kind> <name> { fields }`, merged before the check.
 #[proc_macro]
 pub fn stirling_model(input: TokenStream) -> TokenStream {
     compose::parse(input.into())
