@@ -1,4 +1,5 @@
-//! Parsing: the token syntax of `stirling_model!` into a spanned AST.
+//! Parsing: the token syntax of `stirling_model!` into a spanned AST (after `compose` has
+//! merged a declaration that `extends` a base with the base's items).
 //!
 //! ```text
 //! /// docs
