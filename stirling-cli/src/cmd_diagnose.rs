@@ -7,7 +7,8 @@ use std::path::{Path, PathBuf};
 use anyhow::bail;
 use clap::Args;
 use stirling_models::data::{check_uniform, read_csv_lines};
-use stirling_models::diagnose::{self, selfcheck, DiagnoseOptions, Diagnosis};
+use stirling_models::diagnose::localize::Localization;
+use stirling_models::diagnose::{self, selfcheck, DiagnoseOptions, Diagnosis, RankEntry};
 
 use crate::common::{self, files, ranges};
 
@@ -97,66 +98,7 @@ fn effects_arg(s: &str) -> Option<Vec<String>> {
 
 pub fn run(a: &DiagnoseArgs) -> anyhow::Result<()> {
     if a.self_check {
-        let opts = selfcheck::SelfCheckOptions {
-            model: a.model.clone().unwrap_or_else(|| "cv1".into()),
-            n: a.with.n,
-            effects: effects_arg(&a.effects),
-            strengths: a.strengths.clone(),
-            t_end: a.t_end,
-            rate: a.rate,
-            channels: a.channels.clone(),
-            seed: a.seed,
-            diagnose: DiagnoseOptions {
-                prior: prior_arg(a.prior)?,
-                ..Default::default()
-            },
-            ..Default::default()
-        };
-        let json = a.json;
-        let progress = |c: &selfcheck::Case| {
-            if !json {
-                common::note(format_args!(
-                    "{:<12} {:<16} x{:<4} -> {:<20} rank {:>4} closure {} [{}, {}]  {:>6.1} s  {}",
-                    c.model,
-                    c.truth,
-                    c.strength,
-                    c.verdict,
-                    c.truth_rank.map(|r| r.to_string()).unwrap_or("-".into()),
-                    c.closure_fraction
-                        .map(|v| format!("{v:.2}"))
-                        .unwrap_or("-".into()),
-                    c.ci_low.map(|v| format!("{v:.2}")).unwrap_or("-".into()),
-                    c.ci_high.map(|v| format!("{v:.2}")).unwrap_or("-".into()),
-                    c.seconds,
-                    if c.pass { "right" } else { "WRONG" }
-                ));
-            }
-        };
-        // without a model: every effect of the library, each on the smallest model it fits
-        let sc = if a.model.is_some() {
-            selfcheck::run(&opts, progress)?
-        } else {
-            selfcheck::run_library(&opts, progress)?
-        };
-        if json {
-            common::print_json(&sc)?;
-        } else {
-            let mut o = common::stdout();
-            writeln!(o, "{}", selfcheck::matrix_markdown(&sc))?;
-            writeln!(
-                o,
-                "verdicts right: {}/{}; false alarms on clean records: {}/{}; {:.1} s",
-                sc.passed, sc.total, sc.false_alarms, sc.clean, sc.seconds
-            )?;
-        }
-        if sc.passed < sc.total {
-            bail!(
-                "self-check: {} of {} verdicts wrong",
-                sc.total - sc.passed,
-                sc.total
-            );
-        }
-        return Ok(());
+        return run_self_check(a);
     }
     let (Some(model_name), Some(path)) = (a.model.as_ref(), a.data.as_ref()) else {
         bail!("usage: stirling diagnose <model> --data FILE ... (or --self-check)");
@@ -198,6 +140,76 @@ pub fn run(a: &DiagnoseArgs) -> anyhow::Result<()> {
     Ok(print_text(&mut common::stdout(), path, &d)?)
 }
 
+/// `--self-check`: rig records with each effect withheld, diagnosed; fails when a verdict
+/// is wrong.
+fn run_self_check(a: &DiagnoseArgs) -> anyhow::Result<()> {
+    let opts = selfcheck::SelfCheckOptions {
+        model: a.model.clone().unwrap_or_else(|| "cv1".into()),
+        n: a.with.n,
+        effects: effects_arg(&a.effects),
+        strengths: a.strengths.clone(),
+        t_end: a.t_end,
+        rate: a.rate,
+        channels: a.channels.clone(),
+        seed: a.seed,
+        diagnose: DiagnoseOptions {
+            prior: prior_arg(a.prior)?,
+            ..Default::default()
+        },
+        ..Default::default()
+    };
+    let json = a.json;
+    let progress = |c: &selfcheck::Case| {
+        if !json {
+            common::note(case_line(c));
+        }
+    };
+    // without a model: every effect of the library, each on the smallest model it fits
+    let sc = if a.model.is_some() {
+        selfcheck::run(&opts, progress)?
+    } else {
+        selfcheck::run_library(&opts, progress)?
+    };
+    if json {
+        common::print_json(&sc)?;
+    } else {
+        let mut o = common::stdout();
+        writeln!(o, "{}", selfcheck::matrix_markdown(&sc))?;
+        writeln!(
+            o,
+            "verdicts right: {}/{}; false alarms on clean records: {}/{}; {:.1} s",
+            sc.passed, sc.total, sc.false_alarms, sc.clean, sc.seconds
+        )?;
+    }
+    if sc.passed < sc.total {
+        bail!(
+            "self-check: {} of {} verdicts wrong",
+            sc.total - sc.passed,
+            sc.total
+        );
+    }
+    Ok(())
+}
+
+/// One self-check case as a progress line.
+fn case_line(c: &selfcheck::Case) -> String {
+    let opt = |v: Option<f64>| v.map_or("-".into(), |v| format!("{v:.2}"));
+    format!(
+        "{:<12} {:<16} x{:<4} -> {:<20} rank {:>4} closure {} [{}, {}]  {:>6.1} s  {}",
+        c.model,
+        c.truth,
+        c.strength,
+        c.verdict,
+        c.truth_rank.map_or("-".into(), |r| r.to_string()),
+        opt(c.closure_fraction),
+        opt(c.ci_low),
+        opt(c.ci_high),
+        c.seconds,
+        if c.pass { "right" } else { "WRONG" }
+    )
+}
+
+/// The diagnosis as text: the verdict first (what the user reads), then the evidence.
 fn print_text(o: &mut impl Write, path: &Path, d: &Diagnosis) -> io::Result<()> {
     writeln!(
         o,
@@ -210,96 +222,6 @@ fn print_text(o: &mut impl Write, path: &Path, d: &Diagnosis) -> io::Result<()> 
         d.holdout.0,
         d.holdout.1
     )?;
-    match (&d.simulation_gap, &d.simulation_gap_note) {
-        (Some(g), _) => writeln!(
-            o,
-            "\nthe calibrated model simulated on its own over the held-out block ({} cycles; error = model - measured, 95 % interval over cycles):\n{}",
-            g.cycles,
-            g.markdown()
-        )?,
-        (None, Some(why)) => writeln!(o, "\nsimulated gap: not measured ({why})")?,
-        _ => {}
-    }
-    writeln!(o, "\ngap before (held out, driven subsystems):")?;
-    for c in &d.gap_before.channels {
-        writeln!(
-            o,
-            "  {:<6} rms {:.4e}  noise {:.4e}  ratio {:.3}",
-            c.channel, c.rms, c.noise, c.ratio
-        )?;
-    }
-    for s in &d.gap_before.shifts {
-        writeln!(
-            o,
-            "  {:<6} start {:.4e} -> calibrated {:.4e} (x{:.3}{})",
-            s.name,
-            s.start,
-            s.calibrated,
-            s.factor,
-            s.prior_sd
-                .map(|z| format!(", {z:+.2} prior sd"))
-                .unwrap_or_default()
-        )?;
-    }
-    let l = &d.localization;
-    writeln!(
-        o,
-        "  subsystems: mechanics {:.3}, gas {:.3} noise variances; dominant {}",
-        l.mechanics_error, l.gas_error, l.dominant_subsystem
-    )?;
-    for c in &l.channels {
-        writeln!(
-            o,
-            "  {:<6} harmonics {:?} (noise level {:.2e})",
-            c.channel,
-            c.harmonics
-                .iter()
-                .map(|v| format!("{v:.2e}"))
-                .collect::<Vec<_>>(),
-            c.harmonic_noise
-        )?;
-        writeln!(
-            o,
-            "  {:<6} phase bins {:?}",
-            c.channel,
-            c.phase_bins
-                .iter()
-                .map(|v| format!("{v:.2}"))
-                .collect::<Vec<_>>()
-        )?;
-    }
-    writeln!(o, "\nranking:")?;
-    writeln!(
-        o,
-        "  {:<16} {:>10} {:>10} {:>10} {:>10} {:>22}  params",
-        "effect", "score", "p", "dBIC", "holdout", "closure [95% CI]"
-    )?;
-    for r in &d.ranking {
-        let fmt = |v: Option<f64>| v.map(|v| format!("{v:.3}")).unwrap_or("-".into());
-        writeln!(
-            o,
-            "  {:<16} {:>10.2} {:>10.2e} {:>10} {:>10} {:>22}  {}",
-            r.effect,
-            r.score,
-            r.p_value,
-            fmt(r.delta_bic),
-            fmt(r.holdout_error),
-            format!(
-                "{} [{}, {}]",
-                fmt(r.closure_fraction),
-                fmt(r.ci_low),
-                fmt(r.ci_high)
-            ),
-            r.params
-                .iter()
-                .map(|q| format!(
-                    "{}={:.3e} [{:.3e}, {:.3e}]",
-                    q.name, q.value, q.ci_low, q.ci_high
-                ))
-                .collect::<Vec<_>>()
-                .join(" ")
-        )?;
-    }
     writeln!(
         o,
         "\nverdict: {}{} ({})",
@@ -311,6 +233,114 @@ fn print_text(o: &mut impl Write, path: &Path, d: &Diagnosis) -> io::Result<()> 
             .unwrap_or_default(),
         d.verdict.reason
     )?;
-    writeln!(o, "{} fits (nominal and joint), {:.1} s", d.fits, d.seconds)?;
+    match (&d.simulation_gap, &d.simulation_gap_note) {
+        (Some(g), _) => writeln!(
+            o,
+            "\nthe calibrated model simulated on its own over the held-out block ({} cycles; error = model - measured, 95 % interval over cycles):\n{}",
+            g.cycles,
+            g.markdown()
+        )?,
+        (None, Some(why)) => writeln!(o, "\nsimulated gap: not measured ({why})")?,
+        _ => {}
+    }
+    print_gap_before(o, d)?;
+    print_localization(o, &d.localization)?;
+    print_ranking(o, &d.ranking)?;
+    writeln!(
+        o,
+        "\n{} fits (nominal and joint), {:.1} s",
+        d.fits, d.seconds
+    )
+}
+
+/// The driven subsystems' held-out gap per channel and the calibrated parameters.
+fn print_gap_before(o: &mut impl Write, d: &Diagnosis) -> io::Result<()> {
+    writeln!(o, "\ngap before (held out, driven subsystems):")?;
+    for c in &d.gap_before.channels {
+        writeln!(
+            o,
+            "  {:<6} rms {:.4e}  noise {:.4e}  ratio {:.3}",
+            c.channel, c.rms, c.noise, c.ratio
+        )?;
+    }
+    for s in &d.gap_before.shifts {
+        let sd = s.prior_sd.map(|z| format!(", {z:+.2} prior sd"));
+        writeln!(
+            o,
+            "  {:<6} start {:.4e} -> calibrated {:.4e} (x{:.3}{})",
+            s.name,
+            s.start,
+            s.calibrated,
+            s.factor,
+            sd.unwrap_or_default()
+        )?;
+    }
+    Ok(())
+}
+
+/// Where: subsystems, harmonics and phase bins per channel.
+fn print_localization(o: &mut impl Write, l: &Localization) -> io::Result<()> {
+    writeln!(
+        o,
+        "  subsystems: mechanics {:.3}, gas {:.3} noise variances; dominant {}",
+        l.mechanics_error, l.gas_error, l.dominant_subsystem
+    )?;
+    let list = |v: &[f64], f: fn(&f64) -> String| v.iter().map(f).collect::<Vec<_>>();
+    for c in &l.channels {
+        writeln!(
+            o,
+            "  {:<6} harmonics {:?} (noise level {:.2e})",
+            c.channel,
+            list(&c.harmonics, |v| format!("{v:.2e}")),
+            c.harmonic_noise
+        )?;
+        writeln!(
+            o,
+            "  {:<6} phase bins {:?}",
+            c.channel,
+            list(&c.phase_bins, |v| format!("{v:.2}"))
+        )?;
+    }
+    Ok(())
+}
+
+/// Which: the candidates in rank order.
+fn print_ranking(o: &mut impl Write, ranking: &[RankEntry]) -> io::Result<()> {
+    writeln!(o, "\nranking:")?;
+    writeln!(
+        o,
+        "  {:<16} {:>10} {:>10} {:>10} {:>10} {:>22}  params",
+        "effect", "score", "p", "dBIC", "holdout", "closure [95% CI]"
+    )?;
+    let fmt = |v: Option<f64>| v.map_or("-".into(), |v| format!("{v:.3}"));
+    for r in ranking {
+        let closure = format!(
+            "{} [{}, {}]",
+            fmt(r.closure_fraction),
+            fmt(r.ci_low),
+            fmt(r.ci_high)
+        );
+        let params: Vec<String> = r
+            .params
+            .iter()
+            .map(|q| {
+                format!(
+                    "{}={:.3e} [{:.3e}, {:.3e}]",
+                    q.name, q.value, q.ci_low, q.ci_high
+                )
+            })
+            .collect();
+        writeln!(
+            o,
+            "  {:<16} {:>10.2} {:>10.2e} {:>10} {:>10} {:>22}  {}",
+            r.effect,
+            r.score,
+            r.p_value,
+            fmt(r.delta_bic),
+            fmt(r.holdout_error),
+            closure,
+            params.join(" ")
+        )?;
+    }
     Ok(())
 }

@@ -7,7 +7,10 @@ use std::path::{Path, PathBuf};
 use clap::Args;
 use stirling_dsl::Closure;
 use stirling_models::data::{check_uniform, read_csv_lines};
-use stirling_models::fit::{self, FitOptions, Identification, Series};
+use stirling_models::fit::free_run::FreeRun;
+use stirling_models::fit::multiple_shooting::MultipleShooting;
+use stirling_models::fit::report::{Estimate, FitStats};
+use stirling_models::fit::{self, FitOptions, Identification, Series, StageFit};
 use stirling_models::plot::series::measured_vs_model;
 
 use crate::common::{self, files, ranges};
@@ -138,146 +141,172 @@ fn print_text(o: &mut impl Write, data: &Path, res: &Identification) -> io::Resu
             .unwrap_or_default()
     )?;
     for st in [&res.stage1, &res.stage2].into_iter().flatten() {
-        writeln!(
-            o,
-            "\n{} ({} iterations, {} evaluations, {}, {:.2} s)",
-            st.stage,
-            st.iterations,
-            st.evaluations,
-            if st.converged {
-                "converged"
-            } else {
-                "NOT converged"
-            },
-            st.seconds
-        )?;
-        writeln!(
-            o,
-            "  {:<14} {:>14} {:>14} {:>12} {:>28}",
-            "quantity", "initial", "estimate", "std error", "95 % interval"
-        )?;
-        for e in &st.stats.estimates {
-            writeln!(
-                o,
-                "  {:<14} {:>14.6e} {:>14.6e} {:>12.3e}   [{:.6e}, {:.6e}]",
-                e.name, e.initial, e.value, e.std_error, e.ci_low, e.ci_high
-            )?;
-        }
-        let names: Vec<&str> = st.stats.estimates.iter().map(|e| e.name.as_str()).collect();
-        writeln!(o, "  correlation:")?;
-        writeln!(
-            o,
-            "  {:>12} {}",
-            "",
-            names
-                .iter()
-                .map(|n| format!("{:>9}", &n[..n.len().min(9)]))
-                .collect::<String>()
-        )?;
-        for (i, row) in st.stats.correlation.iter().enumerate() {
-            writeln!(
-                o,
-                "  {:>12} {}",
-                &names[i][..names[i].len().min(12)],
-                row.iter().map(|v| format!("{v:>9.3}")).collect::<String>()
-            )?;
-        }
-        for w in &st.stats.warnings {
-            writeln!(o, "  WARNING: {w}")?;
-        }
-        for f in &st.fits {
-            writeln!(
-                o,
-                "  fit {:<6} {:<8} {:>7.2} %  (rms {:.3e}, {} samples)",
-                f.channel, f.block, f.fit_percent, f.rms, f.samples
-            )?;
-        }
+        print_stage(o, st)?;
     }
     if let Some(ms) = &res.multiple_shooting {
-        writeln!(
-            o,
-            "\nmultiple shooting ({} segments, {} iterations, {}, {:.2} s, largest defect {:.2e})",
-            ms.segments.len(),
-            ms.iterations,
-            if ms.converged {
-                "converged"
-            } else {
-                "NOT converged"
-            },
-            ms.seconds,
-            ms.segments.iter().map(|s| s.defect).fold(0.0, f64::max)
-        )?;
-        for e in ms
-            .stats
-            .estimates
-            .iter()
-            .filter(|e| !e.name.starts_with("seg"))
-        {
-            writeln!(
-                o,
-                "  {:<14} {:>14.6e} {:>14.6e} {:>12.3e}   [{:.6e}, {:.6e}]",
-                e.name, e.initial, e.value, e.std_error, e.ci_low, e.ci_high
-            )?;
-        }
-        // collinear segment initial states (fast gas modes) are expected: count them only
-        let (seg, other): (Vec<&String>, Vec<&String>) =
-            ms.stats.warnings.iter().partition(|w| w.contains("`seg"));
-        for w in other {
-            writeln!(o, "  WARNING: {w}")?;
-        }
-        if !seg.is_empty() {
-            writeln!(
-                o,
-                "  note: {} nearly collinear pairs involve segment initial states (see --json)",
-                seg.len()
-            )?;
-        }
-        for f in &ms.fits {
-            writeln!(
-                o,
-                "  fit {:<6} {:<8} {:>7.2} %",
-                f.channel, f.block, f.fit_percent
-            )?;
-        }
+        print_multiple_shooting(o, ms)?;
     }
     if let Some(fr) = &res.free_run {
-        writeln!(
-            o,
-            "\nfree run from the measured state at {:.3} s (to {:.3} s; short window {:.3} s)",
-            fr.block.0, fr.block.1, fr.short_window
-        )?;
-        for f in &fr.fits {
-            writeln!(
-                o,
-                "  fit {:<6} {:<15} {:>7.2} %  (rms {:.3e})",
-                f.channel, f.block, f.fit_percent, f.rms
-            )?;
-        }
-        if let (Some(m), Some(s)) = (&fr.measured, &fr.simulated) {
-            writeln!(
-                o,
-                "  frequency   measured {:.4} Hz, model {:.4} Hz",
-                m.frequency, s.frequency
-            )?;
-            for (((c, am), (_, asim)), ((_, pm), (_, psim))) in m
-                .amplitude
-                .iter()
-                .zip(&s.amplitude)
-                .zip(m.phase.iter().zip(&s.phase))
-            {
-                writeln!(
-                    o,
-                    "  {c:<6} amplitude {am:.4e} / {asim:.4e}, phase vs x {pm:+.4} / {psim:+.4} rad"
-                )?;
-            }
-        }
-        if let Some(l) = fr.x_phase_lag {
-            writeln!(o, "  displacer phase drift at the block end {l:+.4} rad")?;
-        }
+        print_free_run(o, fr)?;
     }
     for n in &res.notes {
         writeln!(o, "NOTE: {n}")?;
     }
     writeln!(o, "\ntotal {:.2} s", res.seconds)?;
+    Ok(())
+}
+
+/// `converged` or `NOT converged`.
+fn convergence(converged: bool) -> &'static str {
+    if converged {
+        "converged"
+    } else {
+        "NOT converged"
+    }
+}
+
+/// One row of the estimates table.
+fn print_estimate(o: &mut impl Write, e: &Estimate) -> io::Result<()> {
+    writeln!(
+        o,
+        "  {:<14} {:>14.6e} {:>14.6e} {:>12.3e}   [{:.6e}, {:.6e}]",
+        e.name, e.initial, e.value, e.std_error, e.ci_low, e.ci_high
+    )
+}
+
+/// A stage: its estimates, their correlation matrix, warnings and fits.
+fn print_stage(o: &mut impl Write, st: &StageFit) -> io::Result<()> {
+    writeln!(
+        o,
+        "\n{} ({} iterations, {} evaluations, {}, {:.2} s)",
+        st.stage,
+        st.iterations,
+        st.evaluations,
+        convergence(st.converged),
+        st.seconds
+    )?;
+    writeln!(
+        o,
+        "  {:<14} {:>14} {:>14} {:>12} {:>28}",
+        "quantity", "initial", "estimate", "std error", "95 % interval"
+    )?;
+    for e in &st.stats.estimates {
+        print_estimate(o, e)?;
+    }
+    print_correlation(o, &st.stats)?;
+    for w in &st.stats.warnings {
+        writeln!(o, "  WARNING: {w}")?;
+    }
+    for f in &st.fits {
+        writeln!(
+            o,
+            "  fit {:<6} {:<8} {:>7.2} %  (rms {:.3e}, {} samples)",
+            f.channel, f.block, f.fit_percent, f.rms, f.samples
+        )?;
+    }
+    Ok(())
+}
+
+/// The correlation matrix of the estimates, names shortened to fit the columns.
+fn print_correlation(o: &mut impl Write, stats: &FitStats) -> io::Result<()> {
+    let names: Vec<&str> = stats.estimates.iter().map(|e| e.name.as_str()).collect();
+    writeln!(o, "  correlation:")?;
+    writeln!(
+        o,
+        "  {:>12} {}",
+        "",
+        names
+            .iter()
+            .map(|n| format!("{:>9}", &n[..n.len().min(9)]))
+            .collect::<String>()
+    )?;
+    for (i, row) in stats.correlation.iter().enumerate() {
+        writeln!(
+            o,
+            "  {:>12} {}",
+            &names[i][..names[i].len().min(12)],
+            row.iter().map(|v| format!("{v:>9.3}")).collect::<String>()
+        )?;
+    }
+    Ok(())
+}
+
+/// The multiple-shooting refinement: model estimates, warnings (segment pairs counted), fits.
+fn print_multiple_shooting(o: &mut impl Write, ms: &MultipleShooting) -> io::Result<()> {
+    writeln!(
+        o,
+        "\nmultiple shooting ({} segments, {} iterations, {}, {:.2} s, largest defect {:.2e})",
+        ms.segments.len(),
+        ms.iterations,
+        convergence(ms.converged),
+        ms.seconds,
+        ms.segments.iter().map(|s| s.defect).fold(0.0, f64::max)
+    )?;
+    for e in ms
+        .stats
+        .estimates
+        .iter()
+        .filter(|e| !e.name.starts_with("seg"))
+    {
+        print_estimate(o, e)?;
+    }
+    // collinear segment initial states (fast gas modes) are expected: count them only
+    let (seg, other): (Vec<&String>, Vec<&String>) =
+        ms.stats.warnings.iter().partition(|w| w.contains("`seg"));
+    for w in other {
+        writeln!(o, "  WARNING: {w}")?;
+    }
+    if !seg.is_empty() {
+        writeln!(
+            o,
+            "  note: {} nearly collinear pairs involve segment initial states (see --json)",
+            seg.len()
+        )?;
+    }
+    for f in &ms.fits {
+        writeln!(
+            o,
+            "  fit {:<6} {:<8} {:>7.2} %",
+            f.channel, f.block, f.fit_percent
+        )?;
+    }
+    Ok(())
+}
+
+/// The free-run validation: fits, cycle features, the displacer's phase drift.
+fn print_free_run(o: &mut impl Write, fr: &FreeRun) -> io::Result<()> {
+    writeln!(
+        o,
+        "\nfree run from the measured state at {:.3} s (to {:.3} s; short window {:.3} s)",
+        fr.block.0, fr.block.1, fr.short_window
+    )?;
+    for f in &fr.fits {
+        writeln!(
+            o,
+            "  fit {:<6} {:<15} {:>7.2} %  (rms {:.3e})",
+            f.channel, f.block, f.fit_percent, f.rms
+        )?;
+    }
+    if let (Some(m), Some(s)) = (&fr.measured, &fr.simulated) {
+        writeln!(
+            o,
+            "  frequency   measured {:.4} Hz, model {:.4} Hz",
+            m.frequency, s.frequency
+        )?;
+        for (((c, am), (_, asim)), ((_, pm), (_, psim))) in m
+            .amplitude
+            .iter()
+            .zip(&s.amplitude)
+            .zip(m.phase.iter().zip(&s.phase))
+        {
+            writeln!(
+                o,
+                "  {c:<6} amplitude {am:.4e} / {asim:.4e}, phase vs x {pm:+.4} / {psim:+.4} rad"
+            )?;
+        }
+    }
+    if let Some(l) = fr.x_phase_lag {
+        writeln!(o, "  displacer phase drift at the block end {l:+.4} rad")?;
+    }
     Ok(())
 }

@@ -10,7 +10,7 @@ use clap::Args;
 use serde::Serialize;
 use stirling_dsl::Model;
 use stirling_models::linear::export::{self, StateSpaceExport};
-use stirling_models::linear::{self, LinearOptions, LinearReport, Linearization, Pole};
+use stirling_models::linear::{self, LinearOptions, LinearReport, Linearization, Margins, Pole};
 use stirling_models::plot;
 
 use crate::common::{self, files, ModelArgs};
@@ -148,7 +148,11 @@ fn print_text(o: &mut impl Write, r: &LinearReport) -> io::Result<()> {
     for p in &l.open_loop_poles {
         print_pole(o, p)?;
     }
-    let m = &r.margins;
+    print_margins(o, &r.margins)
+}
+
+/// The selected gain and phase margins, then every crossover.
+fn print_margins(o: &mut impl Write, m: &Margins) -> io::Result<()> {
     writeln!(
         o,
         "margins: Gm = {} dB at {} rad/s, Pm = {} deg at {} rad/s",

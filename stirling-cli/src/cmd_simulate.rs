@@ -61,57 +61,13 @@ pub fn run(args: &SimulateArgs) -> anyhow::Result<()> {
     let model = model.as_ref();
     check_outputs(args, model)?;
     let x0 = initial_state(model, &p, args)?;
-    // `--samples` counts the rows: the first at 0, the last at t_end
-    let samples = sim::uniform_samples(args.t_end, args.samples - 1);
-    let opts = SimOptions {
-        rtol: args.rtol,
-        atol: args.atol.unwrap_or(args.rtol),
-        ..Default::default()
-    };
-    let bar = ProgressBar::new(1000);
-    bar.set_style(
-        ProgressStyle::with_template("{spinner} simulating [{bar:40}] t = {msg} s ({elapsed})")
-            .unwrap_or_else(|_| ProgressStyle::default_bar()),
-    );
+    let bar = progress_bar();
     let t_end = args.t_end;
     let mut progress = |t: f64| {
         bar.set_position((1000.0 * t / t_end) as u64);
         bar.set_message(format!("{t:.4}"));
     };
-    let (traj, summary, lc) = if args.limit_cycle {
-        let lc = sim::limit_cycle(
-            model,
-            &p,
-            &x0,
-            args.t_end,
-            &samples,
-            &opts,
-            Some(&mut progress),
-        )
-        .with_context(|| format!("limit cycle of `{}`", model.name()))?;
-        let tr = lc.settled.trajectory.clone();
-        let s = SimSummary::from_run(model, &tr).with_cycle(&lc);
-        (tr, s, Some(lc))
-    } else {
-        let checker = sim::PhysicalCheck::new(model, &p);
-        let check = |t: f64, x: &[f64]| checker.check(t, x);
-        let hooks = sim::Hooks {
-            check: Some(&check),
-            progress: Some(&mut progress),
-            ..Default::default()
-        };
-        let tr = sim::integrate(
-            &sim::ModelSystem { model, p: &p },
-            &x0,
-            args.t_end,
-            &samples,
-            &opts,
-            hooks,
-        )
-        .with_context(|| format!("simulation of `{}`", model.name()))?;
-        let s = SimSummary::from_run(model, &tr);
-        (tr, s, None)
-    };
+    let (traj, summary, lc) = simulate(model, &p, &x0, args, &mut progress)?;
     bar.finish_and_clear();
     if let Some(out) = &args.out {
         write_csv(out, args.force, model, &traj)?;
@@ -124,6 +80,58 @@ pub fn run(args: &SimulateArgs) -> anyhow::Result<()> {
     } else {
         Ok(print_summary(&mut common::stdout(), &summary)?)
     }
+}
+
+/// The progress bar of a run, in thousandths of `t_end`.
+fn progress_bar() -> ProgressBar {
+    let bar = ProgressBar::new(1000);
+    bar.set_style(
+        ProgressStyle::with_template("{spinner} simulating [{bar:40}] t = {msg} s ({elapsed})")
+            .unwrap_or_else(|_| ProgressStyle::default_bar()),
+    );
+    bar
+}
+
+/// The run: a checked integration over `t_end`, or with `--limit-cycle` the refined cycle.
+fn simulate(
+    model: &dyn Model,
+    p: &[f64],
+    x0: &[f64],
+    args: &SimulateArgs,
+    progress: &mut dyn FnMut(f64),
+) -> anyhow::Result<(Trajectory, SimSummary, Option<sim::LimitCycleReport>)> {
+    // `--samples` counts the rows: the first at 0, the last at t_end
+    let samples = sim::uniform_samples(args.t_end, args.samples - 1);
+    let opts = SimOptions {
+        rtol: args.rtol,
+        atol: args.atol.unwrap_or(args.rtol),
+        ..Default::default()
+    };
+    if args.limit_cycle {
+        let lc = sim::limit_cycle(model, p, x0, args.t_end, &samples, &opts, Some(progress))
+            .with_context(|| format!("limit cycle of `{}`", model.name()))?;
+        let tr = lc.settled.trajectory.clone();
+        let s = SimSummary::from_run(model, &tr).with_cycle(&lc);
+        return Ok((tr, s, Some(lc)));
+    }
+    let checker = sim::PhysicalCheck::new(model, p);
+    let check = |t: f64, x: &[f64]| checker.check(t, x);
+    let hooks = sim::Hooks {
+        check: Some(&check),
+        progress: Some(progress),
+        ..Default::default()
+    };
+    let tr = sim::integrate(
+        &sim::ModelSystem { model, p },
+        x0,
+        args.t_end,
+        &samples,
+        &opts,
+        hooks,
+    )
+    .with_context(|| format!("simulation of `{}`", model.name()))?;
+    let s = SimSummary::from_run(model, &tr);
+    Ok((tr, s, None))
 }
 
 /// The figures `--plot` writes.

@@ -4,8 +4,10 @@
 //! `stirling_model!` declaration implements, so a topology declared in user code gets the
 //! same equilibrium, poles, margins, limit cycle and plots as the seed's family.
 //!
-//! - [`family`]: `schmidt`, `cv1`, `cv2`, `nsection` declared with `stirling_model!`
-//!   on the default engine of docs/physics.md section 8.
+//! - [`model`]: model construction. [`family`]: `schmidt`, `cv1`, `cv2`, `nsection`
+//!   declared with `stirling_model!` on the default engine of docs/physics.md section 8;
+//!   [`effects`]: the effects the nominal models leave out; [`params`]: parameter files,
+//!   overrides and validation; [`registry`]: the family by name, as the command line uses it.
 //! - [`linear`]: equilibrium by Newton ([`linear::equilibrium::solve`]), the dynamic poles
 //!   with the inventory mode removed ([`linear::dynamic_poles`]), the loop broken at a
 //!   pressure force with gain and phase margins and Bode/Nyquist data
@@ -15,13 +17,10 @@
 //!   the energy budget as a quadrature), limit cycles by shooting with Floquet multipliers
 //!   ([`sim::limit_cycle`]), cycle work ([`sim::cycle_work`]).
 //! - [`plot`]: SVG figures (pole map, Bode, root locus, start-up response, PV diagrams).
-//! - [`params`]: parameter files, overrides and validation; [`registry`]: the family by
-//!   name, as the command line uses it.
 //! - [`data`]: measured records (CSV) with row and column errors; [`rig`]: the virtual test
 //!   rig that writes them from a truth model with effects, noise and offsets.
 //! - [`fit`]: the two-stage identification (mechanics driven by pressure, gas driven by
-//!   positions), on the seed's sensors too; [`diagnose`]: the sim-to-real gap diagnosis;
-//!   [`effects`]: the effects the nominal models leave out.
+//!   positions), on the seed's sensors too; [`diagnose`]: the sim-to-real gap diagnosis.
 //! - [`layout`]: which state is what; [`signal`]: smoothing, noise level, cycles, harmonics,
 //!   filters and statistical tails shared by the analyses.
 //!
@@ -124,25 +123,16 @@
 pub mod data;
 /// The sim-to-real gap diagnosis: where, which effect, how far.
 pub mod diagnose;
-/// The seed's model family (`schmidt`, `cv1`, `cv2`, `nsection`) on the default engine
-/// (declared first: it declares the bases `default_engine` and `nsection_engine` that
-/// [`effects`] extends).
-#[macro_use]
-pub mod family;
-/// Effects the nominal models leave out, as DSL-declared model augmentations.
-pub mod effects;
 /// Identification: driven subsystems, forward sensitivities, Levenberg-Marquardt, report.
 pub mod fit;
 /// Which state of a model is what (positions, velocities, pressures, masses).
 pub mod layout;
 /// Linear analysis: equilibrium, poles, the loop broken at a pressure force, margins, locus.
 pub mod linear;
-/// Parameter files, overrides and validation.
-pub mod params;
+/// Model construction: the family, the effects, the registry, parameters.
+pub mod model;
 /// SVG figures: pole map, Bode, root locus, start-up, PV diagrams, measured vs model.
 pub mod plot;
-/// The family by name, as the command line uses it.
-pub mod registry;
 /// The virtual test rig: truth model plus effects, noise, offsets, sample rate.
 pub mod rig;
 /// Signal processing shared by fit, diagnose and rig: smoothing, noise level, cycles,
@@ -151,6 +141,7 @@ pub mod signal;
 /// Nonlinear simulation, limit cycles, Floquet multipliers and cycle work.
 pub mod sim;
 
+pub use model::{effects, family, params, registry};
 pub use registry::{build, RegistryError, FAMILY};
 pub use stirling_dsl as dsl;
 /// The macro at this crate's root: the exported bases (`default_engine`, `nsection_engine`)

@@ -32,27 +32,33 @@ pub fn to_dot(t: &TopologyInfo) -> String {
         vessel(&mut s, v);
     }
     for l in t.links {
-        let id = format!("R:{}->{}", l.from, l.to);
-        let label = if l.chain {
-            format!("R: {} (each j)", l.resistance)
-        } else {
-            format!("R: {}", l.resistance)
-        };
-        let _ = writeln!(
-            s,
-            "  \"{id}\" [shape=plaintext, label=\"{}\"];",
-            esc(&label)
-        );
-        let (from, to) = (base(l.from), base(l.to));
-        let _ = writeln!(
-            s,
-            "  \"gas:{from}\" -> \"{id}\" -> \"gas:{to}\" [arrowhead=halfopen, label=\"mdot, H\"];"
-        );
+        link(&mut s, l);
     }
     s.push_str("}\n");
     s
 }
 
+/// A mass-flow link: a resistor between the two vessels it joins.
+fn link(s: &mut String, l: &super::topology_info::LinkInfo) {
+    let id = format!("R:{}->{}", l.from, l.to);
+    let label = if l.chain {
+        format!("R: {} (each j)", l.resistance)
+    } else {
+        format!("R: {}", l.resistance)
+    };
+    let _ = writeln!(
+        s,
+        "  \"{id}\" [shape=plaintext, label=\"{}\"];",
+        esc(&label)
+    );
+    let (from, to) = (base(l.from), base(l.to));
+    let _ = writeln!(
+        s,
+        "  \"gas:{from}\" -> \"{id}\" -> \"gas:{to}\" [arrowhead=halfopen, label=\"mdot, H\"];"
+    );
+}
+
+/// A vessel (capacitance or effort source) with its faces and heat ports.
 fn vessel(s: &mut String, v: &super::topology_info::VesselInfo) {
     let kind = if v.is_cv { "C" } else { "Se" };
     let label = if v.array {
@@ -95,10 +101,12 @@ fn vessel(s: &mut String, v: &super::topology_info::VesselInfo) {
     }
 }
 
+/// A link end without its index (`h[j]` -> `h`).
 fn base(end: &str) -> &str {
     end.split('[').next().unwrap_or(end)
 }
 
+/// `s` with its double quotes escaped for a DOT string.
 fn esc(s: &str) -> String {
     s.replace('"', "\\\"")
 }

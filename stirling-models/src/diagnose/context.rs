@@ -113,75 +113,90 @@ impl Context<'_> {
         theta: Vec<f64>,
         p: Vec<f64>,
     ) -> Result<Eval, DiagnoseError> {
-        let nt = self.data.t.len();
-        let (mut channels, mut resid, mut pred) = (Vec::new(), Vec::new(), Vec::new());
-        for pr in preds {
-            let meas =
-                self.data
-                    .channel(&pr.channel)
-                    .ok_or_else(|| DiagnoseError::MissingChannel {
-                        file: self.data.source.clone(),
-                        channel: pr.channel.clone(),
-                    })?;
-            let mut r = vec![f64::NAN; nt];
-            let mut pv = vec![f64::NAN; nt];
-            for (k, v) in pr.values.iter().enumerate() {
-                let i = pr.first + k;
-                if i < nt {
-                    r[i] = meas[i] - v;
-                    pv[i] = *v;
-                }
-            }
-            channels.push(pr.channel.clone());
-            resid.push(r);
-            pred.push(pv);
-        }
-        if channels.is_empty() {
+        if preds.is_empty() {
             return Err(DiagnoseError::NoOutputs);
         }
+        let mut series = Vec::new();
+        for pr in preds {
+            series.push(self.series(pr)?);
+        }
+        let (resid, pred): (Vec<Vec<f64>>, Vec<Vec<f64>>) = series.into_iter().unzip();
+        let channels: Vec<String> = preds.iter().map(|pr| pr.channel.clone()).collect();
         let hp: Vec<Vec<f64>> = resid
             .iter()
             .zip(preds)
-            .map(|(r, pr)| {
-                let mut h = high_pass(r, self.half_period);
-                for (a, b) in [self.train_idx, self.hold_idx] {
-                    let m = (pr.drift_rate * (b - a) as f64).round() as usize;
-                    if m > 0 && h[a..b].iter().all(|v| v.is_finite()) {
-                        project_drift(&mut h[a..b], m);
-                    }
-                }
-                h
-            })
+            .map(|(r, pr)| self.high_passed(r, pr.drift_rate))
             .collect();
-        let sample_err = |range: (usize, usize)| -> Result<f64, DiagnoseError> {
-            let mut total = 0.0;
-            for i in range.0..range.1 {
-                for (c, r) in channels.iter().zip(&hp) {
-                    let z = r[i] / self.noise_of(c);
-                    if !z.is_finite() {
-                        return Err(DiagnoseError::NoModelOutput {
-                            channel: c.clone(),
-                            sample: i,
-                        });
-                    }
-                    total += z * z;
-                }
-            }
-            let n = ((range.1 - range.0) * channels.len()).max(1) as f64;
-            Ok(total / n)
-        };
-        let train_error = sample_err(self.train_idx)?;
-        let holdout_error = sample_err(self.hold_idx)?;
         Ok(Eval {
             theta,
-            holdout_error,
-            train_error,
+            train_error: self.mean_square(&channels, &hp, self.train_idx)?,
+            holdout_error: self.mean_square(&channels, &hp, self.hold_idx)?,
             channels,
             resid,
             hp,
             pred,
             p,
         })
+    }
+
+    /// A prediction's residual (measured minus model) and values on the record's grid (`NaN`
+    /// where it has none).
+    fn series(&self, pr: &Prediction) -> Result<(Vec<f64>, Vec<f64>), DiagnoseError> {
+        let meas = self
+            .data
+            .channel(&pr.channel)
+            .ok_or_else(|| DiagnoseError::MissingChannel {
+                file: self.data.source.clone(),
+                channel: pr.channel.clone(),
+            })?;
+        let nt = self.data.t.len();
+        let mut r = vec![f64::NAN; nt];
+        let mut pv = vec![f64::NAN; nt];
+        for (k, v) in pr.values.iter().enumerate() {
+            let i = pr.first + k;
+            if i < nt {
+                r[i] = meas[i] - v;
+                pv[i] = *v;
+            }
+        }
+        Ok((r, pv))
+    }
+
+    /// A residual without its slow part, and, on each block, without the sub-cycle drift
+    /// band of `drift_rate` the stage ignores.
+    fn high_passed(&self, r: &[f64], drift_rate: f64) -> Vec<f64> {
+        let mut h = high_pass(r, self.half_period);
+        for (a, b) in [self.train_idx, self.hold_idx] {
+            let m = (drift_rate * (b - a) as f64).round() as usize;
+            if m > 0 && h[a..b].iter().all(|v| v.is_finite()) {
+                project_drift(&mut h[a..b], m);
+            }
+        }
+        h
+    }
+
+    /// Mean squared residual over noise variance on the sample `range`, all channels.
+    fn mean_square(
+        &self,
+        channels: &[String],
+        hp: &[Vec<f64>],
+        range: (usize, usize),
+    ) -> Result<f64, DiagnoseError> {
+        let mut total = 0.0;
+        for i in range.0..range.1 {
+            for (c, r) in channels.iter().zip(hp) {
+                let z = r[i] / self.noise_of(c);
+                if !z.is_finite() {
+                    return Err(DiagnoseError::NoModelOutput {
+                        channel: c.clone(),
+                        sample: i,
+                    });
+                }
+                total += z * z;
+            }
+        }
+        let n = ((range.1 - range.0) * channels.len()).max(1) as f64;
+        Ok(total / n)
     }
 
     /// The evaluation of a fitted joint problem: its stages at `u`, the others nominal.

@@ -226,6 +226,84 @@ fn interval(value: f64, mut boot: Vec<f64>) -> FeatureError {
     }
 }
 
+/// Measured minus simulated waveform by phase, per channel, before and after.
+fn phase_residuals(meas: &Cycles, before: &Cycles, after: Option<&Cycles>) -> Vec<PhaseResidual> {
+    let res_b = meas.residual(before);
+    let res_a = after.map(|s| meas.residual(s));
+    ["x", "y", "p"]
+        .iter()
+        .enumerate()
+        .map(|(c, ch)| PhaseResidual {
+            channel: ch.to_string(),
+            before: res_b[c].clone(),
+            after: res_a.as_ref().map(|r| r[c].clone()),
+        })
+        .collect()
+}
+
+/// The cycles every series has (at least 3).
+fn common_cycles(
+    meas: &[[f64; 7]],
+    before: &[[f64; 7]],
+    after: Option<&[[f64; 7]]>,
+) -> Result<usize, SimGapError> {
+    let k = meas
+        .len()
+        .min(before.len())
+        .min(after.map_or(usize::MAX, |s| s.len()));
+    if k >= 3 {
+        return Ok(k);
+    }
+    let (which, found) = if meas.len() < 3 {
+        ("measured", meas.len())
+    } else {
+        ("simulated", k)
+    };
+    Err(SimGapError::TooFewCycles { which, found })
+}
+
+/// Resamples of the cycles (with replacement), shared by every feature and the closure so
+/// that their intervals come from the same draws.
+struct Bootstrap {
+    all: Vec<usize>,
+    draws: Vec<Vec<usize>>,
+    /// The mean measured frequency (scales the growth rate per cycle).
+    f0: f64,
+}
+
+impl Bootstrap {
+    fn new(meas: &[[f64; 7]], k: usize, resamples: usize, seed: u64) -> Self {
+        let mut rng = StdRng::seed_from_u64(seed);
+        Bootstrap {
+            all: (0..k).collect(),
+            draws: (0..resamples)
+                .map(|_| (0..k).map(|_| rng.gen_range(0..k)).collect())
+                .collect(),
+            f0: meas[..k].iter().map(|r| r[0]).sum::<f64>() / k as f64,
+        }
+    }
+
+    /// Feature `f`'s mean error with its interval, in the feature's unit (`%` scaled).
+    fn feature(&self, e: &[[f64; 7]], f: usize) -> FeatureError {
+        let boot = self.draws.iter().map(|d| mean_errors(e, d)[f]).collect();
+        let v = interval(mean_errors(e, &self.all)[f], boot);
+        let pct = if FEATURES[f].1 == "%" { 100.0 } else { 1.0 };
+        FeatureError {
+            value: v.value * pct,
+            ci_low: v.ci_low * pct,
+            ci_high: v.ci_high * pct,
+        }
+    }
+
+    /// `1 - D_after / D_before` with its interval.
+    fn closure(&self, eb: &[[f64; 7]], ea: &[[f64; 7]]) -> FeatureError {
+        let c = |d: &[usize]| {
+            1.0 - size(&mean_errors(ea, d), self.f0) / size(&mean_errors(eb, d), self.f0)
+        };
+        interval(c(&self.all), self.draws.iter().map(|d| c(d)).collect())
+    }
+}
+
 /// The simulated gap of the calibrated model (`before`) and, if given, of the model with the
 /// leading effect (`after`), on the held-out `block` (s).
 #[allow(clippy::too_many_arguments)]
@@ -246,66 +324,25 @@ pub fn simulation_gap(
         Some((_, m)) => Some(simulate_rows(model, data, off, block, m, "effect", area)?.1),
         None => None,
     };
-    let res_b = meas_c.residual(&sim_bc);
-    let res_a = sim_ac.as_ref().map(|s| meas_c.residual(s));
-    let phase_residuals = ["x", "y", "p"]
-        .iter()
-        .enumerate()
-        .map(|(c, ch)| PhaseResidual {
-            channel: ch.to_string(),
-            before: res_b[c].clone(),
-            after: res_a.as_ref().map(|r| r[c].clone()),
-        })
-        .collect();
+    let phase_residuals = phase_residuals(&meas_c, &sim_bc, sim_ac.as_ref());
     let (meas, sim_b, sim_a) = (meas_c.rows, sim_bc.rows, sim_ac.map(|s| s.rows));
-    let mut k = meas.len().min(sim_b.len());
-    if let Some(s) = &sim_a {
-        k = k.min(s.len());
-    }
-    if k < 3 {
-        let (which, found) = if meas.len() < 3 {
-            ("measured", meas.len())
-        } else {
-            ("simulated", k)
-        };
-        return Err(SimGapError::TooFewCycles { which, found });
-    }
+    let k = common_cycles(&meas, &sim_b, sim_a.as_deref())?;
+    let boot = Bootstrap::new(&meas, k, resamples, seed);
     let eb = errors(&meas, &sim_b, k);
     let ea = sim_a.as_ref().map(|s| errors(&meas, s, k));
-    let all: Vec<usize> = (0..k).collect();
-    let f0 = meas[..k].iter().map(|r| r[0]).sum::<f64>() / k as f64;
-    let mut rng = StdRng::seed_from_u64(seed);
-    let draws: Vec<Vec<usize>> = (0..resamples)
-        .map(|_| (0..k).map(|_| rng.gen_range(0..k)).collect())
-        .collect();
-    let feature = |e: &[[f64; 7]], f: usize| {
-        let boot = draws.iter().map(|d| mean_errors(e, d)[f]).collect();
-        interval(mean_errors(e, &all)[f], boot)
-    };
-    let measured = mean_errors(&meas[..k].to_vec(), &all);
+    let measured = mean_errors(&meas[..k], &boot.all);
     let rows = FEATURES
         .iter()
         .enumerate()
-        .map(|(f, (name, unit))| {
-            let pct = if *unit == "%" { 100.0 } else { 1.0 };
-            let scaled = |v: FeatureError| FeatureError {
-                value: v.value * pct,
-                ci_low: v.ci_low * pct,
-                ci_high: v.ci_high * pct,
-            };
-            FeatureRow {
-                feature: name.to_string(),
-                unit: unit.to_string(),
-                measured: measured[f],
-                before: scaled(feature(&eb, f)),
-                after: ea.as_ref().map(|e| scaled(feature(e, f))),
-            }
+        .map(|(f, (name, unit))| FeatureRow {
+            feature: name.to_string(),
+            unit: unit.to_string(),
+            measured: measured[f],
+            before: boot.feature(&eb, f),
+            after: ea.as_ref().map(|e| boot.feature(e, f)),
         })
         .collect();
-    let closure = ea.as_ref().map(|ea| {
-        let c = |d: &[usize]| 1.0 - size(&mean_errors(ea, d), f0) / size(&mean_errors(&eb, d), f0);
-        interval(c(&all), draws.iter().map(|d| c(d)).collect())
-    });
+    let closure = ea.as_ref().map(|ea| boot.closure(&eb, ea));
     Ok(SimulationGap {
         block,
         cycles: k,

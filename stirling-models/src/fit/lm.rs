@@ -49,6 +49,27 @@ pub struct LmResult {
     pub converged: bool,
 }
 
+/// The Levenberg-Marquardt step `-(J^T J + lambda diag(J^T J))^-1 g`, shortened to
+/// `max_step` (largest component); `None` when the damped matrix is not positive definite.
+fn damped_step(
+    jtj: &DMatrix<f64>,
+    g: &DVector<f64>,
+    lambda: f64,
+    max_step: f64,
+) -> Option<DVector<f64>> {
+    let mut a = jtj.clone();
+    for i in 0..a.nrows() {
+        a[(i, i)] += lambda * jtj[(i, i)].max(1e-12);
+    }
+    let ch = a.cholesky()?;
+    let mut step = ch.solve(&(-g));
+    let long = step.amax();
+    if long > max_step {
+        step *= max_step / long;
+    }
+    Some(step)
+}
+
 /// Minimize `|r(x)|^2 / 2` from `x0`.
 pub fn minimize(eval: &mut Eval, x0: &[f64], opts: &LmOptions) -> Option<LmResult> {
     let mut x = x0.to_vec();
@@ -66,20 +87,11 @@ pub fn minimize(eval: &mut Eval, x0: &[f64], opts: &LmOptions) -> Option<LmResul
         let g = jm.transpose() * DVector::from_column_slice(&r);
         let mut accepted = false;
         for _ in 0..30 {
-            let mut a = jtj.clone();
-            for i in 0..a.nrows() {
-                a[(i, i)] += lambda * jtj[(i, i)].max(1e-12);
-            }
-            let Some(ch) = a.cholesky() else {
+            let Some(step) = damped_step(&jtj, &g, lambda, opts.max_step) else {
                 lambda *= nu;
                 nu *= 2.0;
                 continue;
             };
-            let mut step = ch.solve(&(-&g));
-            let long = step.amax();
-            if long > opts.max_step {
-                step *= opts.max_step / long;
-            }
             let xn: Vec<f64> = x.iter().zip(step.iter()).map(|(a, b)| a + b).collect();
             let pred = -(step.dot(&g) + 0.5 * (step.transpose() * &jtj * &step)[(0, 0)]);
             evals += 1;

@@ -240,13 +240,7 @@ fn step_loop<'a, 's: 'a, M: Backend, S: OdeSolverMethod<'a, Eqn<'s, M>>>(
     opts: &SimOptions,
     mut hooks: Hooks,
 ) -> Result<Trajectory, SimError> {
-    let mut out = Trajectory::default();
-    let mut next = 0;
-    while next < samples.len() && samples[next] <= 0.0 {
-        out.t.push(samples[next]);
-        out.x.push(x0.to_vec());
-        next += 1;
-    }
+    let (mut out, mut next) = start_samples(samples, x0);
     let (mut t_prev, mut x_prev) = (0.0, x0.to_vec());
     let mut stopped = false;
     let interp = |y: Result<M::V, DiffsolError>, t: f64| -> Result<Vec<f64>, SimError> {
@@ -265,12 +259,9 @@ fn step_loop<'a, 's: 'a, M: Backend, S: OdeSolverMethod<'a, Eqn<'s, M>>>(
             next += 1;
         }
         if let Some(k) = hooks.crossing {
-            if x_prev[k] < 0.0 && x[k] >= 0.0 {
-                let tc = refine_crossing::<M, S>(solver, k, (t_prev, x_prev[k]), (t, x[k]));
-                out.crossings.push(Crossing {
-                    t: tc,
-                    x: interp(solver.interpolate(tc), t)?,
-                });
+            let c = crossing_between::<M, S>(solver, k, (t_prev, x_prev[k]), (t, x[k]))?;
+            if let Some(c) = c {
+                out.crossings.push(c);
                 if let Some(f) = hooks.on_crossing.as_mut() {
                     if f(&out.crossings) {
                         stopped = true;
@@ -279,12 +270,7 @@ fn step_loop<'a, 's: 'a, M: Backend, S: OdeSolverMethod<'a, Eqn<'s, M>>>(
             }
         }
         if let Some(f) = hooks.on_step.as_mut() {
-            let s: &S = solver;
-            let dense = |tau: f64, y: &mut [f64]| match s.interpolate(tau) {
-                Ok(v) => y.copy_from_slice(M::slice(&v)),
-                Err(_) => y.fill(f64::NAN),
-            };
-            f(t_prev, t, &dense)?;
+            on_step::<M, S>(solver, &mut **f, t_prev, t)?;
         }
         if let Some(f) = hooks.progress.as_mut() {
             f(t);
@@ -302,16 +288,68 @@ fn step_loop<'a, 's: 'a, M: Backend, S: OdeSolverMethod<'a, Eqn<'s, M>>>(
     }
     out.t_end = t_prev;
     out.x_end = x_prev;
+    out.stats = solver_stats::<M, S>(solver);
+    Ok(out)
+}
+
+/// A trajectory holding the samples at or before the start (all `x0`); the next sample index.
+fn start_samples(samples: &[f64], x0: &[f64]) -> (Trajectory, usize) {
+    let mut out = Trajectory::default();
+    let mut next = 0;
+    while next < samples.len() && samples[next] <= 0.0 {
+        out.t.push(samples[next]);
+        out.x.push(x0.to_vec());
+        next += 1;
+    }
+    (out, next)
+}
+
+/// The solver's work counters.
+fn solver_stats<'a, 's: 'a, M: Backend, S: OdeSolverMethod<'a, Eqn<'s, M>>>(
+    solver: &S,
+) -> SolverStats {
     let st = solver.get_statistics();
-    out.stats = SolverStats {
+    SolverStats {
         steps: st.number_of_steps,
         rhs_calls: solver.problem().eqn.n_rhs.get(),
         jacobian_calls: solver.problem().eqn.n_jac.get(),
         lu_factorizations: st.number_of_linear_solver_setups,
         error_test_failures: st.number_of_error_test_failures,
         newton_failures: st.number_of_nonlinear_solver_fails,
+    }
+}
+
+/// The upward zero crossing of state `k` in the last step `(t_prev, t]` (values `g_prev`,
+/// `g`), refined on the dense output; `None` if it did not cross.
+fn crossing_between<'a, 's: 'a, M: Backend, S: OdeSolverMethod<'a, Eqn<'s, M>>>(
+    solver: &S,
+    k: usize,
+    (t_prev, g_prev): (f64, f64),
+    (t, g): (f64, f64),
+) -> Result<Option<Crossing>, SimError> {
+    if !(g_prev < 0.0 && g >= 0.0) {
+        return Ok(None);
+    }
+    let tc = refine_crossing::<M, S>(solver, k, (t_prev, g_prev), (t, g));
+    let x = solver
+        .interpolate(tc)
+        .map(|v| M::slice(&v).to_vec())
+        .map_err(|e| map_err(e, t))?;
+    Ok(Some(Crossing { t: tc, x }))
+}
+
+/// Call the step hook `f` with the dense output over the last step `[t_prev, t]`.
+fn on_step<'a, 's: 'a, M: Backend, S: OdeSolverMethod<'a, Eqn<'s, M>>>(
+    solver: &S,
+    f: &mut dyn FnMut(f64, f64, &dyn Fn(f64, &mut [f64])) -> Result<(), SimError>,
+    t_prev: f64,
+    t: f64,
+) -> Result<(), SimError> {
+    let dense = |tau: f64, y: &mut [f64]| match solver.interpolate(tau) {
+        Ok(v) => y.copy_from_slice(M::slice(&v)),
+        Err(_) => y.fill(f64::NAN),
     };
-    Ok(out)
+    f(t_prev, t, &dense)
 }
 
 /// Illinois regula falsi on the dense output for the zero of state `k` in `(a, b)`.

@@ -113,6 +113,37 @@ pub fn limit_cycle(
     limit_cycle_with(model, p, x0, t_max, samples, opts, Shooting::Auto, progress)
 }
 
+/// The settled cycle taken as is (no shooting), with its orbit of `n_orbit` samples and the
+/// scaled return-map residual of the measured period.
+fn settled_cycle(
+    model: &dyn Model,
+    p: &[f64],
+    settled: &Settled,
+    n_orbit: usize,
+    opts: &SimOptions,
+) -> Result<(LimitCycle, Trajectory), SimError> {
+    let orbit_t = uniform_samples(settled.period, n_orbit);
+    let orbit_run = simulate(model, p, &settled.x0, settled.period, &orbit_t, opts)?;
+    let s = state_scale(model, p);
+    let residual = orbit_run
+        .x_end
+        .iter()
+        .zip(&settled.x0)
+        .zip(&s)
+        .map(|((a, b), w)| ((a - b) / w).abs())
+        .fold(0.0, f64::max);
+    let cycle = LimitCycle {
+        x0: settled.x0.clone(),
+        period: settled.period,
+        monodromy: vec![],
+        floquet: vec![],
+        iterations: 0,
+        residual,
+        stats: SolverStats::default(),
+    };
+    Ok((cycle, orbit_run))
+}
+
 /// [`limit_cycle`] with a choice of shooting. Without shooting the cycle is the
 /// settled one (periods agreeing to 1e-3), `floquet` and `monodromy` are empty,
 /// and `residual` is the scaled return-map residual of the measured period.
@@ -146,26 +177,7 @@ pub fn limit_cycle_with(
         let orbit_run = simulate(model, p, &cycle.x0, cycle.period, &orbit_t, &sh.sim)?;
         (cycle, orbit_run)
     } else {
-        let orbit_t = uniform_samples(settled.period, n_orbit);
-        let orbit_run = simulate(model, p, &settled.x0, settled.period, &orbit_t, opts)?;
-        let s = state_scale(model, p);
-        let residual = orbit_run
-            .x_end
-            .iter()
-            .zip(&settled.x0)
-            .zip(&s)
-            .map(|((a, b), w)| ((a - b) / w).abs())
-            .fold(0.0, f64::max);
-        let cycle = LimitCycle {
-            x0: settled.x0.clone(),
-            period: settled.period,
-            monodromy: vec![],
-            floquet: vec![],
-            iterations: 0,
-            residual,
-            stats: SolverStats::default(),
-        };
-        (cycle, orbit_run)
+        settled_cycle(model, p, &settled, n_orbit, opts)?
     };
     let fig = figures(model, p, cycle.period, &orbit_run.x);
     let work = cycle_work(model, p, cycle.period, &orbit_run.x);

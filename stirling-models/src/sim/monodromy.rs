@@ -133,13 +133,40 @@ impl Propagator<'_> {
         Ok(())
     }
 
+    /// One Radau IIA step of `Phi` from `t0` to `t1`.
     fn radau(&mut self, t0: f64, t1: f64, dense: &dyn Fn(f64, &mut [f64])) -> Result<(), SimError> {
         let h = t1 - t0;
         if !(h > 0.0) {
             return Ok(());
         }
-        let n = self.n;
         let (c, a) = radau3();
+        self.stage_jacobians(t0, h, &c, dense)?;
+        self.lu += 1;
+        let fail = |why: String| SimError::SolverFailure {
+            t: t0,
+            why: format!("monodromy step: {why}"),
+        };
+        let stage = StageStep {
+            n: self.n,
+            h,
+            a: &a,
+            trip: &self.trip,
+        };
+        match self.sparse.as_mut() {
+            Some(sp) => stage.solve_sparse(sp, &mut self.phi),
+            None => stage.solve_dense(&mut self.phi),
+        }
+        .map_err(fail)
+    }
+
+    /// The scaled Jacobian triplets at the three stage times (state from the dense output).
+    fn stage_jacobians(
+        &mut self,
+        t0: f64,
+        h: f64,
+        c: &[f64; 3],
+        dense: &dyn Fn(f64, &mut [f64]),
+    ) -> Result<(), SimError> {
         for j in 0..3 {
             let tj = t0 + c[j] * h;
             dense(tj, &mut self.x);
@@ -156,81 +183,95 @@ impl Propagator<'_> {
             }
             self.jac_calls += 1;
         }
-        self.lu += 1;
-        let fail = |why: String| SimError::SolverFailure {
-            t: t0,
-            why: format!("monodromy step: {why}"),
-        };
-        if let Some(sp) = self.sparse.as_mut() {
-            let (sym, vals) = sp.mat.parts_mut();
-            vals.fill(0.0);
-            let mut shifted = Vec::with_capacity(self.trip[0].len());
-            for i in 0..3 {
-                for j in 0..3 {
-                    shifted.clear();
-                    shifted.extend(
-                        self.trip[j]
-                            .iter()
-                            .map(|&(r, cc, v)| (i * n + r, j * n + cc, -h * a[i][j] * v)),
-                    );
-                    scatter(sym.col_ptr(), sym.row_idx(), vals, &shifted);
-                }
+        Ok(())
+    }
+}
+
+/// The stage system of one Radau step: `(I - h A (x) J_j) K = Phi` stacked three times.
+struct StageStep<'t> {
+    n: usize,
+    h: f64,
+    a: &'t [[f64; 3]; 3],
+    trip: &'t [Vec<(usize, usize, f64)>; 3],
+}
+
+impl StageStep<'_> {
+    /// Solve with the sparse LU of `sp`; `phi` becomes the last stage.
+    fn solve_sparse(&self, sp: &mut SparseStage, phi: &mut [f64]) -> Result<(), String> {
+        let (n, h, a) = (self.n, self.h, self.a);
+        let (sym, vals) = sp.mat.parts_mut();
+        vals.fill(0.0);
+        let mut shifted = Vec::with_capacity(self.trip[0].len());
+        for i in 0..3 {
+            for j in 0..3 {
                 shifted.clear();
-                shifted.extend((0..n).map(|k| (i * n + k, i * n + k, 1.0)));
+                shifted.extend(
+                    self.trip[j]
+                        .iter()
+                        .map(|&(r, cc, v)| (i * n + r, j * n + cc, -h * a[i][j] * v)),
+                );
                 scatter(sym.col_ptr(), sym.row_idx(), vals, &shifted);
             }
-            let lu = sp
-                .symbolic
-                .factorize_numeric_lu(
-                    &mut sp.numeric,
-                    sp.mat.rb(),
-                    Par::Seq,
-                    MemStack::new(&mut sp.factor_scratch),
-                    Default::default(),
-                )
-                .map_err(|e| fail(format!("{e:?}")))?;
-            for col in 0..n {
-                for i in 0..3 {
-                    for r in 0..n {
-                        sp.rhs[(i * n + r, col)] = self.phi[r + col * n];
-                    }
-                }
-            }
-            lu.solve_in_place_with_conj(
-                Conj::No,
-                sp.rhs.as_mut(),
+            shifted.clear();
+            shifted.extend((0..n).map(|k| (i * n + k, i * n + k, 1.0)));
+            scatter(sym.col_ptr(), sym.row_idx(), vals, &shifted);
+        }
+        let lu = sp
+            .symbolic
+            .factorize_numeric_lu(
+                &mut sp.numeric,
+                sp.mat.rb(),
                 Par::Seq,
-                MemStack::new(&mut sp.solve_scratch),
-            );
-            for col in 0..n {
-                for r in 0..n {
-                    self.phi[r + col * n] = sp.rhs[(2 * n + r, col)];
-                }
-            }
-        } else {
-            let mut mat = DMatrix::<f64>::identity(3 * n, 3 * n);
+                MemStack::new(&mut sp.factor_scratch),
+                Default::default(),
+            )
+            .map_err(|e| format!("{e:?}"))?;
+        for col in 0..n {
             for i in 0..3 {
-                for j in 0..3 {
-                    for &(r, cc, v) in &self.trip[j] {
-                        mat[(i * n + r, j * n + cc)] -= h * a[i][j] * v;
-                    }
-                }
-            }
-            let mut rhs = DMatrix::<f64>::zeros(3 * n, n);
-            for col in 0..n {
-                for i in 0..3 {
-                    for r in 0..n {
-                        rhs[(i * n + r, col)] = self.phi[r + col * n];
-                    }
-                }
-            }
-            if !mat.lu().solve_mut(&mut rhs) {
-                return Err(fail("singular stage matrix".into()));
-            }
-            for col in 0..n {
                 for r in 0..n {
-                    self.phi[r + col * n] = rhs[(2 * n + r, col)];
+                    sp.rhs[(i * n + r, col)] = phi[r + col * n];
                 }
+            }
+        }
+        lu.solve_in_place_with_conj(
+            Conj::No,
+            sp.rhs.as_mut(),
+            Par::Seq,
+            MemStack::new(&mut sp.solve_scratch),
+        );
+        for col in 0..n {
+            for r in 0..n {
+                phi[r + col * n] = sp.rhs[(2 * n + r, col)];
+            }
+        }
+        Ok(())
+    }
+
+    /// Solve with a dense LU; `phi` becomes the last stage.
+    fn solve_dense(&self, phi: &mut [f64]) -> Result<(), String> {
+        let (n, h, a) = (self.n, self.h, self.a);
+        let mut mat = DMatrix::<f64>::identity(3 * n, 3 * n);
+        for i in 0..3 {
+            for j in 0..3 {
+                for &(r, cc, v) in &self.trip[j] {
+                    mat[(i * n + r, j * n + cc)] -= h * a[i][j] * v;
+                }
+            }
+        }
+        let mut rhs = DMatrix::<f64>::zeros(3 * n, n);
+        for col in 0..n {
+            for i in 0..3 {
+                for r in 0..n {
+                    rhs[(i * n + r, col)] = phi[r + col * n];
+                }
+            }
+        }
+        if !mat.lu().solve_mut(&mut rhs) {
+            return Err("singular stage matrix".into());
+        }
+        for col in 0..n {
+            for r in 0..n {
+                phi[r + col * n] = rhs[(2 * n + r, col)];
             }
         }
         Ok(())

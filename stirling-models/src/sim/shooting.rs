@@ -161,40 +161,42 @@ pub fn flow_with_monodromy_variational(
     Ok((z[..n].to_vec(), z[n..].to_vec(), tr.stats))
 }
 
-/// Refine a periodic-orbit guess `(x0, period)` by Newton on the return map.
-pub fn shoot(
-    model: &dyn Model,
-    p: &[f64],
-    x0: &[f64],
-    period: f64,
-    opts: &ShootingOptions,
-) -> Result<LimitCycle, SimError> {
-    let n = model.n_states();
-    let kinds = model.states();
-    let iy = kinds
-        .iter()
-        .position(|s| s.kind == StateKind::Position(1))
-        .ok_or_else(|| {
-            SimError::BadOption(
-                "shooting needs a second body (the power piston) for its section".into(),
-            )
-        })?;
-    let masses = crate::layout::StateLayout::of(model).masses;
-    let s = state_scale(model, p);
-    let m_total: f64 = masses.iter().map(|&i| x0[i]).sum();
-    let (mut x, mut t_per) = (x0.to_vec(), period);
-    let mut stats = SolverStats::default();
-    let mut f = vec![0.0; n];
-    for it in 1..=opts.max_iter {
-        let (phi, mono, st) =
-            flow_with_monodromy_by(model, p, &x, t_per, &opts.sim, opts.monodromy)?;
-        stats.add(&st);
-        let r: Vec<f64> = (0..n).map(|i| (phi[i] - x[i]) / s[i]).collect();
-        let res = r.iter().fold(0.0f64, |a, v| a.max(v.abs()));
-        if res < opts.tol {
-            return Ok(finish(x, t_per, mono, it, res, stats, n, &s));
-        }
-        model.rhs(p, &phi, t_per, &mut f);
+/// What closes the shooting system besides the return map: the Poincare section (the
+/// piston position `iy` at zero) and, with mass states, the conserved inventory `m_total`.
+struct Section {
+    /// State scales.
+    s: Vec<f64>,
+    iy: usize,
+    masses: Vec<usize>,
+    m_total: f64,
+}
+
+impl Section {
+    /// The section of `model` at `p`, with the inventory of the start `x0`.
+    fn of(model: &dyn Model, p: &[f64], x0: &[f64]) -> Result<Section, SimError> {
+        let masses = crate::layout::StateLayout::of(model).masses;
+        let m_total: f64 = masses.iter().map(|&i| x0[i]).sum();
+        Ok(Section {
+            s: state_scale(model, p),
+            iy: section_state(model)?,
+            masses,
+            m_total,
+        })
+    }
+
+    /// The scaled Newton system for `(dx, dT/T)` at `x`, period `t_per`: monodromy `mono`,
+    /// the field `f` at the return point, the scaled return residual `r`; the section row
+    /// and the inventory row appended.
+    fn newton_system(
+        &self,
+        mono: &[f64],
+        f: &[f64],
+        r: &[f64],
+        x: &[f64],
+        t_per: f64,
+    ) -> (DMatrix<f64>, DVector<f64>) {
+        let (s, iy, masses, m_total) = (&self.s, self.iy, &self.masses, self.m_total);
+        let n = x.len();
         let rows = n + 1 + usize::from(!masses.is_empty());
         let mut a = DMatrix::<f64>::zeros(rows, n + 1);
         let mut b = DVector::<f64>::zeros(rows);
@@ -208,11 +210,53 @@ pub fn shoot(
         a[(n, iy)] = 1.0;
         b[n] = -x[iy] / s[iy];
         if !masses.is_empty() {
-            for &j in &masses {
+            for &j in masses {
                 a[(n + 1, j)] = s[j] / m_total;
             }
             b[n + 1] = -(masses.iter().map(|&j| x[j]).sum::<f64>() - m_total) / m_total;
         }
+        (a, b)
+    }
+}
+
+/// The state whose zero is the Poincare section: the second body's (the piston's) position.
+fn section_state(model: &dyn Model) -> Result<usize, SimError> {
+    let kinds = model.states();
+    kinds
+        .iter()
+        .position(|s| s.kind == StateKind::Position(1))
+        .ok_or_else(|| {
+            SimError::BadOption(
+                "shooting needs a second body (the power piston) for its section".into(),
+            )
+        })
+}
+
+/// Refine a periodic-orbit guess `(x0, period)` by Newton on the return map.
+pub fn shoot(
+    model: &dyn Model,
+    p: &[f64],
+    x0: &[f64],
+    period: f64,
+    opts: &ShootingOptions,
+) -> Result<LimitCycle, SimError> {
+    let n = model.n_states();
+    let sec = Section::of(model, p, x0)?;
+    let s = &sec.s;
+    let (mut x, mut t_per) = (x0.to_vec(), period);
+    let mut stats = SolverStats::default();
+    let mut f = vec![0.0; n];
+    for it in 1..=opts.max_iter {
+        let (phi, mono, st) =
+            flow_with_monodromy_by(model, p, &x, t_per, &opts.sim, opts.monodromy)?;
+        stats.add(&st);
+        let r: Vec<f64> = (0..n).map(|i| (phi[i] - x[i]) / s[i]).collect();
+        let res = r.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+        if res < opts.tol {
+            return Ok(finish(x, t_per, mono, it, res, stats, n, s));
+        }
+        model.rhs(p, &phi, t_per, &mut f);
+        let (a, b) = sec.newton_system(&mono, &f, &r, &x, t_per);
         let dz = a
             .svd(true, true)
             .solve(&b, 1e-12)
