@@ -8,7 +8,8 @@
 //!
 //! with the exponent `kappa` a model parameter: `kappa = 1` is the seed's linear profile (and
 //! the model then reproduces `nsection` exactly), `kappa = 2` a profile that sags toward `Tk`
-//! (a regenerator whose cold part is over-cooled). Everything else is the default engine.
+//! (a regenerator whose cold part is over-cooled). Everything else is the family's `nsection`
+//! engine, which the model extends (docs/custom-topologies.md, "Composition").
 //!
 //! Run: `cargo run --release --example custom_profile -- --n 10 --kappa 2`
 //! (`--json` for a machine-readable summary).
@@ -23,93 +24,20 @@ use stirling::models::linear::{self, LinearOptions, Linearization};
 use stirling::stirling_model;
 
 stirling_model! {
-    /// Hot space, `n` regenerator sections with a power-law wall profile, cold space.
-    pub model ProfiledRegenerator {
+    /// Hot space, `n` regenerator sections with a power-law wall profile, cold space: the
+    /// family's `nsection` engine (`stirling::models::nsection_engine`) with its regenerator
+    /// replaced and one parameter added.
+    pub model ProfiledRegenerator extends stirling::models::nsection_engine {
         name "profiled_regenerator";
         params {
-            /// specific gas constant
-            R: 287.05 "J/(kg K)",
-            /// heat-capacity ratio
-            gamma: 1.4 "-",
-            /// cylinder and displacer area
-            A: pi / 4.0 * 0.06 * 0.06 "m^2",
-            /// displacer rod area
-            Ar: pi / 4.0 * 0.015 * 0.015 "m^2",
-            /// hot-space volume at rest
-            Vh0: 1.5e-4 "m^3",
-            /// cold-space volume at rest
-            Vc0: 1.2e-4 "m^3",
-            /// regenerator volume
-            Vr: 4.0e-5 "m^3",
-            /// heater wall temperature
-            Th: 600.0 "K",
-            /// cooler wall temperature
-            Tk: 300.0 "K",
             /// exponent of the regenerator wall profile (1: linear)
             kappa: 2.0 "-",
-            /// charge (mean) pressure
-            Pmean: 101325.0 "Pa",
-            /// bounce-space pressure
-            Pb: 101325.0 "Pa",
-            /// displacer moving mass
-            md: 0.08228 "kg",
-            /// power-piston moving mass
-            mp: 0.33363 "kg",
-            /// displacer spring rate
-            kd: 650.74 "N/m",
-            /// power-piston spring rate
-            kp: 61.482 "N/m",
-            /// displacer viscous damping
-            bd: 0.48643 "N s/m",
-            /// power-piston viscous damping (load)
-            bp: 7.9083 "N s/m",
-            /// displacer-piston coupling damping
-            b: 0.1 "N s/m",
-            /// displacer quadratic damping
-            bqd: 0.5 "N s^2/m^2",
-            /// power-piston quadratic damping
-            bqp: 5.0 "N s^2/m^2",
-            /// hot-space wall area at rest
-            Awh0: 0.0128 "m^2",
-            /// cold-space wall area at rest
-            Awc0: 0.0112 "m^2",
-            /// regenerator wall area
-            Awr: 0.0377 "m^2",
-            /// heater heat-transfer coefficient
-            hh: 500.0 "W/(m^2 K)",
-            /// cooler heat-transfer coefficient
-            hk: 500.0 "W/(m^2 K)",
-            /// regenerator heat-transfer coefficient
-            hr: 100.0 "W/(m^2 K)",
-            /// regenerator flow resistance
-            Rf: 1.0e5 "Pa s/kg",
-            /// smoothing scale of the upwind switch
-            mdot_eps: 1.0e-5 "kg/s",
-        }
-        let D = sqrt(4.0 * A / pi);
-        gas { R: R, gamma: gamma, charge: Pmean, mdot_eps: mdot_eps }
-        body displacer(x, v) { mass: md, spring: kd, damper: bd, quad_damper: bqd }
-        body piston(y, w) { mass: mp, spring: kp, damper: bp, quad_damper: bqp }
-        coupling displacer, piston { damper: b }
-        space bounce { pressure: Pb, faces { displacer: Ar, piston: A - Ar } }
-        cv hot {
-            volume: Vh0,
-            faces { displacer: -A },
-            port hot { h: hh, area: Awh0 - pi * D * x, wall: Th },
         }
         // the user's profile: section j (0 at the hot end) at its mid-point
-        cv regen[n] {
+        replace cv regen[n] {
             volume: Vr / n,
             port wall { h: hr, area: Awr / n, wall: Tk + (Th - Tk) * ((n - j - 0.5) / n).powf(kappa) },
         }
-        cv cold {
-            volume: Vc0,
-            faces { displacer: A - Ar, piston: -(A - Ar) },
-            port cold { h: hk, area: Awc0 + pi * D * (x - y), wall: Tk },
-        }
-        link hot -> regen[0] { resistance: Rf / (2.0 * n) }
-        link regen[j] -> regen[j + 1] for j in 0..n - 1 { resistance: Rf / n }
-        link regen[n - 1] -> cold { resistance: Rf / (2.0 * n) }
     }
 }
 

@@ -8,7 +8,8 @@
 //! - **linear alternator** on the power piston: an extra force `-c_alt w`; its power
 //!   `c_alt w^2` is the electric output. The piston's own damping `bp` is friction only.
 //!
-//! The working gas is the `nsection` layout (hot space, `n` regenerator sections, cold space).
+//! The working gas is the `nsection` layout (hot space, `n` regenerator sections, cold space):
+//! the model extends the family's `nsection_engine` (docs/custom-topologies.md, "Composition").
 //!
 //! Run: `cargo run --release --example custom_topology -- --n 4 --out target/custom_topology`
 //! (`--json` prints a machine-readable summary; `--t-max` bounds the settling run).
@@ -27,105 +28,38 @@ use stirling::models::sim::{self, LimitCycleReport, SimOptions, SimSummary};
 use stirling::stirling_model;
 
 stirling_model! {
-    /// Default engine with a closed, heat-exchanging bounce space and a linear alternator.
-    pub model AlternatorEngine {
+    /// Default engine with a closed, heat-exchanging bounce space and a linear alternator:
+    /// the family's `nsection` engine (`stirling::models::nsection_engine`) extended.
+    pub model AlternatorEngine extends stirling::models::nsection_engine {
         name "alternator_engine";
         params {
-            /// specific gas constant
-            R: 287.05 "J/(kg K)",
-            /// heat-capacity ratio
-            gamma: 1.4 "-",
-            /// cylinder and displacer area
-            A: pi / 4.0 * 0.06 * 0.06 "m^2",
-            /// displacer rod area
-            Ar: pi / 4.0 * 0.015 * 0.015 "m^2",
-            /// hot-space volume at rest
-            Vh0: 1.5e-4 "m^3",
-            /// cold-space volume at rest
-            Vc0: 1.2e-4 "m^3",
-            /// regenerator volume
-            Vr: 4.0e-5 "m^3",
             /// bounce-space volume at rest (closed crankcase)
             Vb0: 2.0e-3 "m^3",
-            /// heater wall temperature
-            Th: 600.0 "K",
-            /// cooler wall temperature
-            Tk: 300.0 "K",
             /// bounce-space wall temperature
             Tb: 300.0 "K",
-            /// charge pressure (working and bounce gas at rest)
-            Pmean: 101325.0 "Pa",
-            /// displacer moving mass
-            md: 0.08228 "kg",
-            /// power-piston moving mass (with the alternator's mover)
-            mp: 0.33363 "kg",
-            /// displacer spring rate
-            kd: 650.74 "N/m",
-            /// power-piston spring rate
-            kp: 61.482 "N/m",
-            /// displacer viscous damping
-            bd: 0.48643 "N s/m",
-            /// power-piston friction
-            bp: 1.9083 "N s/m",
             /// alternator load: force -c_alt w on the piston, electric power c_alt w^2
             c_alt: 6.0 "N s/m",
-            /// displacer-piston coupling damping
-            b: 0.1 "N s/m",
-            /// displacer quadratic damping
-            bqd: 0.5 "N s^2/m^2",
-            /// power-piston quadratic damping
-            bqp: 5.0 "N s^2/m^2",
-            /// hot-space wall area at rest
-            Awh0: 0.0128 "m^2",
-            /// cold-space wall area at rest
-            Awc0: 0.0112 "m^2",
-            /// regenerator wall area
-            Awr: 0.0377 "m^2",
             /// bounce-space wall area
             Awb: 0.06 "m^2",
-            /// heater heat-transfer coefficient
-            hh: 500.0 "W/(m^2 K)",
-            /// cooler heat-transfer coefficient
-            hk: 500.0 "W/(m^2 K)",
-            /// regenerator heat-transfer coefficient
-            hr: 100.0 "W/(m^2 K)",
             /// bounce-space heat-transfer coefficient
             hb: 20.0 "W/(m^2 K)",
-            /// regenerator flow resistance
-            Rf: 1.0e5 "Pa s/kg",
-            /// smoothing scale of the upwind switch
-            mdot_eps: 1.0e-5 "kg/s",
         }
-        // cylinder diameter
-        let D = sqrt(4.0 * A / pi);
-        gas { R: R, gamma: gamma, charge: Pmean, mdot_eps: mdot_eps }
-        body displacer(x, v) { mass: md, spring: kd, damper: bd, quad_damper: bqd }
-        body piston(y, w) { mass: mp, spring: kp, damper: bp, quad_damper: bqp, force: -c_alt * w }
-        coupling displacer, piston { damper: b }
-        cv hot {
-            volume: Vh0,
-            faces { displacer: -A },
-            port hot { h: hh, area: Awh0 - pi * D * x, wall: Th },
+        replace params {
+            /// power-piston friction (the load is the alternator's)
+            bp: 1.9083 "N s/m",
         }
-        cv regen[n] {
-            volume: Vr / n,
-            port wall { h: hr, area: Awr / n, wall: Th - (j + 0.5) * (Th - Tk) / n },
-        }
-        cv cold {
-            volume: Vc0,
-            faces { displacer: A - Ar, piston: -(A - Ar) },
-            port cold { h: hk, area: Awc0 + pi * D * (x - y), wall: Tk },
-        }
+        modify body piston { force: -c_alt * w }
         // the closed bounce space: same faces as the seed's fixed-pressure space, but a gas
-        // volume of its own (no mass-flow link, so its mass is a constant)
+        // volume of its own (no mass-flow link, so its mass is a constant). Removed and added
+        // rather than replaced, so that it comes last among the CVs (`replace cv bounce {..}`
+        // would keep the space's place, first).
+        remove space bounce;
+        remove param Pb;
         cv bounce {
             volume: Vb0,
             faces { displacer: Ar, piston: A - Ar },
             port wall { h: hb, area: Awb, wall: Tb },
         }
-        link hot -> regen[0] { resistance: Rf / (2.0 * n) }
-        link regen[j] -> regen[j + 1] for j in 0..n - 1 { resistance: Rf / n }
-        link regen[n - 1] -> cold { resistance: Rf / (2.0 * n) }
     }
 }
 

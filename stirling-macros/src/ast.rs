@@ -1,4 +1,5 @@
-//! Parsing: the token syntax of `stirling_model!` into a spanned AST.
+//! Parsing: the token syntax of `stirling_model!` into a spanned AST (after `compose` has
+//! merged a declaration that `extends` a base with the base's items).
 //!
 //! ```text
 //! /// docs
@@ -211,7 +212,7 @@ impl Parse for ModelAst {
     }
 }
 
-fn item(input: ParseStream) -> syn::Result<Item> {
+pub(crate) fn item(input: ParseStream) -> syn::Result<Item> {
     if input.peek(Token![let]) {
         input.parse::<Token![let]>()?;
         let name = input.parse()?;

@@ -1,11 +1,12 @@
 //! # stirling-macros: the `stirling_model!` macro
 //!
-//! Parse ([`ast`](self)) -> check and lower to a topology -> assemble and
-//! differentiate with `stirling_dsl` -> emit. The generated code refers to
+//! Compose (bases and `extends`, merged token by token) -> parse ([`ast`](self)) -> check
+//! and lower to a topology -> assemble and differentiate with `stirling_dsl` -> emit. The generated code refers to
 //! `::stirling_dsl`, so a crate using the macro depends on `stirling-dsl` too.
 
 mod ast;
 mod check;
+mod compose;
 mod expand;
 mod expr;
 mod links;
@@ -32,10 +33,15 @@ use proc_macro::TokenStream;
 ///     }
 /// }
 /// ```
+///
+/// Composition (`compose`, docs/custom-topologies.md section 10): `pub base name { items }`
+/// declares no model but a macro `name!` holding its items; `pub model X extends path { .. }`
+/// is that base plus changes: added items, `replace <item>`, `remove <kind> <name>;`,
+/// `modify <kind> <name> { fields }`, merged before the check.
 #[proc_macro]
 pub fn stirling_model(input: TokenStream) -> TokenStream {
-    let ast = syn::parse_macro_input!(input as ast::ModelAst);
-    expand::expand(ast)
+    compose::parse(input.into())
+        .and_then(compose::expand)
         .unwrap_or_else(syn::Error::into_compile_error)
         .into()
 }

@@ -146,3 +146,6 @@ pub mod sweep;
 pub use model::{effects, family, params, registry};
 pub use registry::{build, RegistryError, FAMILY};
 pub use stirling_dsl as dsl;
+/// The macro at this crate's root: the exported bases (`default_engine`, `nsection_engine`)
+/// call it back as `$crate::stirling_model!` when another crate extends them.
+pub use stirling_macros::stirling_model;

@@ -1,4 +1,5 @@
-//! Small test topologies, one feature each, on the default engine's numbers.
+//! Small test topologies, one feature each, on the default engine's numbers: the two-CV and
+//! chain models extend the family's `default_engine` (docs/physics.md section 8).
 
 use stirling::stirling_model;
 
@@ -28,59 +29,9 @@ stirling_model! {
     }
 }
 
-/// The engine frame shared by the two-CV and chain models (docs/physics.md section 8).
-macro_rules! test_engine {
-    ($(#[$meta:meta])* model $name:ident { $($body:tt)* }) => {
-        stirling_model! {
-            $(#[$meta])*
-            pub model $name {
-                params {
-                    R: 287.05 "J/(kg K)",
-                    gamma: 1.4 "-",
-                    A: pi / 4.0 * 0.06 * 0.06 "m^2",
-                    Ar: pi / 4.0 * 0.015 * 0.015 "m^2",
-                    Vh0: 1.5e-4 "m^3",
-                    Vc0: 1.2e-4 "m^3",
-                    Vr: 4.0e-5 "m^3",
-                    Th: 600.0 "K",
-                    Tk: 300.0 "K",
-                    Pmean: 101325.0 "Pa",
-                    Pb: 101325.0 "Pa",
-                    md: 0.08228 "kg",
-                    mp: 0.33363 "kg",
-                    kd: 650.74 "N/m",
-                    kp: 61.482 "N/m",
-                    bd: 0.48643 "N s/m",
-                    bp: 7.9083 "N s/m",
-                    bc: 0.1 "N s/m",
-                    bqd: 0.5 "N s^2/m^2",
-                    bqp: 5.0 "N s^2/m^2",
-                    Awh0: 0.0128 "m^2",
-                    Awc0: 0.0112 "m^2",
-                    Awr: 0.0377 "m^2",
-                    hh: 500.0 "W/(m^2 K)",
-                    hk: 500.0 "W/(m^2 K)",
-                    hr: 100.0 "W/(m^2 K)",
-                    Rf: 1.0e5 "Pa s/kg",
-                    /// quadratic (turbulent) flow coefficient, used by the `*Quad` models
-                    Rq: 1.0e7 "Pa s^2/kg^2",
-                    mdot_eps: 1.0e-5 "kg/s",
-                }
-                let D = sqrt(4.0 * A / pi);
-                gas { R: R, gamma: gamma, charge: Pmean, mdot_eps: mdot_eps }
-                body displacer(x, v) { mass: md, spring: kd, damper: bd, quad_damper: bqd }
-                body piston(y, w) { mass: mp, spring: kp, damper: bp, quad_damper: bqp }
-                coupling displacer, piston { damper: bc }
-                space bounce { pressure: Pb, faces { displacer: Ar, piston: A - Ar } }
-                $($body)*
-            }
-        }
-    };
-}
-
-test_engine! {
+stirling_model! {
     /// Two CVs joined by one linear link.
-    model TwoCv {
+    pub model TwoCv extends stirling::models::default_engine {
         cv hot {
             volume: Vh0 + Vr / 2.0,
             faces { displacer: -A },
@@ -96,9 +47,13 @@ test_engine! {
     }
 }
 
-test_engine! {
+stirling_model! {
     /// Two CVs joined by one link with the quadratic flow law `dP = Rf mdot + Rq mdot |mdot|`.
-    model TwoCvQuad {
+    pub model TwoCvQuad extends stirling::models::default_engine {
+        params {
+            /// quadratic (turbulent) flow coefficient
+            Rq: 1.0e7 "Pa s^2/kg^2",
+        }
         cv hot {
             volume: Vh0 + Vr / 2.0,
             faces { displacer: -A },
@@ -113,9 +68,9 @@ test_engine! {
     }
 }
 
-test_engine! {
-    /// Hot CV `a`, an indexed chain `r[n]`, cold CV `b`.
-    model Chain {
+stirling_model! {
+    /// Hot CV `a`, an indexed chain `r[n]`, cold CV `c` (not `b`: the engine's coupling damper is the parameter `b`).
+    pub model Chain extends stirling::models::default_engine {
         cv a {
             volume: Vh0,
             faces { displacer: -A },
@@ -125,20 +80,24 @@ test_engine! {
             volume: Vr / n,
             port wall { h: hr, area: Awr / n, wall: Th - (j + 0.5) * (Th - Tk) / n },
         }
-        cv b {
+        cv c {
             volume: Vc0,
             faces { displacer: A - Ar, piston: -(A - Ar) },
             port cold { h: hk, area: Awc0 + pi * D * (x - y), wall: Tk },
         }
         link a -> r[0] { resistance: Rf / (2.0 * n) }
         link r[j] -> r[j + 1] for j in 0..n - 1 { resistance: Rf / n }
-        link r[n - 1] -> b { resistance: Rf / (2.0 * n) }
+        link r[n - 1] -> c { resistance: Rf / (2.0 * n) }
     }
 }
 
-test_engine! {
+stirling_model! {
     /// As [`Chain`], every link with the quadratic flow law too (`Rq` per section scaled by `n`).
-    model ChainQuad {
+    pub model ChainQuad extends stirling::models::default_engine {
+        params {
+            /// quadratic (turbulent) flow coefficient
+            Rq: 1.0e7 "Pa s^2/kg^2",
+        }
         cv a {
             volume: Vh0,
             faces { displacer: -A },
@@ -148,13 +107,13 @@ test_engine! {
             volume: Vr / n,
             port wall { h: hr, area: Awr / n, wall: Th - (j + 0.5) * (Th - Tk) / n },
         }
-        cv b {
+        cv c {
             volume: Vc0,
             faces { displacer: A - Ar, piston: -(A - Ar) },
             port cold { h: hk, area: Awc0 + pi * D * (x - y), wall: Tk },
         }
         link a -> r[0] { resistance: Rf / (2.0 * n), quadratic: Rq / (2.0 * n) }
         link r[j] -> r[j + 1] for j in 0..n - 1 { resistance: Rf / n, quadratic: Rq / n }
-        link r[n - 1] -> b { resistance: Rf / (2.0 * n), quadratic: Rq / (2.0 * n) }
+        link r[n - 1] -> c { resistance: Rf / (2.0 * n), quadratic: Rq / (2.0 * n) }
     }
 }

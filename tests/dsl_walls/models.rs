@@ -4,75 +4,37 @@
 
 use stirling::stirling_model;
 
-/// The engine frame shared by the wall models; `$body` declares the gas and the walls.
-macro_rules! wall_engine {
-    ($(#[$meta:meta])* model $name:ident { $($body:tt)* }) => {
-        stirling_model! {
-            $(#[$meta])*
-            pub model $name {
-                params {
-                    R: 287.05 "J/(kg K)",
-                    gamma: 1.4 "-",
-                    A: pi / 4.0 * 0.06 * 0.06 "m^2",
-                    Ar: pi / 4.0 * 0.015 * 0.015 "m^2",
-                    Vh0: 1.5e-4 "m^3",
-                    Vc0: 1.2e-4 "m^3",
-                    Vr: 4.0e-5 "m^3",
-                    Th: 600.0 "K",
-                    Tk: 300.0 "K",
-                    Pmean: 101325.0 "Pa",
-                    Pb: 101325.0 "Pa",
-                    md: 0.08228 "kg",
-                    mp: 0.33363 "kg",
-                    kd: 650.74 "N/m",
-                    kp: 61.482 "N/m",
-                    bd: 0.48643 "N s/m",
-                    bp: 7.9083 "N s/m",
-                    bc: 0.1 "N s/m",
-                    bqd: 0.5 "N s^2/m^2",
-                    bqp: 5.0 "N s^2/m^2",
-                    Awh0: 0.0128 "m^2",
-                    Awc0: 0.0112 "m^2",
-                    Awr: 0.0377 "m^2",
-                    hh: 500.0 "W/(m^2 K)",
-                    hk: 500.0 "W/(m^2 K)",
-                    hr: 100.0 "W/(m^2 K)",
-                    Rf: 1.0e5 "Pa s/kg",
-                    mdot_eps: 1.0e-5 "kg/s",
-                    /// inverse heat capacity of the heater head (0: the fixed head)
-                    kh: 4.0e-3 "K/J",
-                    /// conductance from the head to the cold end (the loss path at rest)
-                    Gloss: 0.5 "W/K",
-                    /// heat input into the head, Gloss (Th - Tk) by default
-                    Qin: 150.0 "W",
-                    /// heat capacity of the whole regenerator matrix
-                    Cm: 25.0 "J/K",
-                    /// axial conductance of the whole matrix
-                    Gm: 0.03 "W/K",
-                }
-                let D = sqrt(4.0 * A / pi);
-                gas { R: R, gamma: gamma, charge: Pmean, mdot_eps: mdot_eps }
-                body displacer(x, v) { mass: md, spring: kd, damper: bd, quad_damper: bqd }
-                body piston(y, w) { mass: mp, spring: kp, damper: bp, quad_damper: bqp }
-                coupling displacer, piston { damper: bc }
-                space bounce { pressure: Pb, faces { displacer: Ar, piston: A - Ar } }
-                cv cold {
-                    volume: Vc0,
-                    faces { displacer: A - Ar, piston: -(A - Ar) },
-                    port cold { h: hk, area: Awc0 + pi * D * (x - y), wall: Tk },
-                }
-                link hot -> r[0] { resistance: Rf / (2.0 * n) }
-                link r[j] -> r[j + 1] for j in 0..n - 1 { resistance: Rf / n }
-                link r[n - 1] -> cold { resistance: Rf / (2.0 * n) }
-                $($body)*
-            }
+stirling_model! {
+    /// The engine frame shared by the wall models: the family's default engine, the wall
+    /// parameters, the cold CV and the regenerator links; each model declares the hot CV, the
+    /// chain `r[n]` and its walls.
+    base wall_engine extends stirling::models::default_engine {
+        params {
+            /// inverse heat capacity of the heater head (0: the fixed head)
+            kh: 4.0e-3 "K/J",
+            /// conductance from the head to the cold end (the loss path at rest)
+            Gloss: 0.5 "W/K",
+            /// heat input into the head, Gloss (Th - Tk) by default
+            Qin: 150.0 "W",
+            /// heat capacity of the whole regenerator matrix
+            Cm: 25.0 "J/K",
+            /// axial conductance of the whole matrix
+            Gm: 0.03 "W/K",
         }
-    };
+        cv cold {
+            volume: Vc0,
+            faces { displacer: A - Ar, piston: -(A - Ar) },
+            port cold { h: hk, area: Awc0 + pi * D * (x - y), wall: Tk },
+        }
+        link hot -> r[0] { resistance: Rf / (2.0 * n) }
+        link r[j] -> r[j + 1] for j in 0..n - 1 { resistance: Rf / n }
+        link r[n - 1] -> cold { resistance: Rf / (2.0 * n) }
+    }
 }
 
-wall_engine! {
+stirling_model! {
     /// Every wall fixed: the baseline (the `Chain` of the foundation tests).
-    model Fixed {
+    pub model Fixed extends wall_engine {
         cv hot {
             volume: Vh0,
             faces { displacer: -A },
@@ -85,9 +47,9 @@ wall_engine! {
     }
 }
 
-wall_engine! {
+stirling_model! {
     /// A heater head of finite heat capacity `1/kh` fed by `Qin`, losing heat to the cold end.
-    model HeadWall {
+    pub model HeadWall extends wall_engine {
         cv hot {
             volume: Vh0,
             faces { displacer: -A },
@@ -102,9 +64,9 @@ wall_engine! {
     }
 }
 
-wall_engine! {
+stirling_model! {
     /// A regenerator matrix of heat capacity `Cm` with axial conduction to the fixed ends.
-    model MatrixWall {
+    pub model MatrixWall extends wall_engine {
         cv hot {
             volume: Vh0,
             faces { displacer: -A },
@@ -121,9 +83,9 @@ wall_engine! {
     }
 }
 
-wall_engine! {
+stirling_model! {
     /// Both: the matrix conducts into the head at its hot end.
-    model HeadMatrix {
+    pub model HeadMatrix extends wall_engine {
         let Th0 = Tk + Qin / (Gloss + Gm);
         cv hot {
             volume: Vh0,

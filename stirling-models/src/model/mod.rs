@@ -6,10 +6,13 @@
 //! The crate root re-exports each module (`stirling_models::family`, ...), so either path
 //! works.
 
+/// The seed's model family (`schmidt`, `cv1`, `cv2`, `nsection`) on the default engine
+/// (declared first: it declares the bases `default_engine` and `nsection_engine` that
+/// [`effects`] extends; a base is a `macro_rules!`, visible in textual order).
+#[macro_use]
+pub mod family;
 /// Effects the nominal models leave out, as DSL-declared model augmentations.
 pub mod effects;
-/// The seed's model family (`schmidt`, `cv1`, `cv2`, `nsection`) on the default engine.
-pub mod family;
 /// Parameter files, overrides and validation.
 pub mod params;
 /// The family by name, as the command line uses it.

@@ -8,15 +8,14 @@
 //! - quadratic regenerator friction (`nsection` only): `quadratic: Rq` on the regenerator links,
 //!   split like `Rf` (`Rq/(2n)` at the ends, `Rq/n` between sections).
 
-use crate::family::engine::engine_model;
+// The effects change the frame's items with `modify` (docs/custom-topologies.md, "Composition").
 
-engine_model! {
+stirling_macros::stirling_model! {
     /// `cv1` with the DSL-expressible effects (leak, Coulomb friction, end stops) at null values.
-    model Cv1Fx with {
-        displacer { , force: -Fcd * tanh(v / v_eps) - kc * ((abs(x) - xmax) + abs(abs(x) - xmax)) / 2.0 * sign(x) }
-        piston { , force: -Fcp * tanh(w / v_eps) - kc * ((abs(y) - ymax) + abs(abs(y) - ymax)) / 2.0 * sign(y) }
-        bounce { , temperature: Tk }
-    } {
+    pub model Cv1Fx extends default_engine {
+        modify body displacer { force: -Fcd * tanh(v / v_eps) - kc * ((abs(x) - xmax) + abs(abs(x) - xmax)) / 2.0 * sign(x) }
+        modify body piston { force: -Fcp * tanh(w / v_eps) - kc * ((abs(y) - ymax) + abs(abs(y) - ymax)) / 2.0 * sign(y) }
+        modify space bounce { temperature: Tk }
         name "cv1_fx";
         params {
             /// seal-leak conductance, cold space to bounce space (0: no leak)
@@ -45,14 +44,13 @@ engine_model! {
     }
 }
 
-engine_model! {
+stirling_macros::stirling_model! {
     /// `nsection` with all DSL-expressible effects (leak, Coulomb friction, end stops,
     /// quadratic regenerator friction) at null values.
-    model NSectionFx with {
-        displacer { , force: -Fcd * tanh(v / v_eps) - kc * ((abs(x) - xmax) + abs(abs(x) - xmax)) / 2.0 * sign(x) }
-        piston { , force: -Fcp * tanh(w / v_eps) - kc * ((abs(y) - ymax) + abs(abs(y) - ymax)) / 2.0 * sign(y) }
-        bounce { , temperature: Tk }
-    } {
+    pub model NSectionFx extends nsection_engine {
+        modify body displacer { force: -Fcd * tanh(v / v_eps) - kc * ((abs(x) - xmax) + abs(abs(x) - xmax)) / 2.0 * sign(x) }
+        modify body piston { force: -Fcp * tanh(w / v_eps) - kc * ((abs(y) - ymax) + abs(abs(y) - ymax)) / 2.0 * sign(y) }
+        modify space bounce { temperature: Tk }
         name "nsection_fx";
         params {
             /// seal-leak conductance, cold space to bounce space (0: no leak)
@@ -72,23 +70,9 @@ engine_model! {
             /// quadratic (turbulent) regenerator friction, whole regenerator (0: linear only)
             Rq: 0.0 "Pa s^2/kg^2",
         }
-        cv hot {
-            volume: Vh0,
-            faces { displacer: -A },
-            port hot { h: hh, area: Awh0 - pi * D * x, wall: Th },
-        }
-        cv regen[n] {
-            volume: Vr / n,
-            port wall { h: hr, area: Awr / n, wall: Th - (j + 0.5) * (Th - Tk) / n },
-        }
-        cv cold {
-            volume: Vc0,
-            faces { displacer: A - Ar, piston: -(A - Ar) },
-            port cold { h: hk, area: Awc0 + pi * D * (x - y), wall: Tk },
-        }
-        link hot -> regen[0] { resistance: Rf / (2.0 * n), quadratic: Rq / (2.0 * n) }
-        link regen[j] -> regen[j + 1] for j in 0..n - 1 { resistance: Rf / n, quadratic: Rq / n }
-        link regen[n - 1] -> cold { resistance: Rf / (2.0 * n), quadratic: Rq / (2.0 * n) }
+        modify link hot -> regen[0] { quadratic: Rq / (2.0 * n) }
+        modify link regen[j] -> regen[j + 1] { quadratic: Rq / n }
+        modify link regen[n - 1] -> cold { quadratic: Rq / (2.0 * n) }
         link cold -> bounce { conductance: Gleak }
     }
 }

@@ -1,10 +1,8 @@
 //! `cv1`: one gas control volume with three heat ports (5th order).
 
-use super::engine::engine_model;
-
-engine_model! {
+stirling_macros::stirling_model! {
     /// One control volume for all the gas; hot, cold and regenerator heat ports.
-    model Cv1 {
+    pub model Cv1 extends default_engine {
         name "cv1";
         cv gas {
             volume: Vh0 + Vc0 + Vr,

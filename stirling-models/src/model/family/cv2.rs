@@ -1,10 +1,8 @@
 //! `cv2`: two gas control volumes joined by the regenerator resistance (6th order frozen, 8 full).
 
-use super::engine::engine_model;
-
-engine_model! {
+stirling_macros::stirling_model! {
     /// Hot space plus upper regenerator half, and cold space plus lower half, joined by `Rf`.
-    model Cv2 {
+    pub model Cv2 extends default_engine {
         name "cv2";
         cv hot {
             volume: Vh0 + Vr / 2.0,

@@ -1,11 +1,9 @@
 //! `nsection`: hot space, `n` regenerator sections, cold space (n+6 frozen, 2n+8 full).
 
-use super::engine::engine_model;
-
-engine_model! {
-    /// Hot space, `n` regenerator sections with a linear wall profile, cold space.
-    model NSection {
-        name "nsection";
+stirling_macros::stirling_model! {
+    /// The default engine with the `nsection` gas: hot space, `n` regenerator sections with a
+    /// linear wall profile, cold space (exported: `stirling::models::nsection_engine`).
+    pub base nsection_engine extends default_engine {
         cv hot {
             volume: Vh0,
             faces { displacer: -A },
@@ -23,5 +21,12 @@ engine_model! {
         link hot -> regen[0] { resistance: Rf / (2.0 * n) }
         link regen[j] -> regen[j + 1] for j in 0..n - 1 { resistance: Rf / n }
         link regen[n - 1] -> cold { resistance: Rf / (2.0 * n) }
+    }
+}
+
+stirling_macros::stirling_model! {
+    /// Hot space, `n` regenerator sections with a linear wall profile, cold space.
+    pub model NSection extends nsection_engine {
+        name "nsection";
     }
 }

@@ -2,11 +2,9 @@
 //!
 //! `P = M R / (Vh/Th + Vc/Tk + Vr/Tr)`, `Tr = (Th - Tk)/ln(Th/Tk)`, `M R = Pmean S0`.
 
-use super::engine::engine_model;
-
-engine_model! {
+stirling_macros::stirling_model! {
     /// The Schmidt model: isothermal spaces at one algebraic pressure.
-    model Schmidt {
+    pub model Schmidt extends default_engine {
         name "schmidt";
         let Tr = (Th - Tk) / ln(Th / Tk);
         let MR = Pmean * (Vh0 / Th + Vc0 / Tk + Vr / Tr);
