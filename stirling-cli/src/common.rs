@@ -3,7 +3,9 @@
 //! the range checks of numeric options ([`ranges`]); the training and held-out blocks.
 
 mod blocks;
+/// One rule for every file the command line writes (`--out FILE`, `--plot DIR`, `--report DIR`).
 pub mod files;
+/// Value parsers for the numeric options.
 pub mod ranges;
 mod stdout;
 

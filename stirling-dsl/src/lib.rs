@@ -111,9 +111,13 @@
 //!   `tanh(mdot/mdot_eps)` makes them exist everywhere).
 
 mod closure;
+/// Rust emission of a whole model.
 pub mod codegen;
+/// The symbolic core.
 pub mod expr;
+/// What generated models implement and what the analyses use.
 pub mod runtime;
+/// The topology description and its energetic assembly into equations.
 pub mod topology;
 
 pub use closure::Closure;

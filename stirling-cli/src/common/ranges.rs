@@ -6,77 +6,95 @@
 /// The largest `--samples`.
 pub const MAX_SAMPLES: usize = 1_000_000;
 
-fn number(s: &str) -> Result<f64, String> {
+/// Why a numeric option's value was refused (clap prefixes the option and the value).
+#[derive(Debug, PartialEq, thiserror::Error)]
+pub enum RangeError {
+    #[error("`{0}` is not a number")]
+    NotANumber(String),
+    #[error("`{0}` is not a finite number")]
+    NotFinite(String),
+    #[error("`{0}` is not a whole number")]
+    NotWhole(String),
+    /// The value is a number outside the option's range: what the range is.
+    #[error("{0}")]
+    Outside(&'static str),
+    #[error("must lie between 2 and {MAX_SAMPLES} (a record needs two samples; more than 1e6 is not a plot or a CSV one can use)")]
+    Samples,
+}
+
+type Parsed<T> = Result<T, RangeError>;
+
+fn number(s: &str) -> Parsed<f64> {
     let v: f64 = s
         .trim()
         .parse()
-        .map_err(|_| format!("`{s}` is not a number"))?;
+        .map_err(|_| RangeError::NotANumber(s.into()))?;
     if !v.is_finite() {
-        return Err(format!("`{s}` is not a finite number"));
+        return Err(RangeError::NotFinite(s.into()));
     }
     Ok(v)
 }
 
 /// An integer, also written as `1e5`.
-fn integer(s: &str) -> Result<f64, String> {
+fn integer(s: &str) -> Parsed<f64> {
     let v = number(s)?;
     if v.fract() != 0.0 {
-        return Err(format!("`{s}` is not a whole number"));
+        return Err(RangeError::NotWhole(s.into()));
     }
     Ok(v)
 }
 
 /// Any finite number.
-pub fn finite(s: &str) -> Result<f64, String> {
+pub fn finite(s: &str) -> Parsed<f64> {
     number(s)
 }
 
 /// A finite number > 0.
-pub fn positive(s: &str) -> Result<f64, String> {
+pub fn positive(s: &str) -> Parsed<f64> {
     let v = number(s)?;
     if v <= 0.0 {
-        return Err("must be a finite number > 0".into());
+        return Err(RangeError::Outside("must be a finite number > 0"));
     }
     Ok(v)
 }
 
 /// A solver tolerance in (0, 0.1].
-pub fn tolerance(s: &str) -> Result<f64, String> {
+pub fn tolerance(s: &str) -> Parsed<f64> {
     let v = number(s)?;
     if !(v > 0.0 && v <= 0.1) {
-        return Err("a tolerance must lie in (0, 0.1], e.g. 1e-7".into());
+        return Err(RangeError::Outside(
+            "a tolerance must lie in (0, 0.1], e.g. 1e-7",
+        ));
     }
     Ok(v)
 }
 
 /// A count >= 1 (sections, steps).
-pub fn at_least_one(s: &str) -> Result<usize, String> {
+pub fn at_least_one(s: &str) -> Parsed<usize> {
     let v = integer(s)?;
     if v < 1.0 {
-        return Err("must be at least 1".into());
+        return Err(RangeError::Outside("must be at least 1"));
     }
     if v > 1e9 {
-        return Err("is too large".into());
+        return Err(RangeError::Outside("is too large"));
     }
     Ok(v as usize)
 }
 
 /// A number of output samples in [2, MAX_SAMPLES].
-pub fn samples(s: &str) -> Result<usize, String> {
+pub fn samples(s: &str) -> Parsed<usize> {
     let v = integer(s)?;
     if !(2.0..=MAX_SAMPLES as f64).contains(&v) {
-        return Err(format!(
-            "must lie between 2 and {MAX_SAMPLES} (a record needs two samples; more than 1e6 is not a plot or a CSV one can use)"
-        ));
+        return Err(RangeError::Samples);
     }
     Ok(v as usize)
 }
 
 /// A number of cycles >= 1 (multiple-shooting segments).
-pub fn cycles(s: &str) -> Result<f64, String> {
+pub fn cycles(s: &str) -> Parsed<f64> {
     let v = number(s)?;
     if v < 1.0 {
-        return Err("must be at least 1 cycle per segment".into());
+        return Err(RangeError::Outside("must be at least 1 cycle per segment"));
     }
     Ok(v)
 }

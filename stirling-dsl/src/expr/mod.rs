@@ -3,9 +3,11 @@
 
 mod arena;
 mod diff;
+/// Rust code emission with common-subexpression elimination.
 pub mod emit;
 mod eval;
 mod node;
+/// Printers.
 pub mod print;
 mod subst;
 

@@ -3,6 +3,7 @@
 mod assemble;
 mod budget;
 mod decl;
+/// Moving array expressions between frames.
 pub mod frame;
 mod links;
 mod system;

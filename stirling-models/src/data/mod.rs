@@ -5,6 +5,7 @@
 //! the file) and the column. Sensor offsets are estimated ([`offsets`]), never assumed zero.
 
 mod csv;
+/// Sensor offsets, estimated from the data.
 pub mod offsets;
 mod sampling;
 mod text;

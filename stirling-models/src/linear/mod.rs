@@ -12,16 +12,27 @@
 //! [`locus`] repeats 1-4 over a parameter range. [`LinearReport`] is the serializable summary
 //! that `stirling linearize --json` prints.
 
+/// Diagonal balancing (Parlett-Reinsch, radix 2).
 pub mod balance;
+/// Bode and Nyquist data of `L(jw)` on a frequency grid, and the grid itself.
 pub mod bode;
+/// The equilibrium `f(x*) = 0` by Newton's method with the analytic Jacobian.
 pub mod equilibrium;
+/// The linear results as control engineers use them.
 pub mod export;
+/// Root locus over any model parameter.
 pub mod locus;
+/// Breaking the feedback loop at a pressure-force input (docs/physics.md section 7).
 pub mod loop_break;
+/// Gain and phase margins of a negative-feedback loop `L(jw)`, as MATLAB's `margin`.
 pub mod margins;
+/// Eigenvalues of a state matrix as poles.
 pub mod poles;
+/// Inventory reduction (docs/physics.md section 6).
 pub mod reduce;
+/// The frequency response `L(s) = K (sI - A)^-1 B` of a single-input single-output triple.
 pub mod response;
+/// Dense real linear solves `A x = b` by LU with partial pivoting (faer).
 pub mod solve;
 
 use nalgebra::{DMatrix, DVector};

@@ -15,13 +15,21 @@
 //! - [`monodromy`]: the monodromy by Radau IIA along the BDF trajectory.
 
 mod adapter;
+/// A linear solver for block-diagonal Newton matrices whose blocks repeat.
 pub mod block_lu;
+/// Periodic motion: settling, the cycle figures.
 pub mod cycle;
+/// The step loop.
 pub mod integrate;
+/// The monodromy matrix without the `n (n + 1)`-state variational system.
 pub mod monodromy;
+/// The nonphysical-state check run after every accepted step.
 pub mod physical;
+/// Limit cycles by single shooting.
 pub mod shooting;
+/// The ODE systems the integrator runs.
 pub mod system;
+/// Cycle work.
 pub mod work;
 
 use serde::Serialize;
