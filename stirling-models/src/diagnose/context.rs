@@ -66,6 +66,8 @@ pub struct Context<'a> {
     /// Training sample range (after the burn-in) and held-out range, inclusive-exclusive.
     pub train_idx: (usize, usize),
     pub hold_idx: (usize, usize),
+    /// Cycle starts (samples) over the training and held-out blocks.
+    pub starts: Vec<usize>,
     /// Half-width (samples) of the moving average removed from the residuals (half a cycle).
     pub half_period: usize,
     /// Bartlett bandwidth of the robust score test (samples).

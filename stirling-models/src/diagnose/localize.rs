@@ -8,7 +8,7 @@ use serde::Serialize;
 
 use super::context::{Context, Eval};
 use crate::data::Measured;
-use crate::signal::{cycle_starts, dft};
+use crate::signal::dft;
 
 /// Number of harmonics reported (0 = mean, 1 = fundamental, ...).
 pub const HARMONICS: usize = 6;
@@ -51,7 +51,7 @@ pub struct Localization {
 /// Localize the gap of the calibrated nominal model.
 pub fn localize(data: &Measured, nominal: &Eval, prof: &Context) -> Localization {
     let dt = data.dt();
-    let starts = cycle_starts(data, (prof.train_idx.0, prof.hold_idx.1));
+    let starts = &prof.starts;
     let period = if starts.len() >= 2 {
         (starts[starts.len() - 1] - starts[0]) as f64 / (starts.len() - 1) as f64 * dt
     } else {
@@ -61,7 +61,7 @@ pub fn localize(data: &Measured, nominal: &Eval, prof: &Context) -> Localization
         .channels
         .iter()
         .zip(&nominal.hp)
-        .map(|(c, r)| channel_loc(c, r, prof, &starts))
+        .map(|(c, r)| channel_loc(c, r, prof, starts))
         .collect();
     let with_cycles = if starts.len() >= 2 {
         &channels[..]

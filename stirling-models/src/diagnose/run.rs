@@ -171,6 +171,7 @@ fn context<'a>(
         noise,
         train_idx: b.train_idx,
         hold_idx: b.hold_idx,
+        starts,
         half_period: period / 2,
         lag: score::bandwidth(b.train_idx.1 - b.train_idx.0, period),
         p_nom,

@@ -3,11 +3,12 @@
 //! settles on. A point that fails is recorded with its error; it never stops the sweep.
 
 use serde::{Deserialize, Serialize};
-use stirling_dsl::{Model, StateKind};
+use stirling_dsl::Model;
 
 use super::grid::{Axis, Tie};
-use crate::linear::{self, NewtonOptions};
-use crate::params;
+use crate::layout::StateLayout;
+use crate::linear::{self, LinearError, NewtonOptions};
+use crate::params::{self, ParamError};
 use crate::sim::{self, SimOptions};
 
 /// What became of a point.
@@ -48,6 +49,15 @@ pub struct PointResult {
     pub work_j: Option<f64>,
     pub power_w: Option<f64>,
     pub error: Option<String>,
+}
+
+/// Why a point failed (recorded in its result, as text in the CSV and JSON).
+#[derive(Debug, thiserror::Error)]
+pub enum PointError {
+    #[error(transparent)]
+    Params(#[from] ParamError),
+    #[error("equilibrium or poles: {0}")]
+    Poles(#[from] LinearError),
 }
 
 /// How a point is evaluated.
@@ -97,17 +107,16 @@ impl Evaluate<'_> {
         };
         if let Err(e) = self.fill(&mut r) {
             r.outcome = Outcome::Failed;
-            r.error = Some(e);
+            r.error = Some(e.to_string());
         }
         r
     }
 
     /// Poles, then the cycle where the engine is unstable at rest.
-    fn fill(&self, r: &mut PointResult) -> Result<(), String> {
+    fn fill(&self, r: &mut PointResult) -> Result<(), PointError> {
         let p = self.params(&r.values);
-        params::validate(self.model, &p).map_err(|e| e.to_string())?;
-        let d = linear::dynamic_poles(self.model, &p, &NewtonOptions::default())
-            .map_err(|e| format!("equilibrium or poles: {e}"))?;
+        params::validate(self.model, &p)?;
+        let d = linear::dynamic_poles(self.model, &p, &NewtonOptions::default())?;
         let dominant = d.poles.iter().max_by(|a, b| a.re.total_cmp(&b.re));
         r.rhp = Some(d.poles.iter().filter(|q| q.rhp).count());
         r.growth_rate = dominant.map(|q| q.growth_rate);
@@ -147,12 +156,7 @@ impl Evaluate<'_> {
     /// The rest state with the displacer moved by 5 mm (as `stirling simulate` starts).
     fn start(&self, rest: &[f64]) -> Vec<f64> {
         let mut x = rest.to_vec();
-        if let Some(i) = self
-            .model
-            .states()
-            .iter()
-            .position(|s| s.kind == StateKind::Position(0))
-        {
+        if let Some(&i) = StateLayout::of(self.model).positions.first() {
             x[i] += 5e-3;
         }
         x
