@@ -4,12 +4,11 @@
 //! over the floor), with a percentile bootstrap interval that resamples whole cycles of the
 //! held-out block (residuals are correlated within a cycle, roughly independent across).
 
-use rand::{rngs::StdRng, Rng, SeedableRng};
 use serde::Serialize;
 
 use super::context::{Context, Eval};
 use crate::data::Measured;
-use crate::signal::cycle_starts;
+use crate::signal::{cycle_starts, percentile_interval, resamples as resamples_of};
 
 /// The closure fraction with its interval.
 #[derive(Clone, Debug, Serialize)]
@@ -42,56 +41,58 @@ pub fn closure(
     resamples: usize,
     seed: u64,
 ) -> Closure {
+    let cycles = cycle_errors(data, before, after, range, prof);
+    let (closed, err_before, err_after) = fraction(cycles.iter());
+    let boots = resamples_of(cycles.len(), resamples, seed)
+        .iter()
+        .map(|pick| fraction(pick.iter().map(|&i| &cycles[i])).0)
+        .collect();
+    let (ci_low, ci_high) = percentile_interval(boots);
+    Closure {
+        fraction: closed,
+        ci_low,
+        ci_high,
+        err_before,
+        err_after,
+        cycles: cycles.len(),
+    }
+}
+
+/// Per cycle of the held-out range: the summed errors before and after, and the sample count.
+fn cycle_errors(
+    data: &Measured,
+    before: &Eval,
+    after: &Eval,
+    range: (usize, usize),
+    prof: &Context,
+) -> Vec<(f64, f64, f64)> {
     let mut starts = cycle_starts(data, range);
     if starts.len() < 3 {
         // too few cycles: fixed blocks of a tenth of the range
         let len = ((range.1 - range.0) / 10).max(1);
         starts = (range.0..range.1).step_by(len).collect();
     }
-    let mut cycles: Vec<(f64, f64, f64)> = Vec::new();
-    for w in starts.windows(2) {
-        let (mut a, mut b) = (0.0, 0.0);
-        for i in w[0]..w[1] {
-            a += sample_err(before, prof, i);
-            b += sample_err(after, prof, i);
-        }
-        cycles.push((a, b, (w[1] - w[0]) as f64));
-    }
-    let frac = |cs: &mut dyn Iterator<Item = &(f64, f64, f64)>| {
-        let (mut a, mut b, mut n) = (0.0, 0.0, 0.0);
-        for c in cs {
-            a += c.0;
-            b += c.1;
-            n += c.2;
-        }
-        let (eb, ea) = (a / n, b / n);
-        (1.0 - (ea - 1.0) / (eb - 1.0), eb, ea)
-    };
-    let (fraction, err_before, err_after) = frac(&mut cycles.iter());
-    let mut rng = StdRng::seed_from_u64(seed);
-    let mut boots: Vec<f64> = (0..resamples)
-        .map(|_| {
-            let pick: Vec<&(f64, f64, f64)> = (0..cycles.len())
-                .map(|_| &cycles[rng.gen_range(0..cycles.len())])
-                .collect();
-            frac(&mut pick.into_iter()).0
+    starts
+        .windows(2)
+        .map(|w| {
+            let (mut a, mut b) = (0.0, 0.0);
+            for i in w[0]..w[1] {
+                a += sample_err(before, prof, i);
+                b += sample_err(after, prof, i);
+            }
+            (a, b, (w[1] - w[0]) as f64)
         })
-        .filter(|v| v.is_finite())
-        .collect();
-    boots.sort_by(f64::total_cmp);
-    let q = |p: f64| {
-        if boots.is_empty() {
-            f64::NAN
-        } else {
-            boots[((boots.len() - 1) as f64 * p).round() as usize]
-        }
-    };
-    Closure {
-        fraction,
-        ci_low: q(0.025),
-        ci_high: q(0.975),
-        err_before,
-        err_after,
-        cycles: cycles.len(),
+        .collect()
+}
+
+/// The closure fraction of a set of cycles, with the mean errors before and after.
+fn fraction<'c>(cycles: impl Iterator<Item = &'c (f64, f64, f64)>) -> (f64, f64, f64) {
+    let (mut a, mut b, mut n) = (0.0, 0.0, 0.0);
+    for c in cycles {
+        a += c.0;
+        b += c.1;
+        n += c.2;
     }
+    let (eb, ea) = (a / n, b / n);
+    (1.0 - (ea - 1.0) / (eb - 1.0), eb, ea)
 }

@@ -30,8 +30,10 @@ mod gap;
 pub mod joint;
 /// Where: residuals by channel, harmonic, phase of the cycle and subsystem.
 pub mod localize;
-/// Which: screen, fit and rank every candidate.
+/// Which: fit and rank the screened candidates.
 pub mod rank;
+/// The score screen of one candidate at the effect's null.
+pub mod screen;
 /// The Markdown report and its figures.
 pub mod report;
 mod run;

@@ -1,71 +1,29 @@
-//! Screen, fit and rank the candidates: for every effect, the score test at its null on the
-//! joint problem ([`super::joint`], [`super::score`]); then the joint Levenberg-Marquardt fit
-//! of its strengths (and shapes) with every nominal variable of the stages it touches, from
-//! the nominal optimum (and from the nominal parameters' estimates); then the held-out error
-//! of the fitted model and the held-out BIC change
+//! Fit and rank the screened candidates ([`super::screen`]): the joint Levenberg-Marquardt
+//! fit of each effect's strengths (and shapes) with every nominal variable of the stages it
+//! touches, from the nominal optimum (and from the nominal parameters' estimates); then the
+//! held-out error of the fitted model and the held-out BIC change
 //! `N_h ln(err_effect / err_nominal) + k ln N_h + dC` (negative: better than nominal), where
 //! `dC` is the change of the prior cost of the nominal parameters ([`crate::fit::prior`]):
 //! an effect that predicts the held-out block as well as the nominal model, but with the
 //! nominal parameters back near their estimates, explains the data better (-2 log posterior).
-//!
-//! Shape parameters (the end stops' travel) are inert at a zero strength, so the score test
-//! cannot see them (Davies' problem): it is taken at a grid of travels (fractions of the
-//! recorded excursion), the largest statistic kept with a Bonferroni factor, and the joint
-//! fit starts from that travel with the travel free.
 
 use nalgebra::DVector;
 
 use super::context::{Context, Eval};
 use super::joint::{EffectVar, Joint};
-use super::score::{robust_score, Score};
+use super::score::Score;
+use super::screen::Screened;
 use super::types::{EffectEstimate, RankEntry};
 use super::DiagnoseError;
 use crate::effects::{EffectInfo, EffectTarget};
 use crate::fit::lm::{self, LmOptions};
 use crate::fit::FittedStage;
 
-/// Travel grid of the end stops, as fractions of the recorded excursion.
-const TRAVEL_GRID: [f64; 4] = [0.6, 0.75, 0.9, 1.0];
-
 /// A candidate's screen and fit.
 pub struct Assessed {
     pub entry: RankEntry,
     /// The fitted model's evaluation on the record.
     pub eval: Option<Eval>,
-}
-
-/// Shape settings to screen: one empty setting, or the travel grid.
-fn shape_grid(ctx: &Context, e: &EffectInfo) -> Vec<Vec<(&'static str, f64)>> {
-    let travel: Vec<(&'static str, f64)> = [("xmax", "x"), ("ymax", "y")]
-        .into_iter()
-        .filter(|(q, _)| e.params.iter().any(|p| p.name == *q))
-        .filter_map(|(q, ch)| ctx.excursion(ch).map(|a| (q, a)))
-        .collect();
-    if travel.is_empty() {
-        return vec![vec![]];
-    }
-    TRAVEL_GRID
-        .iter()
-        .map(|f| travel.iter().map(|(q, a)| (*q, f * a)).collect())
-        .collect()
-}
-
-/// The score test of `joint` at its start.
-fn screen(ctx: &Context, joint: &Joint, u0: &[f64]) -> Result<Score, DiagnoseError> {
-    let (r, j, blocks) = joint.residuals(u0)?;
-    let strengths: Vec<&EffectVar> = joint.effect.iter().filter(|v| !v.shape).collect();
-    let test: Vec<usize> = strengths.iter().map(|v| v.index).collect();
-    let skip: Vec<usize> = joint
-        .effect
-        .iter()
-        .filter(|v| v.shape)
-        .map(|v| v.index)
-        .collect();
-    let bounded: Vec<bool> = strengths.iter().map(|v| v.bounded).collect();
-    let noise = joint.noise_draws(&ctx.input_noise);
-    Ok(robust_score(
-        &r, &j, &test, &skip, &bounded, &blocks, ctx.lag, &noise,
-    ))
 }
 
 /// Levenberg-Marquardt on the joint problem from `u0`, with the variables `fixed` held.
@@ -173,98 +131,6 @@ fn estimates(joint: &Joint, res: &lm::LmResult, fixed: &[usize]) -> Vec<EffectEs
         .collect()
 }
 
-/// A candidate after its score screen.
-pub struct Screened {
-    pub effect: &'static EffectInfo,
-    pub score: Option<Score>,
-    /// The shape setting (end-stop travels) with the largest statistic.
-    pub shapes: Vec<(&'static str, f64)>,
-    pub entry: RankEntry,
-}
-
-impl Screened {
-    /// Whether the screen found the effect significant at `level`.
-    pub fn significant(&self, level: f64) -> bool {
-        self.entry.p_value < level
-    }
-
-    /// The candidate left unfitted, with the reason.
-    pub fn unfitted(mut self, why: &str) -> Assessed {
-        if self.entry.note.is_none() {
-            self.entry.note = Some(why.into());
-        }
-        Assessed {
-            entry: self.entry,
-            eval: None,
-        }
-    }
-}
-
-fn empty_entry(e: &EffectInfo) -> RankEntry {
-    RankEntry {
-        effect: e.name.into(),
-        score: f64::NAN,
-        dof: 0,
-        p_value: f64::NAN,
-        fitted: false,
-        delta_bic: None,
-        holdout_error: None,
-        closure_fraction: None,
-        ci_low: None,
-        ci_high: None,
-        params: Vec::new(),
-        note: None,
-        seconds: 0.0,
-    }
-}
-
-/// The score screen of one candidate (over the travel grid for the end stops).
-pub fn screen_candidate(
-    ctx: &Context,
-    nominal: &[FittedStage],
-    s2: &[f64],
-    e: &'static EffectInfo,
-) -> Screened {
-    let clock = std::time::Instant::now();
-    let mut entry = empty_entry(e);
-    let grid = shape_grid(ctx, e);
-    let mut best: Option<(Score, Vec<(&'static str, f64)>)> = None;
-    for shapes in &grid {
-        let sc = Joint::new(ctx.model, nominal, s2, e, shapes, false)
-            .and_then(|joint| screen(ctx, &joint, &joint.start(nominal)));
-        match sc {
-            Ok(sc) if best.as_ref().is_none_or(|(b, _)| sc.stat > b.stat) => {
-                best = Some((sc, shapes.clone()))
-            }
-            Ok(_) => {}
-            Err(e) => entry.note = Some(e.to_string()),
-        }
-    }
-    let (score, shapes) = match best {
-        Some((sc, shapes)) => (Some(sc), shapes),
-        None => (None, Vec::new()),
-    };
-    if let Some(sc) = &score {
-        entry.score = sc.stat;
-        entry.dof = sc.dof;
-        entry.p_value = (sc.p_value * grid.len() as f64).min(1.0);
-        entry.note = (grid.len() > 1).then(|| {
-            format!(
-                "score: largest over {} end-stop travels (Bonferroni factor {})",
-                grid.len(),
-                grid.len()
-            )
-        });
-    }
-    entry.seconds = clock.elapsed().as_secs_f64();
-    Screened {
-        effect: e,
-        score,
-        shapes,
-        entry,
-    }
-}
-
 /// Fit one screened candidate jointly and evaluate it on the held-out block.
 pub fn assess(
     ctx: &Context,
@@ -329,48 +195,7 @@ fn fit_candidate(
     entry: &mut RankEntry,
 ) -> Result<Option<Eval>, DiagnoseError> {
     let joint = Joint::new(ctx.model, nominal, s2, e, shapes, !shapes.is_empty())?;
-    // starts: from the nominal optimum at the one-step estimate; a strength with a shape (end
-    // stops) is not smooth in its strength, so also at fixed strengths; and for a model effect
-    // the typical strength with the nominal parameters at their estimates (the effect's own
-    // basin when the calibration absorbed it into them: the score, a local test, cannot see
-    // that basin; sensor effects rescale the data and are not absorbed that way)
-    let mut starts: Vec<(Option<f64>, bool)> = vec![(None, false)];
-    if !shapes.is_empty() {
-        starts.extend([(Some(0.3), false), (Some(1.0), false)]);
-    }
-    if e.target == EffectTarget::Model {
-        starts.push((Some(1.0), true));
-    }
-    // the starts are independent: in parallel
-    let results: Vec<Result<(lm::LmResult, Vec<usize>), DiagnoseError>> = {
-        use rayon::prelude::*;
-        starts
-            .par_iter()
-            .map(|&(s0, reset)| {
-                let mut sc = score.clone();
-                if let Some(v) = s0 {
-                    sc.step.iter_mut().for_each(|s| *s = v);
-                }
-                ctx.fits.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-                let u0 = if reset {
-                    joint.reset_start(nominal)
-                } else {
-                    joint.start(nominal)
-                };
-                fit(&joint, &u0, &sc, opts)
-            })
-            .collect()
-    };
-    let mut best: Option<(lm::LmResult, Vec<usize>)> = None;
-    let mut last_err = DiagnoseError::JointStart;
-    for r in results {
-        match r {
-            Ok(r) if best.as_ref().is_none_or(|b| r.0.cost < b.0.cost) => best = Some(r),
-            Ok(_) => {}
-            Err(e) => last_err = e,
-        }
-    }
-    let (res, fixed) = best.ok_or(last_err)?;
+    let (res, fixed) = best_fit(ctx, &joint, nominal, e, score, shapes, opts)?;
     entry.params = estimates(&joint, &res, &fixed);
     let ev = ctx.eval_joint(&joint, &res.x, joint.effect_values(&res.x))?;
     let k = joint.effect.len() - fixed.len();
@@ -384,6 +209,57 @@ fn fit_candidate(
             + prior_change,
     );
     Ok(Some(ev))
+}
+
+/// The joint fit from every start, the lowest cost kept. Starts: from the nominal optimum at
+/// the one-step estimate; a strength with a shape (end stops) is not smooth in its strength,
+/// so also at fixed strengths; and for a model effect the typical strength with the nominal
+/// parameters at their estimates (the effect's own basin when the calibration absorbed it
+/// into them: the score, a local test, cannot see that basin; sensor effects rescale the data
+/// and are not absorbed that way). The starts are independent and run in parallel.
+fn best_fit(
+    ctx: &Context,
+    joint: &Joint,
+    nominal: &[FittedStage],
+    e: &EffectInfo,
+    score: &Score,
+    shapes: &[(&'static str, f64)],
+    opts: &LmOptions,
+) -> Result<(lm::LmResult, Vec<usize>), DiagnoseError> {
+    use rayon::prelude::*;
+    let mut starts: Vec<(Option<f64>, bool)> = vec![(None, false)];
+    if !shapes.is_empty() {
+        starts.extend([(Some(0.3), false), (Some(1.0), false)]);
+    }
+    if e.target == EffectTarget::Model {
+        starts.push((Some(1.0), true));
+    }
+    let results: Vec<Result<(lm::LmResult, Vec<usize>), DiagnoseError>> = starts
+        .par_iter()
+        .map(|&(s0, reset)| {
+            let mut sc = score.clone();
+            if let Some(v) = s0 {
+                sc.step.iter_mut().for_each(|s| *s = v);
+            }
+            ctx.fits.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+            let u0 = if reset {
+                joint.reset_start(nominal)
+            } else {
+                joint.start(nominal)
+            };
+            fit(joint, &u0, &sc, opts)
+        })
+        .collect();
+    let mut best: Option<(lm::LmResult, Vec<usize>)> = None;
+    let mut last_err = DiagnoseError::JointStart;
+    for r in results {
+        match r {
+            Ok(r) if best.as_ref().is_none_or(|b| r.0.cost < b.0.cost) => best = Some(r),
+            Ok(_) => {}
+            Err(e) => last_err = e,
+        }
+    }
+    best.ok_or(last_err)
 }
 
 /// Whether a fitted candidate moved a strength off its null (a fit that returns every

@@ -10,9 +10,11 @@ use super::context::{predict, Context, Eval, Prediction};
 use super::gap::gap_before;
 use super::types::{Diagnosis, RankEntry};
 use super::{
-    closure, joint, localize, rank, score, sim_gap, verdict, DiagnoseError, DiagnoseOptions,
+    closure, joint, localize, rank, score, screen, sim_gap, verdict, DiagnoseError,
+    DiagnoseOptions,
 };
 use crate::data::Measured;
+use crate::fit::free_run::SensorOffsets;
 use crate::effects::{EffectInfo, EffectTarget};
 use crate::fit::{self, FitOptions, FittedStage, Identification};
 use crate::signal::noise_sigma;
@@ -33,10 +35,7 @@ pub fn diagnose(
     let ctx = context(model, data, &b, &stages, p_nom.clone(), opts)?;
     let all: Vec<Prediction> = ctx.nominal_preds.iter().flatten().cloned().collect();
     let nominal = ctx.eval(&all, vec![], p_nom.clone())?;
-    let s2 = stages
-        .iter()
-        .map(joint::variance_factor)
-        .collect::<Result<Vec<f64>, _>>()?;
+    let s2 = variance_factors(&stages)?;
     let localization = localize::localize(data, &nominal, &ctx);
     report_progress(opts, || {
         format!(
@@ -46,15 +45,11 @@ pub fn diagnose(
         )
     });
     let gap_before = gap_before(&ctx, &nominal, &stages);
-    let absorbed = gap_before
-        .shifts
-        .iter()
-        .any(|s| s.prior_sd.is_some_and(|z| z.abs() > ABSORBED_SD));
     let nom = Nominal {
         stages: &stages,
         s2: &s2,
         eval: &nominal,
-        absorbed,
+        absorbed: absorbed(&gap_before),
     };
     let assessed = assess_all(&ctx, &nom, &cands, opts, clock);
     let after = assessed.first().and_then(|a| a.eval.clone());
@@ -66,23 +61,9 @@ pub fn diagnose(
         cands.len(),
         &gap_before.shifts,
     );
-    let sim = simulated_gap(
-        model,
-        data,
-        &id.offsets,
-        &b,
-        &p_nom,
-        &ranking,
-        after.as_ref(),
-        opts,
-    );
-    let (simulation_gap, simulation_gap_note) = match sim {
-        Ok(g) => (Some(g), None),
-        Err(e) => (None, Some(e.to_string())),
-    };
-    Ok(Diagnosis {
-        simulation_gap,
-        simulation_gap_note,
+    let mut diagnosis = Diagnosis {
+        simulation_gap: None,
+        simulation_gap_note: None,
         model: model.name().into(),
         n: model.n(),
         train: b.train,
@@ -95,7 +76,29 @@ pub fn diagnose(
         seconds: clock.elapsed().as_secs_f64(),
         before: Some(nominal),
         after,
-    })
+    };
+    let nominal_run = NominalRun {
+        offsets: &id.offsets,
+        blocks: &b,
+        p_nom: &p_nom,
+    };
+    attach_simulated_gap(&mut diagnosis, model, data, &nominal_run, opts);
+    Ok(diagnosis)
+}
+
+/// The stages' variance factors.
+fn variance_factors(stages: &[FittedStage]) -> Result<Vec<f64>, DiagnoseError> {
+    Ok(stages
+        .iter()
+        .map(joint::variance_factor)
+        .collect::<Result<Vec<f64>, _>>()?)
+}
+
+/// Whether a calibrated parameter moved beyond [`ABSORBED_SD`] prior deviations.
+fn absorbed(gap: &super::types::GapBefore) -> bool {
+    gap.shifts
+        .iter()
+        .any(|s| s.prior_sd.is_some_and(|z| z.abs() > ABSORBED_SD))
 }
 
 /// A progress line, when the caller asked for them.
@@ -220,11 +223,11 @@ fn assess_all(
     lm.max_step = 1.0;
     let level = opts.alpha / cands.len().max(1) as f64;
     let (stages, s2, nominal) = (nom.stages, nom.s2, nom.eval);
-    let screened: Vec<rank::Screened> = cands
+    let screened: Vec<screen::Screened> = cands
         .par_iter()
-        .map(|e| rank::screen_candidate(ctx, stages, s2, e))
+        .map(|e| screen::screen_candidate(ctx, stages, s2, e))
         .collect();
-    let fit = |s: &rank::Screened| {
+    let fit = |s: &screen::Screened| {
         opts.fit_all
             || s.significant(level)
             || (nom.absorbed && s.effect.target == EffectTarget::Model)
@@ -232,18 +235,7 @@ fn assess_all(
     report_progress(opts, || {
         let sig = screened.iter().filter(|s| s.significant(level)).count();
         let fitted = screened.iter().filter(|s| fit(s)).count();
-        let why = if opts.fit_all {
-            " (--fit-all)"
-        } else if nom.absorbed && fitted > sig {
-            " (the calibration moved a parameter beyond 2 prior sd: the model effects too)"
-        } else {
-            ""
-        };
-        format!(
-            "screened {} candidates ({:.1} s): {sig} significant at {level:.1e}; fitting {fitted}{why}",
-            screened.len(),
-            clock.elapsed().as_secs_f64(),
-        )
+        screen_line(screened.len(), (sig, fitted, level), nom.absorbed, opts, clock)
     });
     let mut assessed: Vec<rank::Assessed> = screened
         .into_par_iter()
@@ -256,6 +248,39 @@ fn assess_all(
         })
         .collect();
     rank::sort(&mut assessed, level);
+    attach_closures(ctx, nominal, &mut assessed, opts);
+    assessed
+}
+
+/// The progress line after the screen: how many candidates are significant, how many are
+/// fitted, and why more are fitted than are significant.
+fn screen_line(
+    screened: usize,
+    (sig, fitted, level): (usize, usize, f64),
+    absorbed: bool,
+    opts: &DiagnoseOptions,
+    clock: Instant,
+) -> String {
+    let why = if opts.fit_all {
+        " (--fit-all)"
+    } else if absorbed && fitted > sig {
+        " (the calibration moved a parameter beyond 2 prior sd: the model effects too)"
+    } else {
+        ""
+    };
+    format!(
+        "screened {screened} candidates ({:.1} s): {sig} significant at {level:.1e}; fitting {fitted}{why}",
+        clock.elapsed().as_secs_f64(),
+    )
+}
+
+/// The driven closure, with its interval, of every fitted candidate.
+fn attach_closures(
+    ctx: &Context,
+    nominal: &Eval,
+    assessed: &mut [rank::Assessed],
+    opts: &DiagnoseOptions,
+) {
     for a in assessed.iter_mut() {
         if let Some(ev) = &a.eval {
             let c = closure::closure(
@@ -272,33 +297,36 @@ fn assess_all(
             a.entry.ci_high = Some(c.ci_high);
         }
     }
-    assessed
+}
+
+/// What the simulated gap needs of the nominal calibration.
+struct NominalRun<'a> {
+    offsets: &'a SensorOffsets,
+    blocks: &'a Blocks,
+    p_nom: &'a [f64],
 }
 
 /// The simulated gap before and after the leading fitted candidate (the sensor effects
-/// distort the simulated outputs as they distort the data).
-#[allow(clippy::too_many_arguments)]
-fn simulated_gap(
+/// distort the simulated outputs as they distort the data); when it cannot be computed, the
+/// reason instead.
+fn attach_simulated_gap(
+    d: &mut Diagnosis,
     model: &dyn Model,
     data: &Measured,
-    offsets: &crate::fit::free_run::SensorOffsets,
-    b: &Blocks,
-    p_nom: &[f64],
-    ranking: &[RankEntry],
-    after: Option<&Eval>,
+    nominal: &NominalRun,
     opts: &DiagnoseOptions,
-) -> Result<sim_gap::SimulationGap, sim_gap::SimGapError> {
+) {
     let before = sim_gap::Simulated {
-        p: p_nom,
+        p: nominal.p_nom,
         tau_p: 0.0,
         gain: (0.0, 0.0),
     };
-    let top = ranking.first().filter(|r| r.fitted);
+    let top = d.ranking.first().filter(|r| r.fitted);
     let value = |name: &str| {
         top.and_then(|r| r.params.iter().find(|q| q.name == name))
             .map_or(0.0, |q| q.value)
     };
-    let effect = after.zip(top).map(|(ev, r)| {
+    let effect = d.after.as_ref().zip(top).map(|(ev, r)| {
         (
             r.effect.as_str(),
             sim_gap::Simulated {
@@ -308,14 +336,18 @@ fn simulated_gap(
             },
         )
     });
-    sim_gap::simulation_gap(
+    let sim = sim_gap::simulation_gap(
         model,
         data,
-        offsets,
-        b.holdout,
+        nominal.offsets,
+        nominal.blocks.holdout,
         &before,
         effect.as_ref().map(|(n, m)| (*n, m)),
         opts.bootstrap,
         opts.seed,
-    )
+    );
+    match sim {
+        Ok(g) => d.simulation_gap = Some(g),
+        Err(e) => d.simulation_gap_note = Some(e.to_string()),
+    }
 }

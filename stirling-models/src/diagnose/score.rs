@@ -139,33 +139,7 @@ pub fn robust_score(
             active.remove(drop);
             continue;
         }
-        // rows of the time series contribute `e_i r_i`; an independent row (a prior, a block
-        // of one row) has unit variance by construction, so it contributes `e_i` (its own
-        // squared residual would estimate its variance from one draw)
-        let single: Vec<bool> = {
-            let mut v = vec![false; e.nrows()];
-            blocks
-                .iter()
-                .filter(|(a, b)| *b == a + 1)
-                .for_each(|&(a, _)| v[a] = true);
-            v
-        };
-        // the residuals with the one-step fit of the tested columns removed: under the
-        // alternative the null residuals carry the effect's own periodic signature, and its
-        // square would inflate the long-run variance (and sink the power for large effects)
-        let r_alt = &rv + &e * &step;
-        let c = DMatrix::from_fn(e.nrows(), e.ncols(), |i, q| {
-            e[(i, q)] * if single[i] { 1.0 } else { r_alt[i] }
-        });
-        let mut v = long_run_cov(&c, blocks, lag);
-        if !noise.is_empty() {
-            let mut acc = DMatrix::zeros(v.nrows(), v.ncols());
-            for d in noise {
-                let gd = e.transpose() * DVector::from_column_slice(d);
-                acc += &gd * gd.transpose();
-            }
-            v += acc / noise.len() as f64;
-        }
+        let v = score_variance(&e, &rv, &step, blocks, lag, noise);
         let stat = match v.cholesky() {
             Some(ch) => g.dot(&ch.solve(&g)).max(0.0),
             None => return none(active.len()),
@@ -186,4 +160,44 @@ pub fn robust_score(
             step: full,
         };
     }
+}
+
+/// The covariance of the score `e' r`: the long-run covariance of its rows plus the draws of
+/// the input noise.
+fn score_variance(
+    e: &DMatrix<f64>,
+    rv: &DVector<f64>,
+    step: &DVector<f64>,
+    blocks: &[(usize, usize)],
+    lag: usize,
+    noise: &[Vec<f64>],
+) -> DMatrix<f64> {
+    // rows of the time series contribute `e_i r_i`; an independent row (a prior, a block
+    // of one row) has unit variance by construction, so it contributes `e_i` (its own
+    // squared residual would estimate its variance from one draw)
+    let single: Vec<bool> = {
+        let mut v = vec![false; e.nrows()];
+        blocks
+            .iter()
+            .filter(|(a, b)| *b == a + 1)
+            .for_each(|&(a, _)| v[a] = true);
+        v
+    };
+    // the residuals with the one-step fit of the tested columns removed: under the
+    // alternative the null residuals carry the effect's own periodic signature, and its
+    // square would inflate the long-run variance (and sink the power for large effects)
+    let r_alt = rv + e * step;
+    let c = DMatrix::from_fn(e.nrows(), e.ncols(), |i, q| {
+        e[(i, q)] * if single[i] { 1.0 } else { r_alt[i] }
+    });
+    let mut v = long_run_cov(&c, blocks, lag);
+    if !noise.is_empty() {
+        let mut acc = DMatrix::zeros(v.nrows(), v.ncols());
+        for d in noise {
+            let gd = e.transpose() * DVector::from_column_slice(d);
+            acc += &gd * gd.transpose();
+        }
+        v += acc / noise.len() as f64;
+    }
+    v
 }

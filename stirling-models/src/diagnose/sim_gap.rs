@@ -15,7 +15,6 @@
 //! D_before` with `D = sum_f e_f^2` over the dimensionless errors (the phase in radians, the
 //! growth rate per cycle), resampled with the same cycles for its interval.
 
-use rand::{rngs::StdRng, Rng, SeedableRng};
 use serde::Serialize;
 use stirling_dsl::Model;
 
@@ -23,7 +22,7 @@ use super::cycle_features::{Cycles, FEATURES};
 use crate::data::Measured;
 use crate::fit::free_run::{free_run, FreeRunOptions, SensorOffsets};
 use crate::fit::FitError;
-use crate::signal::first_order_lag;
+use crate::signal::{first_order_lag, percentile_interval};
 
 /// One feature's error (model minus measured) with its 95 % interval.
 #[derive(Clone, Debug, Serialize)]
@@ -211,18 +210,12 @@ fn size(m: &[f64; 7], f0: f64) -> f64 {
 }
 
 /// Percentile interval of bootstrap values around `value`.
-fn interval(value: f64, mut boot: Vec<f64>) -> FeatureError {
-    boot.retain(|v| v.is_finite());
-    boot.sort_by(f64::total_cmp);
-    let q = |p: f64| {
-        boot.get(((boot.len() as f64 - 1.0) * p).round() as usize)
-            .copied()
-            .unwrap_or(f64::NAN)
-    };
+fn interval(value: f64, boot: Vec<f64>) -> FeatureError {
+    let (ci_low, ci_high) = percentile_interval(boot);
     FeatureError {
         value,
-        ci_low: q(0.025),
-        ci_high: q(0.975),
+        ci_low,
+        ci_high,
     }
 }
 
@@ -273,12 +266,9 @@ struct Bootstrap {
 
 impl Bootstrap {
     fn new(meas: &[[f64; 7]], k: usize, resamples: usize, seed: u64) -> Self {
-        let mut rng = StdRng::seed_from_u64(seed);
         Bootstrap {
             all: (0..k).collect(),
-            draws: (0..resamples)
-                .map(|_| (0..k).map(|_| rng.gen_range(0..k)).collect())
-                .collect(),
+            draws: crate::signal::resamples(k, resamples, seed),
             f0: meas[..k].iter().map(|r| r[0]).sum::<f64>() / k as f64,
         }
     }

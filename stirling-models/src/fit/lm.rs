@@ -36,6 +36,19 @@ impl Default for LmOptions {
     }
 }
 
+impl LmOptions {
+    /// The stages' and the multiple shooting's settings: 30 iterations, a relative cost
+    /// decrease of 1e-8 and a step of 1e-7 (scaled variables) to stop.
+    pub fn stage() -> Self {
+        Self {
+            max_iter: 30,
+            ftol: 1e-8,
+            xtol: 1e-7,
+            ..Self::default()
+        }
+    }
+}
+
 /// The result.
 #[derive(Clone, Debug)]
 pub struct LmResult {

@@ -25,6 +25,9 @@ pub mod identify;
 pub mod input_noise;
 /// Levenberg-Marquardt.
 pub mod lm;
+/// The model state and channels a record gives: sensor offsets, measured channels, a state
+/// estimated from the smoothed record.
+pub mod measured_state;
 /// Stage 1: the mechanics driven by the pressures on their faces.
 pub mod mechanics;
 /// Multiple-shooting refinement over short free-running segments.
@@ -104,18 +107,8 @@ impl Default for FitOptions {
             // lasts several thermal time constants (0.03 s left hh/hk 10 % off on nsection n = 2)
             burn_in: 0.2,
             smooth: 0.006,
-            lm: lm::LmOptions {
-                max_iter: 30,
-                ftol: 1e-8,
-                xtol: 1e-7,
-                lambda0: 1e-3,
-                max_step: f64::INFINITY,
-            },
-            sim: SimOptions {
-                rtol: 1e-7,
-                atol: 1e-7,
-                ..Default::default()
-            },
+            lm: lm::LmOptions::stage(),
+            sim: SimOptions::default(),
             stage1: true,
             stage2: true,
             drift_cut: 0.5,

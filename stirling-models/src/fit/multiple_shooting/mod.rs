@@ -57,18 +57,8 @@ impl Default for MsOptions {
             span: 0.5,
             offsets: true,
             smooth: 0.006,
-            lm: lm::LmOptions {
-                max_iter: 30,
-                ftol: 1e-8,
-                xtol: 1e-7,
-                lambda0: 1e-3,
-                max_step: f64::INFINITY,
-            },
-            sim: SimOptions {
-                rtol: 1e-7,
-                atol: 1e-7,
-                ..Default::default()
-            },
+            lm: lm::LmOptions::stage(),
+            sim: SimOptions::default(),
         }
     }
 }

@@ -1,0 +1,144 @@
+//! The score screen of one candidate: the score test at the effect's null on the joint
+//! problem ([`super::joint`], [`super::score`]). Shape parameters (the end stops' travel) are
+//! inert at a zero strength, so the score test cannot see them (Davies' problem): it is
+//! taken at a grid of travels (fractions of the recorded excursion), the largest statistic
+//! kept with a Bonferroni factor, and the joint fit starts from that travel with the travel
+//! free.
+
+use super::context::Context;
+use super::joint::{EffectVar, Joint};
+use super::rank::Assessed;
+use super::score::{robust_score, Score};
+use super::types::RankEntry;
+use super::DiagnoseError;
+use crate::effects::EffectInfo;
+use crate::fit::FittedStage;
+
+/// Travel grid of the end stops, as fractions of the recorded excursion.
+const TRAVEL_GRID: [f64; 4] = [0.6, 0.75, 0.9, 1.0];
+
+/// Shape settings to screen: one empty setting, or the travel grid.
+fn shape_grid(ctx: &Context, e: &EffectInfo) -> Vec<Vec<(&'static str, f64)>> {
+    let travel: Vec<(&'static str, f64)> = [("xmax", "x"), ("ymax", "y")]
+        .into_iter()
+        .filter(|(q, _)| e.params.iter().any(|p| p.name == *q))
+        .filter_map(|(q, ch)| ctx.excursion(ch).map(|a| (q, a)))
+        .collect();
+    if travel.is_empty() {
+        return vec![vec![]];
+    }
+    TRAVEL_GRID
+        .iter()
+        .map(|f| travel.iter().map(|(q, a)| (*q, f * a)).collect())
+        .collect()
+}
+
+/// The score test of `joint` at its start.
+fn screen(ctx: &Context, joint: &Joint, u0: &[f64]) -> Result<Score, DiagnoseError> {
+    let (r, j, blocks) = joint.residuals(u0)?;
+    let strengths: Vec<&EffectVar> = joint.effect.iter().filter(|v| !v.shape).collect();
+    let test: Vec<usize> = strengths.iter().map(|v| v.index).collect();
+    let skip: Vec<usize> = joint
+        .effect
+        .iter()
+        .filter(|v| v.shape)
+        .map(|v| v.index)
+        .collect();
+    let bounded: Vec<bool> = strengths.iter().map(|v| v.bounded).collect();
+    let noise = joint.noise_draws(&ctx.input_noise);
+    Ok(robust_score(
+        &r, &j, &test, &skip, &bounded, &blocks, ctx.lag, &noise,
+    ))
+}
+
+/// A candidate after its score screen.
+pub struct Screened {
+    pub effect: &'static EffectInfo,
+    pub score: Option<Score>,
+    /// The shape setting (end-stop travels) with the largest statistic.
+    pub shapes: Vec<(&'static str, f64)>,
+    pub entry: RankEntry,
+}
+
+impl Screened {
+    /// Whether the screen found the effect significant at `level`.
+    pub fn significant(&self, level: f64) -> bool {
+        self.entry.p_value < level
+    }
+
+    /// The candidate left unfitted, with the reason.
+    pub fn unfitted(mut self, why: &str) -> Assessed {
+        if self.entry.note.is_none() {
+            self.entry.note = Some(why.into());
+        }
+        Assessed {
+            entry: self.entry,
+            eval: None,
+        }
+    }
+}
+
+fn empty_entry(e: &EffectInfo) -> RankEntry {
+    RankEntry {
+        effect: e.name.into(),
+        score: f64::NAN,
+        dof: 0,
+        p_value: f64::NAN,
+        fitted: false,
+        delta_bic: None,
+        holdout_error: None,
+        closure_fraction: None,
+        ci_low: None,
+        ci_high: None,
+        params: Vec::new(),
+        note: None,
+        seconds: 0.0,
+    }
+}
+
+/// The score screen of one candidate (over the travel grid for the end stops).
+pub fn screen_candidate(
+    ctx: &Context,
+    nominal: &[FittedStage],
+    s2: &[f64],
+    e: &'static EffectInfo,
+) -> Screened {
+    let clock = std::time::Instant::now();
+    let mut entry = empty_entry(e);
+    let grid = shape_grid(ctx, e);
+    let mut best: Option<(Score, Vec<(&'static str, f64)>)> = None;
+    for shapes in &grid {
+        let sc = Joint::new(ctx.model, nominal, s2, e, shapes, false)
+            .and_then(|joint| screen(ctx, &joint, &joint.start(nominal)));
+        match sc {
+            Ok(sc) if best.as_ref().is_none_or(|(b, _)| sc.stat > b.stat) => {
+                best = Some((sc, shapes.clone()))
+            }
+            Ok(_) => {}
+            Err(e) => entry.note = Some(e.to_string()),
+        }
+    }
+    let (score, shapes) = match best {
+        Some((sc, shapes)) => (Some(sc), shapes),
+        None => (None, Vec::new()),
+    };
+    if let Some(sc) = &score {
+        entry.score = sc.stat;
+        entry.dof = sc.dof;
+        entry.p_value = (sc.p_value * grid.len() as f64).min(1.0);
+        entry.note = (grid.len() > 1).then(|| {
+            format!(
+                "score: largest over {} end-stop travels (Bonferroni factor {})",
+                grid.len(),
+                grid.len()
+            )
+        });
+    }
+    entry.seconds = clock.elapsed().as_secs_f64();
+    Screened {
+        effect: e,
+        score,
+        shapes,
+        entry,
+    }
+}
