@@ -268,7 +268,8 @@ impl<'t> Assembler<'t> {
             let mut term = a.mul(ha, dt);
             if let Some(wall) = port.wall_ref {
                 term = a.named(&label, term);
-                to_walls.push(PortHeat { wall, q: term });
+                let summed = self.t.cvs[i].array && !self.t.walls[wall].array;
+                to_walls.push(PortHeat { wall, q: term, summed });
             }
             q = a.add(q, term);
         }
