@@ -179,17 +179,29 @@ fn shared_wall_is_an_arrow_linear_in_n() {
         m.rhs(&p, &x, 0.0, &mut f);
         let states = m.states();
         let idx = |name: &str| states.iter().position(|s| s.name == name).unwrap();
-        let names = MatrixShell::PARAMS.iter().map(|q| q.name).collect::<Vec<_>>();
+        let names = MatrixShell::PARAMS
+            .iter()
+            .map(|q| q.name)
+            .collect::<Vec<_>>();
         let par = |name: &str| p[names.iter().position(|q| *q == name).unwrap()];
         let mut temps = vec![0.0; m.n_states()];
         m.temperatures(&p, &x, &mut temps);
         let vessels = m.vessel_names();
         let ts = x[idx("Tw_shell")];
-        let (hs, aws, gms, gs, tk, ks) =
-            (par("hs"), par("Aws"), par("Gms"), par("Gs"), par("Tk"), par("ks"));
+        let (hs, aws, gms, gs, tk, ks) = (
+            par("hs"),
+            par("Aws"),
+            par("Gms"),
+            par("Gs"),
+            par("Tk"),
+            par("ks"),
+        );
         let mut q = -gs * (ts - tk);
         for j in 0..n {
-            let tg = temps[vessels.iter().position(|v| *v == format!("r[{j}]")).unwrap()];
+            let tg = temps[vessels
+                .iter()
+                .position(|v| *v == format!("r[{j}]"))
+                .unwrap()];
             let tm = x[idx(&format!("Tw_matrix[{j}]"))];
             q += hs * aws / n as f64 * (tg - ts) + gms / n as f64 * (tm - ts);
         }

@@ -187,7 +187,11 @@ impl Assembler<'_> {
                 _ => continue,
             };
             let q = self.conduction(&l, RowAt::Scalar, 0);
-            let q = if l.is_per_section() { self.reduce(q) } else { q };
+            let q = if l.is_per_section() {
+                self.reduce(q)
+            } else {
+                q
+            };
             let a = &mut self.t.arena;
             let s = a.num(sign);
             let term = a.mul(s, q);
