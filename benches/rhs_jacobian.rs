@@ -1,11 +1,34 @@
 //! RHS and analytic Jacobian of `nsection` at n = 10, 100, 1000, against a
-//! finite-difference Jacobian as the in-process baseline. Cost must grow linearly in n.
+//! finite-difference Jacobian as the in-process baseline, and of `nsection` with a
+//! regenerator matrix of finite heat capacity (`wall matrix[n]`, section `j` behind
+//! `regen[j]`, axial conduction to the heater and cooler ends): `n` more states, a
+//! tridiagonal wall block. Cost must grow linearly in n, with and without the matrix.
 //!
-//! Run: `cargo bench --bench rhs_jacobian`.
+//! Run: `cargo bench --bench rhs_jacobian` (short: `-- --warm-up-time 1 --measurement-time 3`).
 
 use criterion::{black_box, criterion_group, criterion_main, BenchmarkId, Criterion};
 use stirling::dsl::{Closure, JacSink, Model};
 use stirling::models::family::NSection;
+use stirling::stirling_model;
+
+stirling_model! {
+    /// `nsection` with a regenerator matrix of heat capacity `Cm` (a wall array) conducting
+    /// axially to the fixed heater and cooler temperatures.
+    pub model NSectionMatrix extends stirling::models::nsection_engine {
+        name "nsection_matrix";
+        params {
+            /// heat capacity of the whole regenerator matrix
+            Cm: 25.0 "J/K",
+            /// axial conductance of the whole matrix
+            Gm: 0.03 "W/K",
+        }
+        modify cv regen { port wall { h: hr, area: Awr / n, wall: matrix[j] } }
+        wall matrix[n] { capacity: Cm / n, rest: Th - (j + 0.5) * (Th - Tk) / n }
+        link matrix[j] -> matrix[j + 1] for j in 0..n - 1 { conductance: Gm * n }
+        link Th -> matrix[0] { conductance: 2.0 * Gm * n }
+        link matrix[n - 1] -> Tk { conductance: 2.0 * Gm * n }
+    }
+}
 
 fn state(m: &dyn Model, p: &[f64]) -> Vec<f64> {
     let mut x = vec![0.0; m.n_states()];
@@ -55,31 +78,52 @@ fn bench(c: &mut Criterion) {
         let m = NSection::new(n, Closure::Full).expect("n >= 1");
         let p = m.default_params();
         let x = state(&m, &p);
-        let mut out = vec![0.0; x.len()];
-        let mut trip = Vec::with_capacity(16 * x.len());
-        g.bench_with_input(BenchmarkId::new("rhs", n), &n, |b, _| {
-            b.iter(|| m.rhs(black_box(&p), black_box(&x), 0.0, &mut out))
-        });
-        g.bench_with_input(BenchmarkId::new("jacobian_analytic", n), &n, |b, _| {
-            b.iter(|| {
-                trip.clear();
-                m.jacobian(
-                    black_box(&p),
-                    black_box(&x),
-                    0.0,
-                    &mut JacSink::Triplets(&mut trip),
-                )
-            })
-        });
+        rhs_and_jacobian(&mut g, "", &m, &p, &x, n);
         if n <= 100 {
             let mut f0 = vec![0.0; x.len()];
             m.rhs(&p, &x, 0.0, &mut f0);
+            let mut trip = Vec::with_capacity(16 * x.len());
             g.bench_with_input(BenchmarkId::new("jacobian_fd", n), &n, |b, _| {
                 b.iter(|| fd_jacobian(&m, black_box(&p), black_box(&x), &f0, &mut trip))
             });
         }
+        let m = NSectionMatrix::new(n, Closure::Full).expect("n >= 1");
+        let p = m.default_params();
+        let x = state(&m, &p);
+        rhs_and_jacobian(&mut g, "_matrix", &m, &p, &x, n);
     }
     g.finish();
+}
+
+/// `rhs{tag}` and `jacobian_analytic{tag}` of `m` at `x`.
+fn rhs_and_jacobian(
+    g: &mut criterion::BenchmarkGroup<'_, criterion::measurement::WallTime>,
+    tag: &str,
+    m: &dyn Model,
+    p: &[f64],
+    x: &[f64],
+    n: usize,
+) {
+    let mut out = vec![0.0; x.len()];
+    let mut trip = Vec::with_capacity(16 * x.len());
+    g.bench_with_input(BenchmarkId::new(format!("rhs{tag}"), n), &n, |b, _| {
+        b.iter(|| m.rhs(black_box(p), black_box(x), 0.0, &mut out))
+    });
+    g.bench_with_input(
+        BenchmarkId::new(format!("jacobian_analytic{tag}"), n),
+        &n,
+        |b, _| {
+            b.iter(|| {
+                trip.clear();
+                m.jacobian(
+                    black_box(p),
+                    black_box(x),
+                    0.0,
+                    &mut JacSink::Triplets(&mut trip),
+                )
+            })
+        },
+    );
 }
 
 criterion_group!(benches, bench);

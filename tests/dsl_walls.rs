@@ -6,7 +6,7 @@ mod common;
 #[path = "dsl_walls/models.rs"]
 mod models;
 
-use models::{Fixed, HeadMatrix, HeadWall, MatrixWall, OneWall};
+use models::{Fixed, HeadMatrix, HeadWall, MatrixShell, MatrixWall, OneWall};
 use stirling::dsl::{Closure, Model, StateKind, Style};
 
 #[test]
@@ -57,6 +57,8 @@ fn all(n: usize, closure: Closure) -> Vec<Box<dyn Model>> {
     if n == 1 {
         v.push(Box::new(OneWall::new(1, closure).unwrap()));
     }
+    // per-section ports and conduction into one shared wall (the shell)
+    v.push(Box::new(MatrixShell::new(n, closure).unwrap()));
     v
 }
 
@@ -153,4 +155,72 @@ fn sparse_route_takes_the_walls() {
         .fold(0.0, f64::max);
     eprintln!("sparse vs dense after 0.05 s at n = 50: max scaled difference {gap:.2e}");
     assert!(gap < 1e-4, "{gap:e}");
+}
+
+/// Per-section ports and conduction links into one shared wall: the shell's row sums over the
+/// sections in one O(n) loop and its column is dense (an arrow), so the Jacobian's nonzeros
+/// still grow linearly with `n`; the shell's row holds the exact sums.
+#[test]
+fn shared_wall_is_an_arrow_linear_in_n() {
+    let nnz = |n: usize| {
+        let m = MatrixShell::new(n, Closure::Full).unwrap();
+        m.sparsity(&m.default_params()).len()
+    };
+    let (a, b, c) = (nnz(100), nnz(200), nnz(300));
+    eprintln!("shared wall: nonzeros {a} at n = 100, {b} at n = 200, {c} at n = 300");
+    assert!(b - a == c - b, "nonzeros linear in n: {a}, {b}, {c}");
+    // the shell's row against its hand-written sum at a random state
+    for n in [1, 3, 10] {
+        let m = MatrixShell::new(n, Closure::Full).unwrap();
+        let p = m.default_params();
+        let mut rng = common::rng(4242 + n as u64);
+        let x = common::random_state(&m, &p, common::Spread::Wide, &mut rng);
+        let mut f = vec![0.0; m.n_states()];
+        m.rhs(&p, &x, 0.0, &mut f);
+        let states = m.states();
+        let idx = |name: &str| states.iter().position(|s| s.name == name).unwrap();
+        let names = MatrixShell::PARAMS
+            .iter()
+            .map(|q| q.name)
+            .collect::<Vec<_>>();
+        let par = |name: &str| p[names.iter().position(|q| *q == name).unwrap()];
+        let mut temps = vec![0.0; m.n_states()];
+        m.temperatures(&p, &x, &mut temps);
+        let vessels = m.vessel_names();
+        let ts = x[idx("Tw_shell")];
+        let (hs, aws, gms, gs, tk, ks) = (
+            par("hs"),
+            par("Aws"),
+            par("Gms"),
+            par("Gs"),
+            par("Tk"),
+            par("ks"),
+        );
+        let mut q = -gs * (ts - tk);
+        for j in 0..n {
+            let tg = temps[vessels
+                .iter()
+                .position(|v| *v == format!("r[{j}]"))
+                .unwrap()];
+            let tm = x[idx(&format!("Tw_matrix[{j}]"))];
+            q += hs * aws / n as f64 * (tg - ts) + gms / n as f64 * (tm - ts);
+        }
+        let want = ks * q;
+        let got = f[idx("Tw_shell")];
+        assert!(
+            (got - want).abs() <= 1e-12 * want.abs().max(1e-12),
+            "n={n}: Tw_shell' {got:e} vs hand {want:e}"
+        );
+    }
+}
+
+/// The bond-graph (DOT) view draws the walls: capacitances, their heat inputs, the ports to
+/// them and the conduction links (review it like code).
+#[test]
+fn walls_dot() {
+    use stirling::dsl::to_dot;
+    let m = HeadMatrix::new(3, Closure::Full).unwrap();
+    insta::assert_snapshot!("head_matrix_dot", to_dot(m.topology()));
+    let m = MatrixShell::new(3, Closure::Full).unwrap();
+    insta::assert_snapshot!("matrix_shell_dot", to_dot(m.topology()));
 }

@@ -123,8 +123,8 @@ pub mod topology;
 pub use closure::Closure;
 pub use expr::{Arena, Id, Style, Sym};
 pub use runtime::{
-    to_dot, BodyInfo, FaceInfo, JacSink, LinkInfo, Model, ModelError, ParamInfo, PortInfo,
-    PowerTerms, StateInfo, StateKind, TopologyInfo, VesselInfo,
+    to_dot, BodyInfo, ConductionInfo, FaceInfo, JacSink, LinkInfo, Model, ModelError, ParamInfo,
+    PortInfo, PowerTerms, StateInfo, StateKind, TopologyInfo, VesselInfo, WallInfo,
 };
 pub use topology::{assemble, Topology};
 

@@ -21,10 +21,12 @@
 //!     link regen[j] -> bounce for j in 0..n { resistance: Rl * n }  // every section to one CV
 //!     wall head { capacity: Ch, rest: Th, input: Qin }      // a thermal mass: Tw_head is a state
 //!     wall matrix[n] { capacity: Cm / n, rest: Th - (j + 0.5) * (Th - Tk) / n }
-//!     // a CV port names a wall instead of a fixed temperature: `wall: head`, `wall: matrix[j]`
+//!     // a CV port names a wall instead of a fixed temperature: `wall: head`, `wall: matrix[j]`;
+//!     // a port of an array naming a single wall (`wall: shell`) is every section's port to it
 //!     link matrix[j] -> matrix[j + 1] for j in 0..n - 1 { conductance: Gm * n }  // conduction
 //!     link head -> matrix[0] { conductance: 2.0 * Gm * n }  // between walls ...
 //!     link matrix[n - 1] -> Tk { conductance: 2.0 * Gm * n } // ... or to a fixed temperature
+//!     link matrix[j] -> shell for j in 0..n { conductance: Gms / n } // every section to one wall
 //! }
 //! ```
 

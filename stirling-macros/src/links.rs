@@ -5,7 +5,7 @@ use stirling_dsl::expr::{At, Sym};
 use stirling_dsl::topology::Vessel;
 use syn::spanned::Spanned;
 
-use crate::ast::LinkAst;
+use crate::ast::{LinkAst, RangeAst};
 use crate::check::Lower;
 
 /// `index(j, n)` evaluated at a sample point.
@@ -89,11 +89,16 @@ impl Lower {
                 .error(l.span, "a chain link must join sections of one array");
             return false;
         }
+        self.chain_range_ok(range, from.0, rf.min(rt), rf.max(rt))
+    }
+
+    /// The range of a chain link whose ends sit at offsets `lo <= hi` of array `array`:
+    /// `for j in 0..n - 1` with `hi = lo + 1 = 1`, or an error at the range.
+    fn chain_range_ok(&mut self, range: &RangeAst, array: Vessel, lo: i32, hi: i32) -> bool {
         let start = self.expr(&range.start, None);
         let end = self.expr(&range.end, None);
         let s = sample(self, start, 0.0, 10.0);
         let e_off = sample(self, end, 0.0, 10.0) - 10.0;
-        let (lo, hi) = (rf.min(rt), rf.max(rt));
         if s + lo as f64 != 0.0 && s + (lo as f64) < 0.0 {
             self.cx.error(
                 range.start.span(),
@@ -105,7 +110,7 @@ impl Lower {
             return false;
         }
         if e_off + hi as f64 > 0.0 {
-            let name = self.vessel_name(from.0);
+            let name = self.vessel_name(array);
             let reach = e_off as i32 + hi - 1;
             let reach = if reach == 0 {
                 "n".to_string()

@@ -105,9 +105,8 @@ impl Lower {
                 let (w, array) = self.walls[&id.to_string()];
                 if array {
                     self.cx.error(id.span(), format!("`{id}` is an array of walls: name the section, `{id}[j]`, from a port of an array of CVs"));
-                } else if index.is_some() {
-                    self.cx.error(id.span(), format!("a port of an array of CVs names a section of an array of walls (`wall: matrix[j]`); ports of every section to one wall `{id}` are not supported yet"));
                 } else {
+                    // from an array of CVs: every section's port into the one wall `id`
                     let b = self.wall_block(w);
                     return (self.topo.arena.sym(Sym::State(b, At::Scalar)), Some(w));
                 }
@@ -227,11 +226,6 @@ impl Lower {
             HeatEnd::Wall(end) => (end.vessel, end.at),
             HeatEnd::Fixed(_) => (Vessel::Space(usize::MAX), At::Scalar),
         };
-        let rel = |e: HeatEnd| matches!(e, HeatEnd::Wall(End { at: At::Rel(_), .. }));
-        if rel(from) != rel(to) {
-            self.cx.error(l.span, "per-section conduction links (`for j in 0..n` from every section to one wall or temperature) are not supported yet");
-            return;
-        }
         if self.link_shape_ok(l, key(from), key(to)) {
             self.topo.conductions.push(ConductionDecl {
                 from,

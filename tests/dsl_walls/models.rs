@@ -133,3 +133,43 @@ stirling_model! {
         link sleeve -> Tamb { conductance: G }
     }
 }
+
+stirling_model! {
+    /// A regenerator matrix inside a shell: every gas section and every matrix section exchange
+    /// heat with the one shell wall (per-section ports and per-section conduction), the shell
+    /// cools to `Tk`, and every matrix section loses a little to `Tk` directly.
+    pub model MatrixShell extends wall_engine {
+        params {
+            /// inverse heat capacity of the regenerator shell
+            ks: 2.0e-2 "K/J",
+            /// heat-transfer coefficient from the gas to the shell
+            hs: 50.0 "W/(m^2 K)",
+            /// shell wall area of the whole regenerator
+            Aws: 0.02 "m^2",
+            /// conductance from the whole matrix to the shell
+            Gms: 0.05 "W/K",
+            /// conductance from the whole matrix straight to the cold end
+            Gma: 0.01 "W/K",
+            /// conductance from the shell to the cold end
+            Gs: 0.2 "W/K",
+        }
+        cv hot {
+            volume: Vh0,
+            faces { displacer: -A },
+            port hot { h: hh, area: Awh0 - pi * D * x, wall: Th },
+        }
+        cv r[n] {
+            volume: Vr / n,
+            port wall { h: hr, area: Awr / n, wall: matrix[j] },
+            port shell { h: hs, area: Aws / n, wall: shell },
+        }
+        wall matrix[n] { capacity: Cm / n, rest: Th - (j + 0.5) * (Th - Tk) / n }
+        wall shell { capacity: 1.0 / ks, rest: Tk }
+        link matrix[j] -> matrix[j + 1] for j in 0..n - 1 { conductance: Gm * n }
+        link Th -> matrix[0] { conductance: 2.0 * Gm * n }
+        link matrix[n - 1] -> Tk { conductance: 2.0 * Gm * n }
+        link matrix[j] -> shell for j in 0..n { conductance: Gms / n }
+        link matrix[j] -> Tk for j in 0..n { conductance: Gma / n }
+        link shell -> Tk { conductance: Gs }
+    }
+}

@@ -116,7 +116,14 @@ pub fn topology(topo: &Topology, lay: &Layout, krate: &TokenStream) -> TokenStre
         let faces = c.faces.iter().map(face);
         let ports = c.ports.iter().map(|pt| {
             let (n, w) = (&pt.name, p.expr(pt.wall));
-            quote! { #krate::PortInfo { name: #n, wall: #w } }
+            let r = match pt.wall_ref {
+                Some(k) => {
+                    let name = &topo.walls[k].name;
+                    quote!(Some(#name))
+                }
+                None => quote!(None),
+            };
+            quote! { #krate::PortInfo { name: #n, wall: #w, wall_ref: #r } }
         });
         let (name, array) = (&c.name, c.array);
         vessels.push(quote! { #krate::VesselInfo { name: #name, is_cv: true, array: #array, faces: &[#(#faces),*], ports: &[#(#ports),*] } });
@@ -143,6 +150,7 @@ pub fn topology(topo: &Topology, lay: &Layout, krate: &TokenStream) -> TokenStre
         );
         quote! { #krate::LinkInfo { from: #f, to: #t, resistance: #r, chain: #chain } }
     });
+    let (walls, conductions) = wall_infos(topo, &p, krate);
     let bodies = topo.bodies.iter().map(|b| &b.name);
     let couplings = topo.couplings.iter().map(|c| {
         let (a, b) = (body_name(c.a), body_name(c.b));
@@ -153,8 +161,35 @@ pub fn topology(topo: &Topology, lay: &Layout, krate: &TokenStream) -> TokenStre
         #krate::TopologyInfo {
             name: #name, doc: #doc, bodies: &[#(#bodies),*], couplings: &[#(#couplings),*],
             vessels: &[#(#vessels),*], links: &[#(#links),*],
+            walls: &[#(#walls),*], conductions: &[#(#conductions),*],
         }
     }
+}
+
+/// The `WallInfo`s and `ConductionInfo`s of `topo`.
+fn wall_infos(
+    topo: &Topology,
+    p: &Printer,
+    krate: &TokenStream,
+) -> (Vec<TokenStream>, Vec<TokenStream>) {
+    let walls = topo.walls.iter().map(|w| {
+        let (name, array) = (&w.name, w.array);
+        let (c, q) = (p.expr(w.capacity), p.expr(w.input));
+        quote! { #krate::WallInfo { name: #name, array: #array, capacity: #c, input: #q } }
+    });
+    let end = |e: &crate::topology::HeatEnd| match e {
+        crate::topology::HeatEnd::Wall(e) => match e.vessel {
+            Vessel::Wall(w) => (format!("{}{}", topo.walls[w].name, at_text(e.at)), false),
+            _ => unreachable!("a conduction end is a wall"),
+        },
+        crate::topology::HeatEnd::Fixed(t) => (p.expr(*t), true),
+    };
+    let conductions = topo.conductions.iter().map(|c| {
+        let ((f, ff), (t, tf)) = (end(&c.from), end(&c.to));
+        let (g, chain) = (p.expr(c.conductance), c.is_chain());
+        quote! { #krate::ConductionInfo { from: #f, to: #t, conductance: #g, chain: #chain, fixed: [#ff, #tf] } }
+    });
+    (walls.collect(), conductions.collect())
 }
 
 fn at_text(at: crate::expr::At) -> String {

@@ -47,9 +47,14 @@ pub fn rows_body(
             }
         })
         .collect();
-    let entries = entries(arena, lay, &scalar, what, false);
-    let mut scalar_code = block(arena, lay, &entries, what, private);
-    if what != Output::Value && !lay.sys.sums.is_empty() {
+    let grads = (what != Output::Value && !lay.sys.sums.is_empty()).then(|| {
+        let ids: Vec<Id> = scalar.iter().map(|&(_, id)| id).collect();
+        super::sums::gradients(arena, lay, &ids, what, private)
+    });
+    let entries = entries(arena, lay, &scalar, what, false, grads.as_ref());
+    let mut scalar_code = grads.as_ref().map(|g| g.code.clone()).unwrap_or_default();
+    scalar_code.extend(block(arena, lay, &entries, what, private));
+    if grads.is_some() {
         let rows: Vec<(TokenStream, Id)> = scalar
             .iter()
             .map(|&(b, id)| (lay.index(lay.sys.blocks[b].sym, At::Scalar), id))
@@ -105,7 +110,7 @@ fn variant_arms(
                 .zip(ids)
                 .map(|((i, _), id)| (*i, *id))
                 .collect();
-            let entries = entries(arena, lay, &rows, what, true);
+            let entries = entries(arena, lay, &rows, what, true, None);
             block(arena, lay, &entries, what, private)
         })
         .collect();
@@ -140,6 +145,7 @@ fn entries(
     rows: &[(usize, Id)],
     what: Output,
     in_loop: bool,
+    sums: Option<&super::sums::SumGradients>,
 ) -> Vec<Entry> {
     let mut out = Vec::new();
     for &(b, id) in rows {
@@ -149,7 +155,11 @@ fn entries(
             out.push(Entry { id, row, col: None });
             continue;
         }
-        for s in arena.symbols(id) {
+        let cols = match sums {
+            Some(g) => g.row_columns(arena, id),
+            None => arena.symbols(id),
+        };
+        for s in cols {
             let col = match (what, s) {
                 (Output::StateJacobian, Sym::State(cb, cat)) => lay.index(cb, cat),
                 (Output::ParamJacobian, Sym::Param(k)) => {
@@ -158,7 +168,11 @@ fn entries(
                 }
                 _ => continue,
             };
-            let d = arena.diff(id, s);
+            let mut d = arena.diff(id, s);
+            if let Some(g) = sums {
+                // the sections' part through the sums: `df/dS_k dS_k/ds`
+                d = g.total(arena, id, s, d);
+            }
             if arena.as_const(d) != Some(0.0) {
                 out.push(Entry {
                     id: d,

@@ -1,18 +1,39 @@
-//! Reductions over the sections (per-section links seen from their scalar end): the values
-//! `S_k = sum_j s_k(j)` computed once per call in one O(n) loop, and the Jacobian entries of a
-//! scalar row `f(.., S_k)` by the chain rule, `df/dS_k * ds_k(j)/dx` added for every `j`
-//! (an arrow-shaped Jacobian: the scalar row depends on every section).
+//! Reductions over the sections (per-section links and ports seen from their scalar end): the
+//! values `S_k = sum_j s_k(j)` computed once per call in one O(n) loop, and the Jacobian of a
+//! scalar row `f(.., S_k)` by the chain rule (an arrow-shaped Jacobian: the scalar row depends
+//! on every section).
+//!
+//! In every loop the `let`s that do not depend on the section (the scalar ends' volumes,
+//! temperatures, ...) are computed once, before it. The chain rule is split by column: a
+//! column of a scalar state or of a parameter gets `df/dS_k * dS_k/dx`, where `dS_k/dx =
+//! sum_j ds_k(j)/dx` is itself a sum, accumulated in one loop before the rows and added to
+//! the row's own entry of that column (one triplet per entry); a column of section `j`
+//! gets `df/dS_k * ds_k(j)/dx_j` in a loop over the sections (one triplet per section).
 
-use proc_macro2::{Ident, Literal, TokenStream};
+use proc_macro2::{Ident, TokenStream};
 use quote::{format_ident, quote};
 
 use super::layout::Layout;
 use super::rows::Output;
-use crate::expr::emit::emit_block;
-use crate::expr::{Arena, Id, Sym};
+use crate::expr::emit::emit_split;
+use crate::expr::{Arena, At, Id, Sym};
 
 fn sum_ident(k: usize) -> Ident {
     format_ident!("__sum{}", k)
+}
+
+/// Whether a symbol changes with the section `j` of a loop.
+fn varies(s: Sym) -> bool {
+    matches!(s, Sym::Index | Sym::State(_, At::Rel(_)))
+}
+
+/// Whether `s` is a column of `what` that does not change with the section.
+fn fixed_column(what: Output, s: Sym) -> bool {
+    match (what, s) {
+        (Output::StateJacobian, Sym::State(_, at)) => !matches!(at, At::Rel(_)),
+        (Output::ParamJacobian, Sym::Param(_)) => true,
+        _ => false,
+    }
 }
 
 /// `let mut __sum0 = 0.0; ..; for j in 0..n { __sum0 += s_0(j); .. }` (empty without sums).
@@ -20,22 +41,138 @@ pub fn prologue(arena: &Arena, lay: &Layout, private: &TokenStream) -> TokenStre
     if lay.sys.sums.is_empty() {
         return TokenStream::new();
     }
+    sum_loop(arena, lay, &lay.sys.sums, 0, private)
+}
+
+/// `__sum{first + i} = sum_j templates[i](j)`, the section-independent `let`s before the loop.
+fn sum_loop(
+    arena: &Arena,
+    lay: &Layout,
+    templates: &[Id],
+    first: usize,
+    private: &TokenStream,
+) -> TokenStream {
     let leaf = |s: Sym| lay.leaf(s);
-    let b = emit_block(arena, &lay.sys.sums, &leaf, private);
-    let (lets, outs) = (b.lets, b.outputs);
-    let ids: Vec<Ident> = (0..outs.len()).map(sum_ident).collect();
+    let b = emit_split(arena, templates, &leaf, private, &varies);
+    let (outer, inner, outs) = (b.outer, b.inner, b.outputs);
+    let ids: Vec<Ident> = (first..first + outs.len()).map(sum_ident).collect();
     quote! {
         #(let mut #ids: f64 = 0.0;)*
-        for j in 0..n {
-            let jf = j as f64;
-            let _ = jf;
-            #(#lets)*
-            #(#ids += #outs;)*
+        {
+            #(#outer)*
+            for j in 0..n {
+                let jf = j as f64;
+                let _ = jf;
+                #(#inner)*
+                #(#ids += #outs;)*
+            }
         }
     }
 }
 
-/// The chain-rule entries of the scalar rows `(row index, expression)` that hold sums.
+/// The derivatives of the sums along the columns that do not change with the section.
+pub struct SumGradients {
+    /// The loop that accumulates them (`__sum{K}` after the sums themselves).
+    pub code: TokenStream,
+    /// `(k, column, dS_k/dcolumn as the symbol Sum(K))`.
+    grads: Vec<(u32, Sym, Id)>,
+}
+
+impl SumGradients {
+    /// `dS_k/ds` (the symbol of its accumulator), if nonzero.
+    fn get(&self, k: u32, s: Sym) -> Option<Id> {
+        let found = self.grads.iter().find(|g| g.0 == k && g.1 == s);
+        found.map(|g| g.2)
+    }
+
+    /// The columns of `what` that the sums in `row` add to it, in order.
+    fn columns(&self, arena: &Arena, row: Id) -> Vec<Sym> {
+        let sums = sums_of(arena, row);
+        let mut out: Vec<Sym> = Vec::new();
+        for g in self.grads.iter().filter(|g| sums.contains(&g.0)) {
+            if !out.contains(&g.1) {
+                out.push(g.1);
+            }
+        }
+        out
+    }
+
+    /// `df/ds` with the sums' part: `df/ds + sum_k df/dS_k dS_k/ds`.
+    pub fn total(&self, arena: &mut Arena, row: Id, s: Sym, partial: Id) -> Id {
+        let mut d = partial;
+        for k in sums_of(arena, row) {
+            if let Some(g) = self.get(k, s) {
+                let dk = arena.diff(row, Sym::Sum(k));
+                let term = arena.mul(dk, g);
+                d = arena.add(d, term);
+            }
+        }
+        d
+    }
+
+    /// The columns of `row`: its own, then those only its sums depend on.
+    pub fn row_columns(&self, arena: &Arena, row: Id) -> Vec<Sym> {
+        let mut cols = arena.symbols(row);
+        for s in self.columns(arena, row) {
+            if !cols.contains(&s) {
+                cols.push(s);
+            }
+        }
+        cols
+    }
+}
+
+fn sums_of(arena: &Arena, row: Id) -> Vec<u32> {
+    let syms = arena.symbols(row);
+    syms.into_iter()
+        .filter_map(|s| if let Sym::Sum(k) = s { Some(k) } else { None })
+        .collect()
+}
+
+/// The sums' derivatives along the fixed columns of `what`, for the sums that `rows` use.
+pub fn gradients(
+    arena: &mut Arena,
+    lay: &Layout,
+    rows: &[Id],
+    what: Output,
+    private: &TokenStream,
+) -> SumGradients {
+    let mut used: Vec<u32> = Vec::new();
+    for &r in rows {
+        for k in sums_of(arena, r) {
+            if !used.contains(&k) {
+                used.push(k);
+            }
+        }
+    }
+    used.sort_unstable();
+    let first = lay.sys.sums.len();
+    let (mut templates, mut grads) = (Vec::new(), Vec::new());
+    for k in used {
+        let template = lay.sys.sums[k as usize];
+        for s in arena.symbols(template) {
+            if !fixed_column(what, s) {
+                continue;
+            }
+            let g = arena.diff(template, s);
+            if arena.as_const(g) == Some(0.0) {
+                continue;
+            }
+            let sym = arena.sym(Sym::Sum((first + templates.len()) as u32));
+            templates.push(g);
+            grads.push((k, s, sym));
+        }
+    }
+    let code = if templates.is_empty() {
+        TokenStream::new()
+    } else {
+        sum_loop(arena, lay, &templates, first, private)
+    };
+    SumGradients { code, grads }
+}
+
+/// The chain-rule entries of the scalar rows `(row index, expression)` in the columns of the
+/// sections: one loop per row and sum (the fixed columns are in the rows' own entries).
 pub fn jacobian(
     arena: &mut Arena,
     lay: &Layout,
@@ -44,66 +181,57 @@ pub fn jacobian(
     private: &TokenStream,
 ) -> TokenStream {
     let mut code = TokenStream::new();
+    if what != Output::StateJacobian {
+        return code;
+    }
     for (row, id) in rows {
-        for s in arena.symbols(*id) {
-            let Sym::Sum(k) = s else { continue };
-            let d = arena.diff(*id, s);
+        for k in sums_of(arena, *id) {
+            let d = arena.diff(*id, Sym::Sum(k));
             if arena.as_const(d) == Some(0.0) {
                 continue;
             }
-            code.extend(one_sum(
-                arena,
-                lay,
-                row,
-                d,
-                lay.sys.sums[k as usize],
-                what,
-                private,
-            ));
+            let template = lay.sys.sums[k as usize];
+            code.extend(one_sum(arena, lay, row, d, template, private));
         }
     }
     code
 }
 
-/// `{ let __d = df/dS; for j in 0..n { sink.add(row, col, __d * ds(j)/dcol); .. } }`.
+/// `{ let __d = df/dS; for j in 0..n { sink.add(row, col(j), __d * ds(j)/dcol); .. } }`.
 fn one_sum(
     arena: &mut Arena,
     lay: &Layout,
     row: &TokenStream,
     d: Id,
     template: Id,
-    what: Output,
     private: &TokenStream,
 ) -> TokenStream {
-    let (mut cols, mut roots) = (Vec::new(), Vec::new());
+    let (mut cols, mut roots) = (Vec::new(), vec![d]);
     for s in arena.symbols(template) {
-        let col = match (what, s) {
-            (Output::StateJacobian, Sym::State(b, at)) => lay.index(b, at),
-            (Output::ParamJacobian, Sym::Param(k)) => {
-                let k = Literal::u32_unsuffixed(k);
-                quote!(#k)
-            }
-            _ => continue,
+        let Sym::State(b, at @ At::Rel(_)) = s else {
+            continue;
         };
         let ds = arena.diff(template, s);
         if arena.as_const(ds) != Some(0.0) {
-            cols.push(col);
+            cols.push(lay.index(b, at));
             roots.push(ds);
         }
     }
+    if cols.is_empty() {
+        return TokenStream::new();
+    }
     let leaf = |s: Sym| lay.leaf(s);
-    let outer = emit_block(arena, &[d], &leaf, private);
-    let inner = emit_block(arena, &roots, &leaf, private);
-    let (olets, dout) = (outer.lets, &outer.outputs[0]);
-    let (ilets, outs) = (inner.lets, inner.outputs);
+    let b = emit_split(arena, &roots, &leaf, private, &varies);
+    let (outer, inner) = (b.outer, b.inner);
+    let (dout, outs) = (&b.outputs[0], &b.outputs[1..]);
     quote! {
         {
-            #(#olets)*
+            #(#outer)*
             let __d: f64 = #dout;
             for j in 0..n {
                 let jf = j as f64;
                 let _ = jf;
-                #(#ilets)*
+                #(#inner)*
                 #(sink.add(#row, #cols, __d * (#outs));)*
             }
         }

@@ -32,6 +32,65 @@ pub fn emit_block(
     leaf: &dyn Fn(Sym) -> TokenStream,
     private: &TokenStream,
 ) -> Block {
+    let (_, lets, outputs) = emit(arena, roots, leaf, private, None);
+    Block { lets, outputs }
+}
+
+/// A block for the body of a loop over the sections, split in two: the `let`s that do not
+/// depend on a symbol for which `varies` holds (hoisted before the loop), the `let`s that
+/// do (inside it), and the outputs.
+pub struct SplitBlock {
+    pub outer: Vec<TokenStream>,
+    pub inner: Vec<TokenStream>,
+    pub outputs: Vec<TokenStream>,
+}
+
+/// Emit `roots` as one block whose loop-invariant `let`s (no symbol for which `varies`
+/// holds among their leaves) are hoisted out of the loop.
+pub fn emit_split(
+    arena: &Arena,
+    roots: &[Id],
+    leaf: &dyn Fn(Sym) -> TokenStream,
+    private: &TokenStream,
+    varies: &dyn Fn(Sym) -> bool,
+) -> SplitBlock {
+    let (outer, inner, outputs) = emit(arena, roots, leaf, private, Some(varies));
+    SplitBlock {
+        outer,
+        inner,
+        outputs,
+    }
+}
+
+/// Per node: whether it depends on a symbol for which `varies` holds (children come before
+/// their parents in the arena).
+fn varying(arena: &Arena, varies: &dyn Fn(Sym) -> bool) -> Vec<bool> {
+    let mut out = vec![false; arena.len()];
+    for i in 0..arena.len() {
+        out[i] = match *arena.node(Id(i as u32)) {
+            Node::Const(_) => false,
+            Node::Sym(s) => varies(s),
+            ref n => n.children().iter().any(|c| out[c.index()]),
+        };
+    }
+    out
+}
+
+type Lets = Vec<TokenStream>;
+
+fn emit(
+    arena: &Arena,
+    roots: &[Id],
+    leaf: &dyn Fn(Sym) -> TokenStream,
+    private: &TokenStream,
+    varies: Option<&dyn Fn(Sym) -> bool>,
+) -> (Lets, Lets, Vec<TokenStream>) {
+    // without `varies` every `let` is an inner one, in arena order
+    let vary = match varies {
+        Some(v) => varying(arena, v),
+        None => vec![true; arena.len()],
+    };
+    let mut outer = Vec::new();
     let uses = count_uses(arena, roots);
     let mut names: Vec<Option<Ident>> = vec![None; arena.len()];
     let mut taken = std::collections::HashSet::new();
@@ -56,14 +115,19 @@ pub fn emit_block(
         }
         let base = preferred[i]
             .clone()
-            .unwrap_or_else(|| temp_name(arena, id, lets.len()));
+            .unwrap_or_else(|| temp_name(arena, id, lets.len() + outer.len()));
         let name = fresh(base, &mut taken);
         let value = em.go(inner(arena, id), &names).0;
-        lets.push(quote! { let #name = #value; });
+        let stmt = quote! { let #name = #value; };
+        if vary[i] {
+            lets.push(stmt);
+        } else {
+            outer.push(stmt);
+        }
         names[i] = Some(name);
     }
     let outputs = roots.iter().map(|&r| em.go(r, &names).0).collect();
-    Block { lets, outputs }
+    (outer, lets, outputs)
 }
 
 /// The name of the quantity a shared node is the value of, so that its `let` reads

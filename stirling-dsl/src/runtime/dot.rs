@@ -4,7 +4,10 @@
 //! space is an effort source `Se`), each face is a transformer (`TF: a`) between a
 //! vessel and a body, each heat port a thermal source (`Se: Tw`) with its conduction
 //! resistance, each mass-flow link a resistor (`R`), each coupling damper a resistor
-//! between bodies.
+//! between bodies. A wall with a temperature state is a thermal capacitance (`C: Tw`, with
+//! its heat input a flow source `Sf`), a port to it a heat-flow bond from the wall to the
+//! gas, and a conduction link a thermal resistor (`R: 1/G`) between two walls or a wall and
+//! a fixed temperature (`Se: T`).
 
 use std::fmt::Write;
 
@@ -33,6 +36,12 @@ pub fn to_dot(t: &TopologyInfo) -> String {
     }
     for l in t.links {
         link(&mut s, l);
+    }
+    for w in t.walls {
+        wall(&mut s, w);
+    }
+    for c in t.conductions {
+        conduction(&mut s, c);
     }
     s.push_str("}\n");
     s
@@ -87,6 +96,16 @@ fn vessel(s: &mut String, v: &super::topology_info::VesselInfo) {
         );
     }
     for p in v.ports {
+        if let Some(w) = p.wall_ref {
+            // a port to a declared wall: heat from the wall's capacitance into the gas
+            let each = if v.array { " (each j)" } else { "" };
+            let _ = writeln!(
+                s,
+                "  \"wall:{w}\" -> \"gas:{}\" [arrowhead=halfopen, label=\"Q: {}{each}\"];",
+                v.name, p.name
+            );
+            continue;
+        }
         let id = format!("Se:{}.{}", v.name, p.name);
         let _ = writeln!(
             s,
@@ -99,6 +118,67 @@ fn vessel(s: &mut String, v: &super::topology_info::VesselInfo) {
             v.name, p.name
         );
     }
+}
+
+/// A wall: a thermal capacitance, with its heat input as a flow source.
+fn wall(s: &mut String, w: &super::topology_info::WallInfo) {
+    let label = if w.array {
+        format!("C: {}[j], j < n (capacity {})", w.name, w.capacity)
+    } else {
+        format!("C: {} (capacity {})", w.name, w.capacity)
+    };
+    let _ = writeln!(
+        s,
+        "  \"wall:{}\" [shape=ellipse, style=dashed, label=\"{}\"];",
+        w.name,
+        esc(&label)
+    );
+    if w.input != "0" {
+        let id = format!("Sf:{}", w.name);
+        let _ = writeln!(
+            s,
+            "  \"{id}\" [shape=plaintext, label=\"Sf: {}\"];",
+            esc(w.input)
+        );
+        let _ = writeln!(
+            s,
+            "  \"{id}\" -> \"wall:{}\" [arrowhead=halfopen, label=\"Q\"];",
+            w.name
+        );
+    }
+}
+
+/// A conduction link: a thermal resistor between two walls or a wall and a fixed temperature.
+fn conduction(s: &mut String, c: &super::topology_info::ConductionInfo) {
+    let id = format!("Rth:{}->{}", c.from, c.to);
+    let each = if c.chain { " (each j)" } else { "" };
+    let label = format!("R: 1/({}){each}", c.conductance);
+    let _ = writeln!(
+        s,
+        "  \"{}\" [shape=plaintext, label=\"{}\"];",
+        esc(&id),
+        esc(&label)
+    );
+    let mut ends = [c.from, c.to].map(|e| format!("wall:{}", base(e)));
+    for (k, fixed) in c.fixed.iter().enumerate() {
+        if *fixed {
+            let t = [c.from, c.to][k];
+            ends[k] = format!("Se:T={t}");
+            let _ = writeln!(
+                s,
+                "  \"{}\" [shape=plaintext, label=\"Se: {}\"];",
+                esc(&ends[k]),
+                esc(t)
+            );
+        }
+    }
+    let _ = writeln!(
+        s,
+        "  \"{}\" -> \"{}\" -> \"{}\" [arrowhead=halfopen, label=\"Q\"];",
+        esc(&ends[0]),
+        esc(&id),
+        esc(&ends[1])
+    );
 }
 
 /// A link end without its index (`h[j]` -> `h`).

@@ -8,4 +8,6 @@ mod topology_info;
 pub use dot::to_dot;
 pub use error::ModelError;
 pub use model::{BodyInfo, JacSink, Model, ParamInfo, PowerTerms, StateInfo, StateKind};
-pub use topology_info::{FaceInfo, LinkInfo, PortInfo, TopologyInfo, VesselInfo};
+pub use topology_info::{
+    ConductionInfo, FaceInfo, LinkInfo, PortInfo, TopologyInfo, VesselInfo, WallInfo,
+};

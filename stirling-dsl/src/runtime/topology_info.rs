@@ -6,6 +6,32 @@ pub struct PortInfo {
     pub name: &'static str,
     /// The wall temperature, as declared.
     pub wall: &'static str,
+    /// The declared wall (a thermal mass) the port exchanges heat with, if any.
+    pub wall_ref: Option<&'static str>,
+}
+
+/// A wall whose temperature is a state (a thermal capacitance), or an array of `n`.
+#[derive(Clone, Copy, Debug)]
+pub struct WallInfo {
+    pub name: &'static str,
+    pub array: bool,
+    /// The heat capacity, as declared.
+    pub capacity: &'static str,
+    /// The heat input from outside, as declared (`"0"` without one).
+    pub input: &'static str,
+}
+
+/// A conduction link `Q = G (T_from - T_to)` between walls or a wall and a fixed temperature
+/// (`from`, `to` as written, e.g. `matrix[j]`, `Tk`; `fixed` marks a fixed-temperature end).
+#[derive(Clone, Copy, Debug)]
+pub struct ConductionInfo {
+    pub from: &'static str,
+    pub to: &'static str,
+    pub conductance: &'static str,
+    /// Whether it repeats along the sections (a chain or a per-section link).
+    pub chain: bool,
+    /// Whether `from` / `to` is a fixed temperature.
+    pub fixed: [bool; 2],
 }
 
 /// A face coupling a vessel to a body.
@@ -45,4 +71,8 @@ pub struct TopologyInfo {
     pub couplings: &'static [(&'static str, &'static str)],
     pub vessels: &'static [VesselInfo],
     pub links: &'static [LinkInfo],
+    /// Walls with a temperature state.
+    pub walls: &'static [WallInfo],
+    /// Conduction links between walls, or a wall and a fixed temperature.
+    pub conductions: &'static [ConductionInfo],
 }

@@ -116,6 +116,13 @@ impl ConductionDecl {
     pub fn is_chain(&self) -> bool {
         self.rel().iter().any(Option::is_some)
     }
+
+    /// Whether the link joins every section of a wall array to one wall or fixed temperature
+    /// (`link matrix[j] -> shell for j in 0..n`).
+    pub fn is_per_section(&self) -> bool {
+        let [a, b] = self.rel();
+        a.is_some() != b.is_some()
+    }
 }
 
 /// A space whose pressure is given (a fixed bounce space, or an algebraic pressure such as

@@ -1,11 +1,14 @@
 //! The topology description and its energetic assembly into equations.
 
 mod assemble;
+mod balance;
 mod budget;
+mod cv;
 mod decl;
 /// Moving array expressions between frames.
 pub mod frame;
 mod links;
+mod mechanics;
 mod system;
 mod walls;
 

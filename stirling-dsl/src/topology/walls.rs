@@ -25,6 +25,8 @@ use crate::expr::{At, Id, Node, Sym};
 pub(super) struct PortHeat {
     pub(super) wall: usize,
     pub(super) q: Id,
+    /// A port of an array of CVs to a single wall: the wall takes the sum over the sections.
+    pub(super) summed: bool,
 }
 
 impl Assembler<'_> {
@@ -67,14 +69,16 @@ impl Assembler<'_> {
     /// `Tw'` of wall `w` at `row`.
     pub(super) fn wall_row(&mut self, w: usize, row: RowAt) -> Id {
         let mut total = self.t.walls[w].input;
-        let ports: Vec<Id> = self
+        let ports: Vec<PortHeat> = self
             .port_heat
             .iter()
             .flatten()
             .filter(|h| h.wall == w)
-            .map(|h| h.q)
+            .copied()
             .collect();
-        for q in ports {
+        for h in ports {
+            // every section's port into one wall: the wall row takes their sum (O(n) loop)
+            let q = if h.summed { self.reduce(h.q) } else { h.q };
             total = self.t.arena.sub(total, q);
         }
         for l in self.t.conductions.clone() {
@@ -84,8 +88,21 @@ impl Assembler<'_> {
                     continue;
                 }
                 let (fa, ta) = (heat_at(l.from), heat_at(l.to));
-                if let Some(base) = touches(e.at, row, rel_min(fa, ta)) {
+                let per_section = l.is_per_section();
+                let base = match (per_section, e.at, row) {
+                    // the array end of a per-section link: every section
+                    (true, At::Rel(_), RowAt::Array(..)) => Some(0),
+                    (true, At::Rel(_), RowAt::Scalar) => None,
+                    _ => touches(e.at, row, rel_min(fa, ta)),
+                };
+                if let Some(base) = base {
                     let q = self.conduction(&l, row, base);
+                    // the scalar end of a per-section link: the sum over the sections
+                    let q = if per_section && row == RowAt::Scalar {
+                        self.reduce(q)
+                    } else {
+                        q
+                    };
                     let a = &mut self.t.arena;
                     total = if into {
                         a.add(total, q)
@@ -170,6 +187,11 @@ impl Assembler<'_> {
                 _ => continue,
             };
             let q = self.conduction(&l, RowAt::Scalar, 0);
+            let q = if l.is_per_section() {
+                self.reduce(q)
+            } else {
+                q
+            };
             let a = &mut self.t.arena;
             let s = a.num(sign);
             let term = a.mul(s, q);
