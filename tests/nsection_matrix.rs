@@ -35,7 +35,7 @@ fn poles_converge_to_the_fixed_wall() {
             (q.0 - fixed.pole.0).hypot(q.1 - fixed.pole.1) / fixed.pole.0.hypot(fixed.pole.1)
         })
         .collect();
-    eprintln!("relative distance of the dominant pole at C = 1, 10, 100, 1000 J/K: {d:.3e?}");
+    eprintln!("relative distance of the dominant pole at C = 1, 10, 100, 1000 J/K: {d:?}");
     for k in 1..d.len() {
         assert!(d[k] < 0.15 * d[k - 1] && d[k] > 0.05 * d[k - 1], "{d:?}");
     }

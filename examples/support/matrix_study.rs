@@ -2,6 +2,7 @@
 //! `nsection` with a regenerator matrix of finite heat capacity, declared by extending the
 //! family's `nsection_engine`, against the fixed-wall `nsection` and the seed's 8th-order
 //! model (`nsection` with two sections, alias `order8`).
+#![allow(dead_code)] // the test uses a part of it
 
 use stirling::dsl::{Closure, Model};
 use stirling::models::family::NSection;
