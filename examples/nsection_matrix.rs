@@ -52,7 +52,13 @@ fn parse_args() -> Result<Args, ArgError> {
                     .filter(|v: &f64| v.is_finite() && *v > 0.0)
                     .ok_or(ArgError::TMax)?
             }
-            s => args.n = s.parse().ok().filter(|&n| n >= 1).ok_or(ArgError::Sections(s.into()))?,
+            s => {
+                args.n = s
+                    .parse()
+                    .ok()
+                    .filter(|&n| n >= 1)
+                    .ok_or(ArgError::Sections(s.into()))?
+            }
         }
     }
     Ok(args)

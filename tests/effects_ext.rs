@@ -75,8 +75,16 @@ fn nulls_recover_nsection_exactly() {
             let (mut fb, mut ff) = (vec![0.0; base.n_states()], vec![0.0; fx.n_states()]);
             base.rhs(&pb, xb, 0.0, &mut fb);
             fx.rhs(&pf, xb, 0.0, &mut ff);
-            assert_eq!(&fe[..base.n_states()], &fb[..], "n = {n}, state {k}: nsection");
-            assert_eq!(&fe[..base.n_states()], &ff[..], "n = {n}, state {k}: nsection_fx");
+            assert_eq!(
+                &fe[..base.n_states()],
+                &fb[..],
+                "n = {n}, state {k}: nsection"
+            );
+            assert_eq!(
+                &fe[..base.n_states()],
+                &ff[..],
+                "n = {n}, state {k}: nsection_fx"
+            );
             assert!(fe[base.n_states()..].iter().all(|v| *v == 0.0), "wall rows");
         }
     }
@@ -94,7 +102,10 @@ fn each_new_effect_acts() {
     for e in NEW {
         let s = EffectSettings::parse(
             "nsection_ext",
-            &[format!("{e}={}", effects::effect(e).unwrap().strength().typical)],
+            &[format!(
+                "{e}={}",
+                effects::effect(e).unwrap().strength().typical
+            )],
         )
         .unwrap();
         let mut p = p0.clone();
@@ -121,7 +132,11 @@ fn jacobians_match_finite_differences() {
                 for b in common::check_jacobians_from(&m, &p, &x, &STARTS, 0.0) {
                     let rel = (b.analytic - b.fd).abs() / b.analytic.abs().max(b.fd.abs());
                     // the chains' switches at n = 50, as in tests/dsl_sections.rs
-                    let tol = if n >= 50 && b.col == "param mdot_eps" { 1e-5 } else { common::REL };
+                    let tol = if n >= 50 && b.col == "param mdot_eps" {
+                        1e-5
+                    } else {
+                        common::REL
+                    };
                     if rel > tol {
                         report.push(format!(
                             "n={n} {label} {spread:?}: d {}/d {}: {:e} vs {:e} ({rel:.1e})",
@@ -142,14 +157,27 @@ fn registry_serves_the_new_effects() {
     let m = effects::augmented("nsection_ext", Some(3), Closure::Full).unwrap();
     assert_eq!((m.name(), m.n()), ("nsection_ext_fx", 3));
     let names = |b: &str| -> Vec<&str> { effects::effects_for(b).iter().map(|e| e.name).collect() };
-    let old = ["leak", "coulomb", "regen_quadratic", "end_stops", "sensor_lag", "sensor_gain"];
+    let old = [
+        "leak",
+        "coulomb",
+        "regen_quadratic",
+        "end_stops",
+        "sensor_lag",
+        "sensor_gain",
+    ];
     assert_eq!(names("nsection"), old.to_vec());
-    assert_eq!(names("cv1"), ["leak", "coulomb", "end_stops", "sensor_lag", "sensor_gain"]);
+    assert_eq!(
+        names("cv1"),
+        ["leak", "coulomb", "end_stops", "sensor_lag", "sensor_gain"]
+    );
     let ext = names("nsection_ext");
     assert!(old.iter().chain(&NEW).all(|e| ext.contains(e)), "{ext:?}");
     let e = EffectSettings::parse("nsection", &["matrix_capacity=2".into()]).unwrap_err();
     assert!(e.to_string().contains("it applies to nsection_ext"), "{e}");
-    let s = EffectSettings::parse("nsection_ext", &["km=0.02".into(), "Gloss=1".into(), "Co=1e-6".into()]);
+    let s = EffectSettings::parse(
+        "nsection_ext",
+        &["km=0.02".into(), "Gloss=1".into(), "Co=1e-6".into()],
+    );
     assert_eq!(s.unwrap().active(), vec!["matrix_capacity", "orifice_leak"]);
     let e = EffectSettings::parse("nsection_ext", &["Gm=0".into()]).unwrap_err();
     assert!(e.to_string().contains("must be > 0"), "{e}");

@@ -111,7 +111,13 @@ pub fn matrix_case(n: usize, capacity: f64, t_max: f64) -> Result<Case, StudyErr
     // the matrix's thermal time constant C / (hr Awr): let it settle (within 60 s)
     let tau = capacity / (100.0 * 0.0377);
     let t = (t_max + 4.0 * tau).min(60.0f64.max(t_max));
-    case(&m, &p, &format!("matrix {capacity:e} J/K"), Some(capacity), t)
+    case(
+        &m,
+        &p,
+        &format!("matrix {capacity:e} J/K"),
+        Some(capacity),
+        t,
+    )
 }
 
 /// The fixed-wall `nsection` at `n` (label `label`).
@@ -124,7 +130,11 @@ pub fn fixed_case(n: usize, label: &str, t_max: f64) -> Result<Case, StudyError>
 pub fn study(n: usize, capacities: &[f64], t_max: f64) -> Result<Vec<Case>, StudyError> {
     let mut out = vec![
         fixed_case(2, "8th order (nsection n=2, fixed wall)", t_max)?,
-        fixed_case(n, &format!("nsection n={n}, fixed wall (infinite C)"), t_max)?,
+        fixed_case(
+            n,
+            &format!("nsection n={n}, fixed wall (infinite C)"),
+            t_max,
+        )?,
     ];
     for &c in capacities {
         out.push(matrix_case(n, c, t_max)?);

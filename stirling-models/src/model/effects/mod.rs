@@ -15,7 +15,9 @@
 
 mod models;
 
-pub use models::{Cv1Fx, Cv1FxParams, NSectionExtFx, NSectionExtFxParams, NSectionFx, NSectionFxParams};
+pub use models::{
+    Cv1Fx, Cv1FxParams, NSectionExtFx, NSectionExtFxParams, NSectionFx, NSectionFxParams,
+};
 
 use stirling_dsl::{Closure, Model};
 
@@ -228,7 +230,11 @@ pub fn augmented(
 ) -> Result<Box<dyn Model>, EffectError> {
     let (b, fixed) = canonical(base).ok_or_else(|| EffectError::NoAugmented(base.to_string()))?;
     // reuse the registry's checks of n and aliases
-    let family = if b == "nsection_ext" { "nsection" } else { base };
+    let family = if b == "nsection_ext" {
+        "nsection"
+    } else {
+        base
+    };
     crate::registry::build(family, n, closure).map_err(|e| EffectError::Model(e.to_string()))?;
     let n = n.or(fixed).unwrap_or(1);
     let model_err = |e: stirling_dsl::ModelError| EffectError::Model(e.to_string());

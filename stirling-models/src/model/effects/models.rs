@@ -88,7 +88,6 @@ stirling_macros::stirling_model! {
     }
 }
 
-
 stirling_macros::stirling_model! {
     /// `nsection_fx` plus the effects that need walls with a temperature state or the orifice
     /// law, at null values: a regenerator matrix of heat capacity `1/km` (wall `matrix[n]`
