@@ -39,10 +39,7 @@ pub fn classify(
             .zip(col)
             .any(|(s, v)| matches!(s.kind, StateKind::Velocity(_)) && *v != 0.0);
         let g = st.iter().zip(col).any(|(s, v)| {
-            matches!(
-                s.kind,
-                StateKind::Pressure(_) | StateKind::Mass(_) | StateKind::WallTemperature(_)
-            ) && *v != 0.0
+            matches!(s.kind, StateKind::Pressure(_) | StateKind::Mass(_)) && *v != 0.0
         });
         if !body && !g {
             return Err(FitError::NotInEquations {
