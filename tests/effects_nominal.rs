@@ -112,6 +112,7 @@ fn nominal_nsection_is_the_base_nsection_bitwise() {
     );
 }
 
+/// Every model effect of `nsection` (those of `nsection_ext` only: tests/effects_ext.rs).
 #[test]
 fn each_model_effect_changes_the_rhs() {
     let fx = NSectionFx::new(2, Closure::Full).unwrap();
@@ -123,7 +124,7 @@ fn each_model_effect_changes_the_rhs() {
     let mut f0 = vec![0.0; fx.n_states()];
     for e in EFFECTS
         .iter()
-        .filter(|e| e.target == effects::EffectTarget::Model)
+        .filter(|e| e.target == effects::EffectTarget::Model && e.applies_to.contains(&"nsection"))
     {
         let s = EffectSettings::parse(
             "nsection",

@@ -6,15 +6,18 @@
 //! augmented model at the nulls. Sensor effects (`sensor_lag`, `sensor_gain`) act on the
 //! measured outputs, not on the model (see [`crate::rig`]).
 //!
-//! Not expressible in the DSL yet (they need new state kinds): regenerator matrix heat
-//! capacity (wall temperatures as states), heater dynamics (`Th` as a state), the closed
-//! bounce space as a control volume with its own heat port, the orifice leak law
-//! `C sign(dP)|dP|^0.5` (its slope is infinite at `dP = 0`), and the end-stop contact damper
-//! `-cc v` (needs a step function of the position).
+//! The effects that need walls with a temperature state or the orifice law (regenerator matrix
+//! heat capacity, a heater head with finite input, the orifice leak) are declared on a third
+//! augmented member, [`NSectionExtFx`] (base name `nsection_ext`), so that the nominal models
+//! of `cv1` and `nsection` and their default candidate lists stay as they are. Not expressible
+//! yet: the closed bounce space as a control volume with its own heat port as an effect, and
+//! the end-stop contact damper `-cc v` (needs a step function of the position).
 
 mod models;
 
-pub use models::{Cv1Fx, Cv1FxParams, NSectionFx, NSectionFxParams};
+pub use models::{
+    Cv1Fx, Cv1FxParams, NSectionExtFx, NSectionExtFxParams, NSectionFx, NSectionFxParams,
+};
 
 use stirling_dsl::{Closure, Model};
 
@@ -69,14 +72,27 @@ const fn ep(
     }
 }
 
-/// The effect library.
+/// Typical inverse matrix capacity: `1/km` = 0.5 J/K (the default engine's steel-mesh matrix,
+/// about 0.1 kg, is about 50 J/K: `km` = 0.02 K/J).
+const KM_TYPICAL: f64 = 2.0;
+/// Typical inverse heater-head capacity: `1/kh` = 25 J/K (a light head; a 0.5 kg steel head
+/// is about 250 J/K, `kh` = 4e-3 K/J).
+const KH_TYPICAL: f64 = 0.04;
+/// Typical orifice coefficient: `Co = Cd A0 sqrt(2 rho)` with `Cd` 0.6, a 1.2 mm hole and air
+/// at the charge (about 1e-6 kg/(s Pa^0.5), 5e-5 kg/s at 3 kPa, like `leak` at 2e-8).
+const CO_TYPICAL: f64 = 1.0e-6;
+
+/// The effect library. The effects that need wall states or the orifice law
+/// (`matrix_capacity`, `heater_input`, `orifice_leak`) apply to `nsection_ext` only, the
+/// augmented member [`NSectionExtFx`]: they add `n + 1` wall states, so they stay out of the
+/// nominal models (and the default candidates) of `cv1` and `nsection`.
 pub const EFFECTS: &[EffectInfo] = &[
     EffectInfo {
         name: "leak",
         summary: "seal leakage cold space -> bounce space, mdot = Gleak (Pc - Pb)",
         target: EffectTarget::Model,
         params: &[ep("Gleak", Some(0.0), 2.0e-8, "kg/(s Pa)")],
-        applies_to: &["cv1", "nsection"],
+        applies_to: &["cv1", "nsection", "nsection_ext"],
     },
     EffectInfo {
         name: "coulomb",
@@ -87,14 +103,14 @@ pub const EFFECTS: &[EffectInfo] = &[
             ep("Fcp", Some(0.0), 1.0, "N"),
             ep("v_eps", None, 1.0e-3, "m/s"),
         ],
-        applies_to: &["cv1", "nsection"],
+        applies_to: &["cv1", "nsection", "nsection_ext"],
     },
     EffectInfo {
         name: "regen_quadratic",
         summary: "quadratic (turbulent) regenerator friction, dP = Rf mdot + Rq mdot |mdot|",
         target: EffectTarget::Model,
         params: &[ep("Rq", Some(0.0), 1.0e9, "Pa s^2/kg^2")],
-        applies_to: &["nsection"],
+        applies_to: &["nsection", "nsection_ext"],
     },
     EffectInfo {
         name: "end_stops",
@@ -105,14 +121,35 @@ pub const EFFECTS: &[EffectInfo] = &[
             ep("xmax", None, 0.01, "m"),
             ep("ymax", None, 0.01, "m"),
         ],
-        applies_to: &["cv1", "nsection"],
+        applies_to: &["cv1", "nsection", "nsection_ext"],
+    },
+    EffectInfo {
+        name: "matrix_capacity",
+        summary: "regenerator matrix of finite heat capacity 1/km: C_j Tw_j' = hA (T_j - Tw_j) + axial conduction Gm",
+        target: EffectTarget::Model,
+        params: &[ep("km", Some(0.0), KM_TYPICAL, "K/J"), ep("Gm", None, 0.03, "W/K")],
+        applies_to: &["nsection_ext"],
+    },
+    EffectInfo {
+        name: "heater_input",
+        summary: "heater head of finite heat capacity 1/kh fed by Gloss (Th - Tk), losing Gloss (T_head - Tk) to the cooler",
+        target: EffectTarget::Model,
+        params: &[ep("kh", Some(0.0), KH_TYPICAL, "K/J"), ep("Gloss", None, 0.5, "W/K")],
+        applies_to: &["nsection_ext"],
+    },
+    EffectInfo {
+        name: "orifice_leak",
+        summary: "square-root seal leak cold space -> bounce space, mdot = Co dP / (dP^2 + dP0^2)^(1/4)",
+        target: EffectTarget::Model,
+        params: &[ep("Co", Some(0.0), CO_TYPICAL, "kg/(s Pa^0.5)"), ep("dP0", None, 50.0, "Pa")],
+        applies_to: &["nsection_ext"],
     },
     EffectInfo {
         name: "sensor_lag",
         summary: "first-order lag of the pressure transducers, time constant tau_p",
         target: EffectTarget::Sensor,
         params: &[ep("tau_p", Some(0.0), 2.0e-3, "s")],
-        applies_to: &["cv1", "nsection"],
+        applies_to: &["cv1", "nsection", "nsection_ext"],
     },
     EffectInfo {
         name: "sensor_gain",
@@ -122,7 +159,7 @@ pub const EFFECTS: &[EffectInfo] = &[
             ep("gain_x", Some(0.0), 0.05, "-"),
             ep("gain_y", Some(0.0), 0.05, "-"),
         ],
-        applies_to: &["cv1", "nsection"],
+        applies_to: &["cv1", "nsection", "nsection_ext"],
     },
 ];
 
@@ -137,7 +174,7 @@ pub enum EffectError {
         model: String,
         applies: String,
     },
-    #[error("model `{0}` has no augmented member: effects are declared for cv1 and nsection (aliases order5, order7, order8)")]
+    #[error("model `{0}` has no augmented member: effects are declared for cv1, nsection and nsection_ext (aliases order5, order7, order8)")]
     NoAugmented(String),
     #[error("effect parameter `{name}` = {value} is not physical: it must be {range}")]
     OutOfRange {
@@ -177,13 +214,15 @@ fn canonical(name: &str) -> Option<(&'static str, Option<usize>)> {
     match name {
         "cv1" | "order5" | "cv1_fx" => Some(("cv1", None)),
         "nsection" | "nsection_fx" => Some(("nsection", None)),
+        "nsection_ext" | "nsection_ext_fx" => Some(("nsection_ext", None)),
         "order7" => Some(("nsection", Some(1))),
         "order8" => Some(("nsection", Some(2))),
         _ => None,
     }
 }
 
-/// The augmented model of a base model (`cv1` -> [`Cv1Fx`], `nsection` -> [`NSectionFx`]).
+/// The augmented model of a base model (`cv1` -> [`Cv1Fx`], `nsection` -> [`NSectionFx`],
+/// `nsection_ext` -> [`NSectionExtFx`], `n` checked like `nsection`'s).
 pub fn augmented(
     base: &str,
     n: Option<usize>,
@@ -191,22 +230,28 @@ pub fn augmented(
 ) -> Result<Box<dyn Model>, EffectError> {
     let (b, fixed) = canonical(base).ok_or_else(|| EffectError::NoAugmented(base.to_string()))?;
     // reuse the registry's checks of n and aliases
-    crate::registry::build(base, n, closure).map_err(|e| EffectError::Model(e.to_string()))?;
+    let family = if b == "nsection_ext" {
+        "nsection"
+    } else {
+        base
+    };
+    crate::registry::build(family, n, closure).map_err(|e| EffectError::Model(e.to_string()))?;
+    let n = n.or(fixed).unwrap_or(1);
+    let model_err = |e: stirling_dsl::ModelError| EffectError::Model(e.to_string());
     Ok(match b {
-        "cv1" => Box::new(Cv1Fx::new(1, closure).map_err(|e| EffectError::Model(e.to_string()))?),
-        _ => {
-            let n = n.or(fixed).unwrap_or(1);
-            Box::new(NSectionFx::new(n, closure).map_err(|e| EffectError::Model(e.to_string()))?)
-        }
+        "cv1" => Box::new(Cv1Fx::new(1, closure).map_err(model_err)?),
+        "nsection_ext" => Box::new(NSectionExtFx::new(n, closure).map_err(model_err)?),
+        _ => Box::new(NSectionFx::new(n, closure).map_err(model_err)?),
     })
 }
 
 /// Reject an effect parameter outside its physical range: strengths are non-negative,
-/// smoothing widths and end-stop travels positive, sensor gains above -1 (a gain of -1 would
+/// smoothing widths, end-stop travels and the walls' loss conductances positive (they make the
+/// rest state unique), sensor gains above -1 (a gain of -1 would
 /// read zero for every position).
 pub fn check_range(name: &str, v: f64) -> Result<(), EffectError> {
     let (ok, range) = match name {
-        "v_eps" | "xmax" | "ymax" => (v > 0.0, "> 0"),
+        "v_eps" | "xmax" | "ymax" | "Gm" | "Gloss" | "dP0" => (v > 0.0, "> 0"),
         "gain_x" | "gain_y" => (v > -0.5 && v < 0.5, "between -0.5 and 0.5"),
         _ => (v >= 0.0, ">= 0"),
     };

@@ -10,6 +10,9 @@
 
 // The effects change the frame's items with `modify` (docs/custom-topologies.md, "Composition").
 
+// `nsection_fx_engine` is crate-local: extending it calls back through the `stirling_model` in scope.
+use stirling_macros::stirling_model;
+
 stirling_macros::stirling_model! {
     /// `cv1` with the DSL-expressible effects (leak, Coulomb friction, end stops) at null values.
     pub model Cv1Fx extends default_engine {
@@ -45,13 +48,13 @@ stirling_macros::stirling_model! {
 }
 
 stirling_macros::stirling_model! {
-    /// `nsection` with all DSL-expressible effects (leak, Coulomb friction, end stops,
-    /// quadratic regenerator friction) at null values.
-    pub model NSectionFx extends nsection_engine {
+    /// `nsection` with the effects that add no state (leak, Coulomb friction, end stops,
+    /// quadratic regenerator friction) at null values: the frame of [`NSectionFx`] and
+    /// [`NSectionExtFx`].
+    base nsection_fx_engine extends nsection_engine {
         modify body displacer { force: -Fcd * tanh(v / v_eps) - kc * ((abs(x) - xmax) + abs(abs(x) - xmax)) / 2.0 * sign(x) }
         modify body piston { force: -Fcp * tanh(w / v_eps) - kc * ((abs(y) - ymax) + abs(abs(y) - ymax)) / 2.0 * sign(y) }
         modify space bounce { temperature: Tk }
-        name "nsection_fx";
         params {
             /// seal-leak conductance, cold space to bounce space (0: no leak)
             Gleak: 0.0 "kg/(s Pa)",
@@ -74,5 +77,49 @@ stirling_macros::stirling_model! {
         modify link regen[j] -> regen[j + 1] { quadratic: Rq / n }
         modify link regen[n - 1] -> cold { quadratic: Rq / (2.0 * n) }
         link cold -> bounce { conductance: Gleak }
+    }
+}
+
+stirling_macros::stirling_model! {
+    /// `nsection` with all DSL-expressible effects (leak, Coulomb friction, end stops,
+    /// quadratic regenerator friction) at null values.
+    pub model NSectionFx extends nsection_fx_engine {
+        name "nsection_fx";
+    }
+}
+
+stirling_macros::stirling_model! {
+    /// `nsection_fx` plus the effects that need walls with a temperature state or the orifice
+    /// law, at null values: a regenerator matrix of heat capacity `1/km` (wall `matrix[n]`
+    /// behind `regen[j]`, axial conduction `Gm` to the fixed heater and cooler ends), a heater
+    /// head of heat capacity `1/kh` fed by a fixed input `Gloss (Th - Tk)` and losing heat to
+    /// the cooler by conduction `Gloss` (so its rest state is `Th`), and a square-root seal leak
+    /// cold space -> bounce space. At `km = kh = 0` the walls are frozen at their rest, the
+    /// fixed walls of `nsection`; at `Co = 0` the orifice carries nothing.
+    pub model NSectionExtFx extends nsection_fx_engine {
+        name "nsection_ext_fx";
+        params {
+            /// inverse heat capacity of the whole regenerator matrix (0: infinite, the fixed wall)
+            km: 0.0 "K/J",
+            /// axial conductance of the whole matrix (its path to the heater and cooler ends)
+            Gm: 0.03 "W/K",
+            /// inverse heat capacity of the heater head (0: infinite, the head fixed at Th)
+            kh: 0.0 "K/J",
+            /// conductance from the heater head to the cooler (the heater's loss path)
+            Gloss: 0.5 "W/K",
+            /// orifice seal-leak coefficient, cold space to bounce space (0: no leak)
+            Co: 0.0 "kg/(s Pa^0.5)",
+            /// width of the orifice law's linear core
+            dP0: 50.0 "Pa",
+        }
+        modify cv hot { port hot { h: hh, area: Awh0 - pi * D * x, wall: head } }
+        wall head { capacity: 1.0 / kh, rest: Th, input: Gloss * (Th - Tk) }
+        link head -> Tk { conductance: Gloss }
+        modify cv regen { port wall { h: hr, area: Awr / n, wall: matrix[j] } }
+        wall matrix[n] { capacity: 1.0 / (km * n), rest: Th - (j + 0.5) * (Th - Tk) / n }
+        link matrix[j] -> matrix[j + 1] for j in 0..n - 1 { conductance: Gm * n }
+        link Th -> matrix[0] { conductance: 2.0 * Gm * n }
+        link matrix[n - 1] -> Tk { conductance: 2.0 * Gm * n }
+        link cold -> bounce { orifice: Co, dp0: dP0 }
     }
 }
