@@ -66,14 +66,14 @@ pub const OUTSIDE: &[OutsideInfo] = &[
         name: "h_speed",
         summary: "heat-transfer coefficients growing with the gas speed: h = hh (1 + chv |v|), hk (1 + chv |v - w|)",
         param: "chv",
-        typical: 20.0,
+        typical: 1.0,
         unit: "s/m",
     },
     OutsideInfo {
         name: "spring_cubic",
         summary: "hardening flexure springs: -k3 x^3 on the displacer, -k3 kp/kd y^3 on the piston",
         param: "k3",
-        typical: 2.0e7,
+        typical: 5.0e6,
         unit: "N/m^3",
     },
 ];
