@@ -40,12 +40,22 @@ fn at_their_null_the_outside_models_are_nominal_nsection() {
             let p = m.default_params();
             assert_eq!(p[m.param_index(o.param).unwrap()], 0.0, "{} null", o.name);
             for bp in base.params() {
-                assert_eq!(p[m.param_index(bp.name).unwrap()], bp.default, "{}", bp.name);
+                assert_eq!(
+                    p[m.param_index(bp.name).unwrap()],
+                    bp.default,
+                    "{}",
+                    bp.name
+                );
             }
             let mut f = vec![0.0; m.n_states()];
             m.rhs(&p, &xb, 0.0, &mut f);
             assert_eq!(f, fb, "{} rhs at its null (n = {n})", o.name);
-            assert_eq!(m.jacobian_dense(&p, &xb, 0.0), jb, "{} Jacobian at its null", o.name);
+            assert_eq!(
+                m.jacobian_dense(&p, &xb, 0.0),
+                jb,
+                "{} Jacobian at its null",
+                o.name
+            );
         }
     }
 }
@@ -59,7 +69,10 @@ fn outside_model_jacobians_match_central_differences() {
         let x = state(m.as_ref(), &p);
         let bad = common::check_jacobians(m.as_ref(), &p, &x);
         for b in &bad {
-            eprintln!("{}: {} / {}: analytic {:e} fd {:e}", o.name, b.row, b.col, b.analytic, b.fd);
+            eprintln!(
+                "{}: {} / {}: analytic {:e} fd {:e}",
+                o.name, b.row, b.col, b.analytic, b.fd
+            );
         }
         assert!(bad.is_empty(), "{}: {} mismatches", o.name, bad.len());
     }
@@ -80,11 +93,19 @@ fn the_rig_runs_an_outside_truth_and_it_acts() {
     };
     let clean = rig::run(&cfg(None, vec![])).unwrap();
     for o in OUTSIDE {
-        let on = rig::run(&cfg(Some(o.name), vec![format!("{}={}", o.param, o.typical)])).unwrap();
+        let on = rig::run(&cfg(
+            Some(o.name),
+            vec![format!("{}={}", o.param, o.typical)],
+        ))
+        .unwrap();
         assert_eq!(on.truth.outside.as_deref(), Some(o.name));
         assert_eq!(on.data.channels(), ["p", "x", "y"]);
         let (a, b) = (clean.data.x.as_ref().unwrap(), on.data.x.as_ref().unwrap());
-        let diff = a.iter().zip(b).map(|(u, v)| (u - v).abs()).fold(0.0, f64::max);
+        let diff = a
+            .iter()
+            .zip(b)
+            .map(|(u, v)| (u - v).abs())
+            .fold(0.0, f64::max);
         assert!(diff > 1e-5, "{} changes x by {diff} m only", o.name);
     }
     let err = rig::run(&RigConfig {
@@ -94,10 +115,19 @@ fn the_rig_runs_an_outside_truth_and_it_acts() {
     .unwrap_err()
     .to_string();
     assert!(err.contains("takes no --effect"), "{err}");
-    let err = rig::run(&cfg(Some("bounce"), vec![])).unwrap_err().to_string();
-    assert!(err.contains("unknown truth model `bounce`") && err.contains("h_speed"), "{err}");
-    let err = rig::run(&RigConfig { model: "cv1".into(), n: None, ..cfg(Some("h_speed"), vec![]) })
+    let err = rig::run(&cfg(Some("bounce"), vec![]))
         .unwrap_err()
         .to_string();
+    assert!(
+        err.contains("unknown truth model `bounce`") && err.contains("h_speed"),
+        "{err}"
+    );
+    let err = rig::run(&RigConfig {
+        model: "cv1".into(),
+        n: None,
+        ..cfg(Some("h_speed"), vec![])
+    })
+    .unwrap_err()
+    .to_string();
     assert!(err.contains("extends nsection"), "{err}");
 }

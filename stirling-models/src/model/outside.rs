@@ -93,7 +93,11 @@ pub fn outside(name: &str) -> Option<&'static OutsideInfo> {
 }
 
 /// The truth model of outside cause `name` with `n` regenerator sections (default 1).
-pub fn build(name: &str, n: Option<usize>, closure: Closure) -> Result<Box<dyn Model>, OutsideError> {
+pub fn build(
+    name: &str,
+    n: Option<usize>,
+    closure: Closure,
+) -> Result<Box<dyn Model>, OutsideError> {
     let n = n.unwrap_or(1);
     let bad = || OutsideError::Sections { name: name.into() };
     Ok(match name {
@@ -102,7 +106,11 @@ pub fn build(name: &str, n: Option<usize>, closure: Closure) -> Result<Box<dyn M
         _ => {
             return Err(OutsideError::Unknown {
                 name: name.into(),
-                known: OUTSIDE.iter().map(|o| o.name).collect::<Vec<_>>().join(", "),
+                known: OUTSIDE
+                    .iter()
+                    .map(|o| o.name)
+                    .collect::<Vec<_>>()
+                    .join(", "),
             })
         }
     })

@@ -44,4 +44,3 @@ pub enum RigError {
     #[error("cannot write `{0}`: {1}")]
     Io(PathBuf, std::io::Error),
 }
-

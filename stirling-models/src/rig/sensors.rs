@@ -78,4 +78,3 @@ pub(super) fn read_sensors(
     let y = noisy(col(2), gy, cfg.offset_y, cfg.noise_x);
     Ok(Readings { pc, ph, x, y })
 }
-

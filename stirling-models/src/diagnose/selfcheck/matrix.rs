@@ -50,8 +50,11 @@ impl Confusion {
             right: cases.iter().filter(|(_, e, v)| e == v).count(),
             total: cases.len(),
             clean: clean.len(),
-            false_alarms: clean.iter().filter(|(_, _, v)| v != "no_significant_gap").count(),
-            }
+            false_alarms: clean
+                .iter()
+                .filter(|(_, _, v)| v != "no_significant_gap")
+                .count(),
+        }
     }
 
     /// Fraction of right verdicts (NaN without cases).
@@ -105,7 +108,16 @@ mod tests {
         ];
         let m = Confusion::of(&cases, &effects);
         assert_eq!(m.rows, ["clean", "coulomb", "leak", "outside:h_speed"]);
-        assert_eq!(m.columns, ["coulomb", "leak", "unexplained", "no_significant_gap", "error"]);
+        assert_eq!(
+            m.columns,
+            [
+                "coulomb",
+                "leak",
+                "unexplained",
+                "no_significant_gap",
+                "error"
+            ]
+        );
         assert_eq!(m.counts[0], [1, 0, 1, 2, 0]);
         assert_eq!(m.counts[1], [1, 0, 0, 0, 0]);
         assert_eq!(m.counts[2], [1, 0, 0, 0, 0]);
@@ -117,14 +129,23 @@ mod tests {
         assert_eq!(m.false_alarm_rate(), 0.5);
         let md = m.markdown();
         assert!(md.contains("| clean | 1 | 0 | 1 | 2 | 0 |"), "{md}");
-        assert!(md.contains("| outside:h_speed | 0 | 0 | 1 | 0 | 1 |"), "{md}");
+        assert!(
+            md.contains("| outside:h_speed | 0 | 0 | 1 | 0 | 1 |"),
+            "{md}"
+        );
     }
 
     #[test]
     fn empty_rows_are_left_out_of_the_table() {
-        let m = Confusion::of(&[t("coulomb", "coulomb", "coulomb")], &["coulomb".into(), "leak".into()]);
+        let m = Confusion::of(
+            &[t("coulomb", "coulomb", "coulomb")],
+            &["coulomb".into(), "leak".into()],
+        );
         let md = m.markdown();
-        assert!(!md.contains("| leak |") && !md.contains("| clean |"), "{md}");
+        assert!(
+            !md.contains("| leak |") && !md.contains("| clean |"),
+            "{md}"
+        );
         assert!(m.false_alarm_rate().is_nan());
     }
 }

@@ -102,7 +102,12 @@ impl Outcome {
         self.truth_rank = name
             .as_ref()
             .and_then(|n| d.ranking.iter().position(|r| &r.effect == n).map(|i| i + 1));
-        self.verdict = d.verdict.effect.clone().filter(|_| d.verdict.verdict == "effect").unwrap_or(d.verdict.verdict.clone());
+        self.verdict = d
+            .verdict
+            .effect
+            .clone()
+            .filter(|_| d.verdict.verdict == "effect")
+            .unwrap_or(d.verdict.verdict.clone());
         self.tuned_verdict = self.verdict.clone();
         self.top = d.ranking.first().map(|r| r.effect.clone());
         // the closure of the truth when it was fitted, else of the leading candidate
@@ -138,8 +143,14 @@ pub fn run_case(
         Ok((diagnose(model, &p0, &data, &opts.diagnose)?, sig))
     };
     let mut out = match attempt() {
-        Ok((d, sig)) => Outcome { signature: sig, ..blank.read(d) },
-        Err(e) => Outcome { error: Some(e.to_string()), ..blank },
+        Ok((d, sig)) => Outcome {
+            signature: sig,
+            ..blank.read(d)
+        },
+        Err(e) => Outcome {
+            error: Some(e.to_string()),
+            ..blank
+        },
     };
     out.seconds = clock.elapsed().as_secs_f64();
     out

@@ -122,12 +122,24 @@ impl Default for VerdictOptions {
 
 /// The library effects of the plan (checked against the library).
 pub fn effect_names(opts: &VerdictOptions) -> Result<Vec<String>, DiagnoseError> {
-    let known = || effects_for(&opts.model).iter().map(|e| e.name).collect::<Vec<_>>().join(", ");
+    let known = || {
+        effects_for(&opts.model)
+            .iter()
+            .map(|e| e.name)
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
     match &opts.effects {
-        None => Ok(effects_for(&opts.model).iter().map(|e| e.name.to_string()).collect()),
+        None => Ok(effects_for(&opts.model)
+            .iter()
+            .map(|e| e.name.to_string())
+            .collect()),
         Some(v) => {
             if let Some(bad) = v.iter().find(|n| effect(n).is_none()) {
-                return Err(DiagnoseError::UnknownEffect { name: bad.clone(), known: known() });
+                return Err(DiagnoseError::UnknownEffect {
+                    name: bad.clone(),
+                    known: known(),
+                });
             }
             Ok(v.clone())
         }
@@ -143,7 +155,11 @@ pub fn outside_names(opts: &VerdictOptions) -> Result<Vec<String>, DiagnoseError
     if let Some(bad) = names.iter().find(|n| outside(n).is_none()) {
         return Err(DiagnoseError::UnknownEffect {
             name: bad.clone(),
-            known: OUTSIDE.iter().map(|o| o.name).collect::<Vec<_>>().join(", "),
+            known: OUTSIDE
+                .iter()
+                .map(|o| o.name)
+                .collect::<Vec<_>>()
+                .join(", "),
         });
     }
     Ok(names)
@@ -164,12 +180,26 @@ fn split_cases(
     for s in 0..seeds as u64 {
         for name in effects {
             for &m in &opts.strengths {
-                out.push((Truth::Effect { name: name.clone(), strength: m }, split, base + s));
+                out.push((
+                    Truth::Effect {
+                        name: name.clone(),
+                        strength: m,
+                    },
+                    split,
+                    base + s,
+                ));
             }
         }
         for name in outside {
             for &m in &opts.outside_strengths {
-                out.push((Truth::Outside { name: name.clone(), strength: m }, split, base + s));
+                out.push((
+                    Truth::Outside {
+                        name: name.clone(),
+                        strength: m,
+                    },
+                    split,
+                    base + s,
+                ));
             }
         }
     }
@@ -206,10 +236,17 @@ mod tests {
         let p = plan(&VerdictOptions::default()).unwrap();
         let n = |f: &dyn Fn(&Planned) -> bool| p.iter().filter(|c| f(c)).count();
         assert!(p.len() >= 40, "{} records", p.len());
-        assert_eq!(n(&|c| c.truth == Truth::Clean && c.split == Split::Eval), 20);
+        assert_eq!(
+            n(&|c| c.truth == Truth::Clean && c.split == Split::Eval),
+            20
+        );
         assert!(n(&|c| matches!(c.truth, Truth::Outside { .. })) >= 4);
         // distinct seeds and starts on the clean records
-        let mut seeds: Vec<u64> = p.iter().filter(|c| c.truth == Truth::Clean).map(|c| c.seed).collect();
+        let mut seeds: Vec<u64> = p
+            .iter()
+            .filter(|c| c.truth == Truth::Clean)
+            .map(|c| c.seed)
+            .collect();
         let mut starts: Vec<u64> = p.iter().map(|c| c.perturb_seed).collect();
         let (ls, lp) = (seeds.len(), starts.len());
         seeds.dedup();
@@ -217,13 +254,23 @@ mod tests {
         starts.dedup();
         assert_eq!((seeds.len(), starts.len()), (ls, lp));
         // the two seed sets share no seed
-        let tune: Vec<u64> = p.iter().filter(|c| c.split == Split::Tune).map(|c| c.seed).collect();
-        assert!(p.iter().filter(|c| c.split == Split::Eval).all(|c| !tune.contains(&c.seed)));
+        let tune: Vec<u64> = p
+            .iter()
+            .filter(|c| c.split == Split::Tune)
+            .map(|c| c.seed)
+            .collect();
+        assert!(p
+            .iter()
+            .filter(|c| c.split == Split::Eval)
+            .all(|c| !tune.contains(&c.seed)));
     }
 
     #[test]
     fn unknown_names_are_errors() {
-        let o = VerdictOptions { outside: Some(vec!["bounce".into()]), ..Default::default() };
+        let o = VerdictOptions {
+            outside: Some(vec!["bounce".into()]),
+            ..Default::default()
+        };
         assert!(plan(&o).unwrap_err().to_string().contains("bounce"));
     }
 }

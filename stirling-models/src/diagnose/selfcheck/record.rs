@@ -114,7 +114,10 @@ pub fn signature(d: &Measured) -> Signature {
         x_amp: amp(&d.x),
         y_amp: amp(&d.y),
         p_amp: amp(&d.p),
-        freq: d.x.as_ref().map_or(f64::NAN, |x| frequency(&d.t[h..], &x[h..])),
+        freq: d
+            .x
+            .as_ref()
+            .map_or(f64::NAN, |x| frequency(&d.t[h..], &x[h..])),
     }
 }
 
@@ -125,8 +128,18 @@ mod tests {
     #[test]
     fn signature_of_a_sine() {
         let t: Vec<f64> = (0..4000).map(|k| k as f64 / 2000.0).collect();
-        let x: Vec<f64> = t.iter().map(|t| 0.003 * (2.0 * std::f64::consts::PI * 13.0 * t).sin()).collect();
-        let d = Measured { source: "test".into(), t, p: None, p_hot: None, x: Some(x), y: None };
+        let x: Vec<f64> = t
+            .iter()
+            .map(|t| 0.003 * (2.0 * std::f64::consts::PI * 13.0 * t).sin())
+            .collect();
+        let d = Measured {
+            source: "test".into(),
+            t,
+            p: None,
+            p_hot: None,
+            x: Some(x),
+            y: None,
+        };
         let s = signature(&d);
         assert!((s.x_amp / 0.003 - 1.0).abs() < 1e-3, "{}", s.x_amp);
         assert!((s.freq / 13.0 - 1.0).abs() < 1e-3, "{}", s.freq);

@@ -20,7 +20,11 @@ fn pct(v: f64) -> String {
 
 /// One case as a table row (and a progress line).
 pub fn case_row(c: &Outcome) -> String {
-    let right = if c.tuned_verdict == c.expected { "right" } else { "WRONG" };
+    let right = if c.tuned_verdict == c.expected {
+        "right"
+    } else {
+        "WRONG"
+    };
     format!(
         "| {} | {:?} | {} | {} | {} | {} | {} {} [{}, {}] | {} | {:.0} |",
         c.index,
@@ -73,7 +77,12 @@ pub fn markdown(v: &VerdictCheck) -> String {
     for g in &v.signatures {
         s += &format!(
             "| {} | {} | {:+.1} % | {:+.1} % | {:+.1} % | {:+.2} % |\n",
-            g.label, g.strength, 100.0 * g.x_amp, 100.0 * g.y_amp, 100.0 * g.p_amp, 100.0 * g.freq
+            g.label,
+            g.strength,
+            100.0 * g.x_amp,
+            100.0 * g.y_amp,
+            100.0 * g.p_amp,
+            100.0 * g.freq
         );
     }
     s += "\n## Cases\n\n| # | set | truth | strength | seed | verdict (default) | closure of [95 % CI] | tuned verdict | time (s) |\n|---|---|---|---|---|---|---|---|---|\n";
@@ -82,7 +91,11 @@ pub fn markdown(v: &VerdictCheck) -> String {
         s.push('\n');
     }
     for c in v.cases.iter().filter(|c| c.error.is_some()) {
-        s += &format!("\ncase {} failed: {}\n", c.index, c.error.as_deref().unwrap_or(""));
+        s += &format!(
+            "\ncase {} failed: {}\n",
+            c.index,
+            c.error.as_deref().unwrap_or("")
+        );
     }
     s
 }

@@ -72,7 +72,11 @@ pub fn tune(tune: &[&Outcome], alpha: f64) -> Tuned {
     }
     let (thresholds, s) = best.unwrap_or((defaults, (0, 0, 0)));
     Tuned {
-        thresholds: if tune.is_empty() { defaults } else { thresholds },
+        thresholds: if tune.is_empty() {
+            defaults
+        } else {
+            thresholds
+        },
         right: s.0,
         total: tune.len(),
         false_alarms: s.1,

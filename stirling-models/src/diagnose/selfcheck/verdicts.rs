@@ -102,11 +102,19 @@ pub fn summarize(opts: &VerdictOptions, mut cases: Vec<Outcome>, clock: Instant)
 /// Mean signature of each (truth, strength) relative to the mean of the clean records.
 fn signatures(cases: &[Outcome]) -> Vec<SignatureChange> {
     let mean = |sel: &dyn Fn(&Outcome) -> bool, f: &dyn Fn(&Signature) -> f64| {
-        let v: Vec<f64> = cases.iter().filter(|c| sel(c) && c.error.is_none()).map(|c| f(&c.signature)).collect();
+        let v: Vec<f64> = cases
+            .iter()
+            .filter(|c| sel(c) && c.error.is_none())
+            .map(|c| f(&c.signature))
+            .collect();
         v.iter().sum::<f64>() / v.len() as f64
     };
-    let fields: [&dyn Fn(&Signature) -> f64; 4] = [&|s| s.x_amp, &|s| s.y_amp, &|s| s.p_amp, &|s| s.freq];
-    let clean: Vec<f64> = fields.iter().map(|f| mean(&|c| c.truth == Truth::Clean, *f)).collect();
+    let fields: [&dyn Fn(&Signature) -> f64; 4] =
+        [&|s| s.x_amp, &|s| s.y_amp, &|s| s.p_amp, &|s| s.freq];
+    let clean: Vec<f64> = fields
+        .iter()
+        .map(|f| mean(&|c| c.truth == Truth::Clean, *f))
+        .collect();
     let mut keys: Vec<(String, f64)> = Vec::new();
     for c in cases {
         let k = (c.label.clone(), c.truth.strength());
@@ -117,8 +125,19 @@ fn signatures(cases: &[Outcome]) -> Vec<SignatureChange> {
     keys.into_iter()
         .map(|(label, strength)| {
             let sel = |c: &Outcome| c.label == label && c.truth.strength() == strength;
-            let rel: Vec<f64> = fields.iter().zip(&clean).map(|(f, c0)| mean(&sel, *f) / c0 - 1.0).collect();
-            SignatureChange { label, strength, x_amp: rel[0], y_amp: rel[1], p_amp: rel[2], freq: rel[3] }
+            let rel: Vec<f64> = fields
+                .iter()
+                .zip(&clean)
+                .map(|(f, c0)| mean(&sel, *f) / c0 - 1.0)
+                .collect();
+            SignatureChange {
+                label,
+                strength,
+                x_amp: rel[0],
+                y_amp: rel[1],
+                p_amp: rel[2],
+                freq: rel[3],
+            }
         })
         .collect()
 }
