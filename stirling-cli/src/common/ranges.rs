@@ -119,9 +119,9 @@ mod tests {
 
 /// A pair of counts `TUNE:EVAL` (whole numbers >= 0), as `--seeds 1:1`.
 pub fn split_counts(s: &str) -> Parsed<(usize, usize)> {
-    let (a, b) = s
-        .split_once(':')
-        .ok_or(RangeError::Outside("expected TUNE:EVAL, two whole numbers such as 1:1"))?;
+    let (a, b) = s.split_once(':').ok_or(RangeError::Outside(
+        "expected TUNE:EVAL, two whole numbers such as 1:1",
+    ))?;
     let count = |v: &str| -> Parsed<usize> {
         let x = integer(v)?;
         if x < 0.0 || x > 1e6 {

@@ -167,17 +167,17 @@ pub mod plan;
 pub mod record;
 /// The verdict self-check: Markdown and JSON.
 pub mod report;
+/// The confusion matrix over the cases.
+mod summary;
 /// The verdict self-check: thresholds chosen on the tuning seeds.
 pub mod tune;
 /// The verdict self-check: run, tune, count.
 pub mod verdicts;
-/// The confusion matrix over the cases.
-mod summary;
 
 use case::{measured_channels, perturbed_start, scratch_dir, Bench};
+pub use plan::{Split, Truth, VerdictOptions};
 pub use summary::matrix_markdown;
 use summary::summarize;
-pub use plan::{Split, Truth, VerdictOptions};
 pub use verdicts::{run_verdicts, VerdictCheck};
 
 /// Run the self-check.
