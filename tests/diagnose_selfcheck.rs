@@ -169,3 +169,44 @@ fn library_self_check_rejects_an_unknown_effect() {
     let err = selfcheck::run_library(&opts, log).unwrap_err().to_string();
     assert!(err.contains("unknown effect `bogus`"), "{err}");
 }
+
+/// The verdict self-check, reduced for CI: on `nsection` n = 2, `p,x,y` records of 2 s at
+/// 1 kHz, one withheld Coulomb friction, one clean record and one cause outside the library
+/// (hardening springs), all on the evaluation seeds (no tuning: the diagnosis's thresholds);
+/// candidates `coulomb, sensor_lag, sensor_gain`. Each verdict must be right, and the
+/// confusion matrix must say so.
+#[test]
+fn reduced_verdict_self_check_gets_the_verdicts_right() {
+    use selfcheck::VerdictOptions;
+    let opts = VerdictOptions {
+        effects: Some(strings(&["coulomb"])),
+        strengths: vec![1.0],
+        outside: Some(strings(&["spring_cubic"])),
+        seeds: (0, 1),
+        clean: (0, 1),
+        rate: 1000.0,
+        diagnose: DiagnoseOptions {
+            effects: Some(strings(&["coulomb", "sensor_lag", "sensor_gain"])),
+            bootstrap: 200,
+            ..Default::default()
+        },
+        ..Default::default()
+    };
+    let progress = |c: &selfcheck::outcome::Outcome, done: usize, total: usize| {
+        eprintln!("[{done}/{total}] {}", selfcheck::report::case_row(c));
+    };
+    let v = selfcheck::run_verdicts(&opts, &progress).unwrap();
+    assert_eq!(v.cases.len(), 3);
+    for c in &v.cases {
+        assert!(c.error.is_none(), "{:?}", c.error);
+        assert_eq!(c.verdict, c.expected, "{}: top {:?}", c.label, c.top);
+    }
+    assert_eq!((v.eval.right, v.eval.total), (3, 3));
+    assert_eq!((v.eval.clean, v.eval.false_alarms), (1, 0));
+    let md = selfcheck::report::markdown(&v);
+    assert!(md.contains("| outside:spring_cubic | 0 | 1 | 0 |"), "{md}");
+    // the outside cause moved the record at least as much as the friction did
+    let sig = |l: &str| v.signatures.iter().find(|s| s.label == l).unwrap().clone();
+    let (f, o) = (sig("coulomb"), sig("outside:spring_cubic"));
+    assert!(o.freq.abs().max(o.x_amp.abs()) >= f.freq.abs().max(f.x_amp.abs()), "{o:?} vs {f:?}");
+}

@@ -18,6 +18,11 @@ pub struct RigArgs {
     /// effects: leak, coulomb, regen_quadratic, end_stops, sensor_lag, sensor_gain; on nsection_ext also matrix_capacity, heater_input, orifice_leak
     #[arg(long = "effect", value_name = "NAME=VALUE")]
     pub effect: Vec<String>,
+    /// Truth model outside the effect library instead of the augmented member (nsection
+    /// only; the diagnosis does not know it): h_speed (strength --set chv=..., s/m) or
+    /// spring_cubic (--set k3=..., N/m^3)
+    #[arg(long)]
+    pub truth: Option<String>,
     /// The truth's parameters: sections, file, overrides
     #[command(flatten)]
     pub with: crate::common::ParamArgs,
@@ -84,6 +89,7 @@ pub fn run(a: &RigArgs) -> anyhow::Result<()> {
         x0: a.x0,
         seed: a.seed,
         channels: a.channels.clone(),
+        truth: a.truth.clone(),
     };
     // refuse before the (long) simulation
     for f in [a.out.clone(), rig::sidecar_path(&a.out)] {

@@ -74,6 +74,54 @@ fn shift_note(shifts: &[ParamShift], top: Option<&RankEntry>) -> String {
     )
 }
 
+/// The thresholds of the verdict rule (the self-check tunes them on its tuning seeds).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct Thresholds {
+    /// Family-wise significance level of the score (Bonferroni over the candidates).
+    pub alpha: f64,
+    /// Held-out BIC change a winner must beat (negative).
+    pub strong_bic: f64,
+    /// Lower closure bound a winner must clear.
+    pub min_closure: f64,
+}
+
+impl Thresholds {
+    /// The diagnosis's rule at significance level `alpha`.
+    pub fn at(alpha: f64) -> Self {
+        Self {
+            alpha,
+            strong_bic: STRONG_BIC,
+            min_closure: MIN_CLOSURE,
+        }
+    }
+}
+
+/// Which verdict the rule gives (the reasons are [`decide`]'s).
+#[derive(Clone, Copy, Debug)]
+pub enum Pick<'a> {
+    Effect(&'a RankEntry),
+    NoSignificantGap,
+    Unexplained,
+}
+
+/// The verdict rule on a ranking of `candidates` candidates.
+pub fn pick<'a>(ranking: &'a [RankEntry], candidates: usize, th: &Thresholds) -> Pick<'a> {
+    let level = th.alpha / candidates.max(1) as f64;
+    if let Some(t) = ranking.first().filter(|t| {
+        t.fitted
+            && t.p_value < level
+            && t.delta_bic.is_some_and(|d| d < th.strong_bic)
+            && t.ci_low.is_some_and(|c| c > th.min_closure)
+    }) {
+        return Pick::Effect(t);
+    }
+    if ranking.iter().any(|r| r.p_value < level) {
+        Pick::Unexplained
+    } else {
+        Pick::NoSignificantGap
+    }
+}
+
 /// Decide from the ranking.
 pub fn decide(
     ranking: &[RankEntry],
@@ -83,11 +131,11 @@ pub fn decide(
     shifts: &[ParamShift],
 ) -> Verdict {
     let level = alpha / candidates.max(1) as f64;
-    let significant: Vec<&RankEntry> = ranking.iter().filter(|r| r.p_value < level).collect();
-    let better: Vec<&RankEntry> = ranking
+    let significant = ranking.iter().filter(|r| r.p_value < level).count();
+    let better = ranking
         .iter()
         .filter(|r| r.delta_bic.is_some_and(|d| d < STRONG_BIC))
-        .collect();
+        .count();
     let top = ranking.first();
     let mk = |v: &str, r: Option<&RankEntry>, reason: String| Verdict {
         verdict: v.into(),
@@ -98,19 +146,16 @@ pub fn decide(
         gap: nominal.holdout_error,
         reason,
     };
-    if let Some(t) = top.filter(|t| {
-        t.fitted
-            && t.p_value < level
-            && t.delta_bic.is_some_and(|d| d < STRONG_BIC)
-            && t.ci_low.is_some_and(|c| c > MIN_CLOSURE)
-    }) {
-        return mk("effect", Some(t), format!("`{}`: score p = {:.2e} < {:.1e}, held-out BIC change {:.1}, closure {:.2} [{:.2}, {:.2}]", t.effect, t.p_value, level, t.delta_bic.unwrap_or(f64::NAN), t.closure_fraction.unwrap_or(f64::NAN), t.ci_low.unwrap_or(f64::NAN), t.ci_high.unwrap_or(f64::NAN)));
+    match pick(ranking, candidates, &Thresholds::at(alpha)) {
+        Pick::Effect(t) => mk("effect", Some(t), format!("`{}`: score p = {:.2e} < {:.1e}, held-out BIC change {:.1}, closure {:.2} [{:.2}, {:.2}]", t.effect, t.p_value, level, t.delta_bic.unwrap_or(f64::NAN), t.closure_fraction.unwrap_or(f64::NAN), t.ci_low.unwrap_or(f64::NAN), t.ci_high.unwrap_or(f64::NAN))),
+        Pick::NoSignificantGap => {
+            let mut reason = format!("no candidate is significant at {level:.1e} ({better} lower the held-out BIC by more than {}; held-out error {:.3} noise variances)", -STRONG_BIC, nominal.holdout_error);
+            reason.push_str(&shift_note(shifts, top));
+            mk("no_significant_gap", None, reason)
+        }
+        Pick::Unexplained => {
+            let r = top.filter(|t| t.fitted);
+            mk("unexplained", r, format!("{significant} candidate(s) significant, {better} lower the held-out BIC, but none closes more than {MIN_CLOSURE} of the gap with confidence"))
+        }
     }
-    if significant.is_empty() {
-        let mut reason = format!("no candidate is significant at {level:.1e} ({} lower the held-out BIC by more than {}; held-out error {:.3} noise variances)", better.len(), -STRONG_BIC, nominal.holdout_error);
-        reason.push_str(&shift_note(shifts, top));
-        return mk("no_significant_gap", None, reason);
-    }
-    let r = top.filter(|t| t.fitted);
-    mk("unexplained", r, format!("{} candidate(s) significant, {} lower the held-out BIC, but none closes more than {MIN_CLOSURE} of the gap with confidence", significant.len(), better.len()))
 }

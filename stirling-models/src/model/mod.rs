@@ -13,6 +13,8 @@
 pub mod family;
 /// Effects the nominal models leave out, as DSL-declared model augmentations.
 pub mod effects;
+/// Causes outside the effect library: truth models for the rig and the self-check only.
+pub mod outside;
 /// Parameter files, overrides and validation.
 pub mod params;
 /// The family by name, as the command line uses it.

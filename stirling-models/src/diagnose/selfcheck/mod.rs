@@ -1,4 +1,7 @@
-//! The self-check: for each effect of the library, rig data with that effect (at one or two
+//! The self-check. [`run_verdicts`] measures verdicts (issue 15 item 5: effects at two
+//! strengths, causes outside the library, clean records, thresholds tuned on one set of seeds
+//! and the accuracy counted on another). [`run`] and [`run_library`], the older rank check:
+//! for each effect of the library, rig data with that effect (at one or two
 //! strengths) is diagnosed against the nominal model from perturbed starting parameters; the
 //! withheld effect must rank first, and data with no added effect must give
 //! `no_significant_gap`. The diagnosis sees only the CSV the rig writes (read back from a
@@ -152,12 +155,30 @@ fn truth_value(set: &[String], model: &dyn Model, p_nom: &[f64], name: &str) -> 
 
 /// One case: a rig record, its CSV, its diagnosis and what the user reads of it.
 mod case;
+/// The verdict self-check: running the planned cases in parallel.
+mod exec;
+/// The verdict self-check: the confusion matrix of verdicts.
+pub mod matrix;
+/// The verdict self-check: one case's diagnosis and what the user reads of it.
+pub mod outcome;
+/// The verdict self-check: the case plan (effects, outside causes, clean; tune / eval seeds).
+pub mod plan;
+/// The verdict self-check: one case's record, signature and perturbed start.
+pub mod record;
+/// The verdict self-check: Markdown and JSON.
+pub mod report;
 /// The confusion matrix over the cases.
 mod summary;
+/// The verdict self-check: thresholds chosen on the tuning seeds.
+pub mod tune;
+/// The verdict self-check: run, tune, count.
+pub mod verdicts;
 
 use case::{measured_channels, perturbed_start, scratch_dir, Bench};
+pub use plan::{Split, Truth, VerdictOptions};
 pub use summary::matrix_markdown;
 use summary::summarize;
+pub use verdicts::{run_verdicts, VerdictCheck};
 
 /// Run the self-check.
 pub fn run(

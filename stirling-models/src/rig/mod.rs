@@ -7,15 +7,21 @@
 
 use std::path::{Path, PathBuf};
 
-use rand::{rngs::StdRng, Rng, SeedableRng};
 use serde::Serialize;
 use stirling_dsl::{Closure, Model};
 
 use crate::data::{write_csv, Measured};
 use crate::effects::{augmented, EffectSettings};
 use crate::layout::StateLayout;
-use crate::signal::first_order_lag;
 use crate::sim::{simulate, SimOptions};
+
+/// Why the rig could not run.
+mod error;
+/// The sensors: lag, gain, offsets, noise.
+mod sensors;
+
+pub use error::RigError;
+use sensors::read_sensors;
 
 /// What the rig runs.
 #[derive(Clone, Debug, Serialize)]
@@ -49,6 +55,10 @@ pub struct RigConfig {
     /// Channels written besides `t` (default: the seed's sensors `p`, `x`, `y`; `p_hot` on
     /// request for multi-CV models).
     pub channels: Vec<String>,
+    /// A truth model outside the effect library ([`crate::outside::OUTSIDE`], e.g.
+    /// `h_speed`) instead of the augmented family member; its strength is a parameter
+    /// (`set`), and it takes no `effects`.
+    pub truth: Option<String>,
 }
 
 impl Default for RigConfig {
@@ -70,6 +80,7 @@ impl Default for RigConfig {
             x0: 2e-3,
             seed: 1,
             channels: vec!["p".into(), "x".into(), "y".into()],
+            truth: None,
         }
     }
 }
@@ -86,6 +97,8 @@ pub struct Truth {
     /// Effect settings and the effects switched on.
     pub effects: EffectSettings,
     pub active_effects: Vec<String>,
+    /// The outside truth model, when the rig ran one (`--truth`).
+    pub outside: Option<String>,
     pub seed: u64,
     pub noise: Noise,
     pub offsets: std::collections::BTreeMap<String, f64>,
@@ -107,50 +120,6 @@ pub struct Noise {
 pub struct RigOutput {
     pub data: Measured,
     pub truth: Truth,
-}
-
-/// Why the rig could not run.
-#[derive(Debug, thiserror::Error)]
-pub enum RigError {
-    #[error(transparent)]
-    Effect(#[from] crate::effects::EffectError),
-    #[error(transparent)]
-    Params(#[from] crate::params::ParamError),
-    #[error("simulation of the truth model failed: {0}")]
-    Sim(#[from] crate::sim::SimError),
-    #[error("{option} must be {need} (got {got})")]
-    Setting {
-        option: &'static str,
-        got: String,
-        need: String,
-    },
-    #[error("--t-end {t_end} s at --rate {rate} Hz is {:.0} samples, more than the 5 million the rig writes", t_end * rate)]
-    TooManySamples { t_end: f64, rate: f64 },
-    #[error("unknown channel `{channel}` in --channels: expected some of {known}")]
-    UnknownChannel { channel: String, known: String },
-    #[error("--channels is empty: name at least one of p, p_hot, x, y")]
-    NoChannels,
-    #[error("the measured pressure would go negative: its minimum {min:.0} Pa plus --offset-p {offset} minus 5 x --noise-p {noise} is not positive")]
-    NegativePressure { min: f64, offset: f64, noise: f64 },
-    #[error("`{model}` has no gas volume to measure")]
-    NoGas { model: String },
-    #[error("channel p_hot asked for, but `{model}` has a single gas volume")]
-    NoHotSide { model: String },
-    #[error("`{0}` exists: pass --force to overwrite")]
-    Exists(PathBuf),
-    #[error("cannot write `{0}`: {1}")]
-    Io(PathBuf, std::io::Error),
-}
-
-/// Gaussian samples by Box-Muller on a seeded generator.
-struct Gauss(StdRng);
-
-impl Gauss {
-    fn next(&mut self) -> f64 {
-        let u1: f64 = 1.0 - self.0.gen::<f64>();
-        let u2: f64 = self.0.gen::<f64>();
-        (-2.0 * u1.ln()).sqrt() * (2.0 * std::f64::consts::PI * u2).cos()
-    }
 }
 
 /// Lowest sample rate the rig accepts (Hz): the family runs near 13 Hz, and the fit's
@@ -202,27 +171,50 @@ fn validate(cfg: &RigConfig) -> Result<(), RigError> {
     Ok(())
 }
 
-/// Refuse a record whose absolute pressure can go negative (noise or offset larger than
-/// the pressure itself).
-fn check_pressure(p: &[f64], cfg: &RigConfig) -> Result<(), RigError> {
-    let lo = p.iter().copied().fold(f64::INFINITY, f64::min);
-    if lo + cfg.offset_p - 5.0 * cfg.noise_p <= 0.0 {
-        return Err(RigError::NegativePressure {
-            min: lo,
-            offset: cfg.offset_p,
-            noise: cfg.noise_p,
-        });
-    }
-    Ok(())
-}
-
-/// The engine of `cfg`: the augmented model with its effects and parameters.
+/// The engine of `cfg`: the augmented model with its effects and parameters, or the outside
+/// truth model with its parameters.
 fn engine(cfg: &RigConfig) -> Result<(Box<dyn Model>, EffectSettings, Vec<f64>), RigError> {
-    let model = augmented(&cfg.model, cfg.n, Closure::Full)?;
+    let model = match &cfg.truth {
+        Some(t) => outside_engine(cfg, t)?,
+        None => augmented(&cfg.model, cfg.n, Closure::Full)?,
+    };
     let fx = EffectSettings::parse(&cfg.model, &cfg.effects)?;
     let mut p = crate::params::load(model.as_ref(), cfg.params.as_deref(), &cfg.set)?;
     fx.apply(model.as_ref(), &mut p)?;
     Ok((model, fx, p))
+}
+
+/// The outside truth model `truth` (on `nsection` only, without library effects).
+fn outside_engine(cfg: &RigConfig, truth: &str) -> Result<Box<dyn Model>, RigError> {
+    let info = crate::outside::outside(truth).ok_or_else(|| {
+        RigError::Outside(crate::outside::OutsideError::Unknown {
+            name: truth.into(),
+            known: crate::outside::OUTSIDE
+                .iter()
+                .map(|o| o.name)
+                .collect::<Vec<_>>()
+                .join(", "),
+        })
+    })?;
+    if !cfg.effects.is_empty() {
+        return Err(RigError::TruthWithEffects {
+            truth: truth.into(),
+            effects: cfg.effects.join(" "),
+            param: info.param.into(),
+        });
+    }
+    let n = match cfg.model.as_str() {
+        "nsection" => cfg.n,
+        "order7" => Some(1),
+        "order8" => Some(2),
+        other => {
+            return Err(RigError::TruthBase {
+                truth: truth.into(),
+                model: other.into(),
+            })
+        }
+    };
+    Ok(crate::outside::build(truth, n, Closure::Full)?)
 }
 
 /// The clean run: from equilibrium with the displacer kicked by `x0`, sampled at `rate`
@@ -254,54 +246,6 @@ fn clean_run(
     Ok(traj.x)
 }
 
-/// The sensor readings of a clean run: cold and hot pressure, `x`, `y`.
-struct Readings {
-    pc: Vec<f64>,
-    ph: Option<Vec<f64>>,
-    x: Vec<f64>,
-    y: Vec<f64>,
-}
-
-/// What the sensors read from the clean `rows`: lag, gain, offset and seeded noise (cold
-/// pressure state `ic`, hot `ih` when there are several CVs).
-fn read_sensors(
-    rows: &[Vec<f64>],
-    (ic, ih, ncv): (usize, usize, usize),
-    fx: &EffectSettings,
-    cfg: &RigConfig,
-) -> Result<Readings, RigError> {
-    let dt = 1.0 / cfg.rate;
-    let col = |i: usize| rows.iter().map(|r| r[i]).collect::<Vec<f64>>();
-    let tau = fx.sensor_value("tau_p");
-    let (gx, gy) = (fx.sensor_value("gain_x"), fx.sensor_value("gain_y"));
-    let mut g = Gauss(StdRng::seed_from_u64(cfg.seed));
-    let mut noisy = |v: Vec<f64>, gain: f64, off: f64, sd: f64| {
-        v.into_iter()
-            .map(|s| (1.0 + gain) * s + off + sd * g.next())
-            .collect::<Vec<f64>>()
-    };
-    let pc = noisy(
-        first_order_lag(&col(ic), dt, tau),
-        0.0,
-        cfg.offset_p,
-        cfg.noise_p,
-    );
-    let ph = if ncv > 1 {
-        Some(noisy(
-            first_order_lag(&col(ih), dt, tau),
-            0.0,
-            cfg.offset_p,
-            cfg.noise_p,
-        ))
-    } else {
-        None
-    };
-    check_pressure(&col(ic), cfg)?;
-    let x = noisy(col(0), gx, cfg.offset_x, cfg.noise_x);
-    let y = noisy(col(2), gy, cfg.offset_y, cfg.noise_x);
-    Ok(Readings { pc, ph, x, y })
-}
-
 /// The truth record: what generated the data.
 fn truth(cfg: &RigConfig, model: &dyn Model, p: &[f64], fx: EffectSettings) -> Truth {
     let want = |c: &str| cfg.channels.iter().any(|k| k == c);
@@ -323,6 +267,7 @@ fn truth(cfg: &RigConfig, model: &dyn Model, p: &[f64], fx: EffectSettings) -> T
         parameters,
         active_effects: fx.active().into_iter().map(String::from).collect(),
         effects: fx,
+        outside: cfg.truth.clone(),
         seed: cfg.seed,
         noise: Noise {
             p: cfg.noise_p,

@@ -1,0 +1,157 @@
+//! One verdict case run: its record, its diagnosis from the case's own perturbed start, and
+//! what a user reads of it (the verdict, the leading candidate's closure with its interval).
+
+use std::path::Path;
+use std::time::Instant;
+
+use serde::Serialize;
+use stirling_dsl::Model;
+
+use super::plan::{Planned, Split, Truth, VerdictOptions};
+use super::record::{record, seeded_start, signature, Signature};
+use crate::diagnose::run::diagnose;
+use crate::diagnose::types::{Diagnosis, RankEntry};
+use crate::diagnose::verdict::{pick, Pick, Thresholds};
+use crate::diagnose::DiagnoseError;
+
+/// One case of the verdict self-check.
+#[derive(Clone, Debug, Serialize)]
+pub struct Outcome {
+    pub index: usize,
+    pub truth: Truth,
+    /// Row label: `clean`, the effect, `outside:NAME`.
+    pub label: String,
+    pub split: Split,
+    pub seed: u64,
+    pub perturb_seed: u64,
+    /// The diagnosis's own verdict (default thresholds): an effect's name, `unexplained`
+    /// or `no_significant_gap`.
+    pub verdict: String,
+    /// The verdict under the thresholds tuned on the tuning set (filled in by the summary).
+    pub tuned_verdict: String,
+    /// The right verdict.
+    pub expected: String,
+    /// Candidates the diagnosis considered (the Bonferroni count).
+    pub candidates: usize,
+    /// The top-ranked candidate and its closure [95 % CI] (the truth's when it is an effect
+    /// that was fitted).
+    pub top: Option<String>,
+    pub closure_of: Option<String>,
+    pub closure: Option<f64>,
+    pub ci_low: Option<f64>,
+    pub ci_high: Option<f64>,
+    /// Rank of the withheld effect (1 = first), if it is a library effect.
+    pub truth_rank: Option<usize>,
+    /// The ranking (what the thresholds are tuned on).
+    pub ranking: Vec<RankEntry>,
+    pub signature: Signature,
+    pub seconds: f64,
+    /// Set when the case failed to run (rig or diagnosis error): counted as wrong.
+    pub error: Option<String>,
+}
+
+/// A verdict label from the rule's pick.
+pub fn label_of(p: Pick<'_>) -> String {
+    match p {
+        Pick::Effect(r) => r.effect.clone(),
+        Pick::NoSignificantGap => "no_significant_gap".into(),
+        Pick::Unexplained => "unexplained".into(),
+    }
+}
+
+impl Outcome {
+    /// The verdict of this case under `th` (an errored case keeps `error`).
+    pub fn relabel(&self, th: &Thresholds) -> String {
+        if self.error.is_some() {
+            return "error".into();
+        }
+        label_of(pick(&self.ranking, self.candidates, th))
+    }
+
+    fn blank(c: &Planned) -> Self {
+        Outcome {
+            index: c.index,
+            truth: c.truth.clone(),
+            label: c.truth.label(),
+            split: c.split,
+            seed: c.seed,
+            perturb_seed: c.perturb_seed,
+            verdict: "error".into(),
+            tuned_verdict: "error".into(),
+            expected: c.truth.expected(),
+            candidates: 0,
+            top: None,
+            closure_of: None,
+            closure: None,
+            ci_low: None,
+            ci_high: None,
+            truth_rank: None,
+            ranking: Vec::new(),
+            signature: Signature::default(),
+            seconds: 0.0,
+            error: None,
+        }
+    }
+
+    /// Fill in what the diagnosis says.
+    fn read(mut self, d: Diagnosis) -> Self {
+        let name = match &self.truth {
+            Truth::Effect { name, .. } => Some(name.clone()),
+            _ => None,
+        };
+        self.truth_rank = name
+            .as_ref()
+            .and_then(|n| d.ranking.iter().position(|r| &r.effect == n).map(|i| i + 1));
+        self.verdict = d
+            .verdict
+            .effect
+            .clone()
+            .filter(|_| d.verdict.verdict == "effect")
+            .unwrap_or(d.verdict.verdict.clone());
+        self.tuned_verdict = self.verdict.clone();
+        self.top = d.ranking.first().map(|r| r.effect.clone());
+        // the closure of the truth when it was fitted, else of the leading candidate
+        let entry = name
+            .as_ref()
+            .and_then(|n| d.ranking.iter().find(|r| &r.effect == n && r.fitted))
+            .or_else(|| d.ranking.iter().find(|r| r.fitted));
+        self.closure_of = entry.map(|r| r.effect.clone());
+        self.closure = entry.and_then(|r| r.closure_fraction);
+        self.ci_low = entry.and_then(|r| r.ci_low);
+        self.ci_high = entry.and_then(|r| r.ci_high);
+        self.candidates = d.ranking.len();
+        self.ranking = d.ranking;
+        self
+    }
+}
+
+/// Run case `c`: rig record through a CSV in `dir`, diagnosis from its seeded start. A rig
+/// or diagnosis error is kept in the outcome (a wrong case), not returned.
+pub fn run_case(
+    opts: &VerdictOptions,
+    model: &dyn Model,
+    p_nom: &[f64],
+    c: &Planned,
+    dir: &Path,
+) -> Outcome {
+    let clock = Instant::now();
+    let blank = Outcome::blank(c);
+    let attempt = || -> Result<(Diagnosis, Signature), DiagnoseError> {
+        let data = record(opts, c, dir)?;
+        let sig = signature(&data);
+        let p0 = seeded_start(model, p_nom, opts.perturb, c.perturb_seed);
+        Ok((diagnose(model, &p0, &data, &opts.diagnose)?, sig))
+    };
+    let mut out = match attempt() {
+        Ok((d, sig)) => Outcome {
+            signature: sig,
+            ..blank.read(d)
+        },
+        Err(e) => Outcome {
+            error: Some(e.to_string()),
+            ..blank
+        },
+    };
+    out.seconds = clock.elapsed().as_secs_f64();
+    out
+}

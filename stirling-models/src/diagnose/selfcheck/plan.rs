@@ -1,0 +1,276 @@
+//! The verdict self-check's case plan: every library effect at its strengths, the causes
+//! outside the library, and clean records, each on noise seeds split into a tuning set (the
+//! verdict thresholds are chosen there) and an evaluation set (never used for tuning).
+
+use serde::Serialize;
+
+use crate::diagnose::{DiagnoseError, DiagnoseOptions};
+use crate::effects::{effect, effects_for};
+use crate::outside::{outside, OUTSIDE};
+
+/// Which seed set a case belongs to.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Split {
+    Tune,
+    Eval,
+}
+
+/// What generated a record.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+#[serde(tag = "kind", rename_all = "lowercase")]
+pub enum Truth {
+    /// The nominal model alone.
+    Clean,
+    /// A library effect at `strength` times its self-check unit ([`super::base_strength`]).
+    Effect { name: String, strength: f64 },
+    /// A cause outside the library at `strength` times its unit ([`crate::outside::OUTSIDE`]).
+    Outside { name: String, strength: f64 },
+}
+
+impl Truth {
+    /// The row label of the confusion matrix: `clean`, the effect, `outside:NAME`.
+    pub fn label(&self) -> String {
+        match self {
+            Truth::Clean => "clean".into(),
+            Truth::Effect { name, .. } => name.clone(),
+            Truth::Outside { name, .. } => format!("outside:{name}"),
+        }
+    }
+
+    /// The right verdict: `no_significant_gap`, the effect's name, `unexplained`.
+    pub fn expected(&self) -> String {
+        match self {
+            Truth::Clean => "no_significant_gap".into(),
+            Truth::Effect { name, .. } => name.clone(),
+            Truth::Outside { .. } => "unexplained".into(),
+        }
+    }
+
+    pub fn strength(&self) -> f64 {
+        match self {
+            Truth::Clean => 0.0,
+            Truth::Effect { strength, .. } | Truth::Outside { strength, .. } => *strength,
+        }
+    }
+}
+
+/// One planned case: the truth, its seed set, the rig's noise seed and the seed of the
+/// starting-parameter perturbation.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Planned {
+    pub index: usize,
+    pub truth: Truth,
+    pub split: Split,
+    pub seed: u64,
+    pub perturb_seed: u64,
+}
+
+/// What the verdict self-check runs (`stirling diagnose --self-check`).
+#[derive(Clone, Debug)]
+pub struct VerdictOptions {
+    /// Model of the rig and the diagnosis (`nsection`), sections `n`.
+    pub model: String,
+    pub n: Option<usize>,
+    /// Library effects to withhold (`None`: every effect of the model).
+    pub effects: Option<Vec<String>>,
+    /// Strengths of the library effects, as multiples of their self-check unit.
+    pub strengths: Vec<f64>,
+    /// Outside causes (`None`: all of [`OUTSIDE`]; empty: none).
+    pub outside: Option<Vec<String>>,
+    /// Strengths of the outside causes, as multiples of their unit.
+    pub outside_strengths: Vec<f64>,
+    /// Noise seeds per effect / outside case in the tuning and the evaluation set.
+    pub seeds: (usize, usize),
+    /// Clean records in the tuning and the evaluation set (each its own seed and start).
+    pub clean: (usize, usize),
+    pub t_end: f64,
+    pub settle: f64,
+    pub rate: f64,
+    /// First noise seed; the evaluation set's seeds start at `seed + 1000`.
+    pub seed: u64,
+    /// Largest relative perturbation of kd, kp, bd, bp, hh, hk in the diagnosis's start.
+    pub perturb: f64,
+    pub channels: Vec<String>,
+    pub diagnose: DiagnoseOptions,
+    /// Cases run at once (each diagnosis also uses the rayon pool).
+    pub jobs: usize,
+}
+
+impl Default for VerdictOptions {
+    fn default() -> Self {
+        Self {
+            model: "nsection".into(),
+            n: Some(2),
+            effects: None,
+            strengths: vec![1.0, 2.0],
+            outside: None,
+            outside_strengths: vec![1.0],
+            seeds: (1, 1),
+            clean: (10, 20),
+            t_end: 2.0,
+            settle: 0.1,
+            rate: 2000.0,
+            seed: 5,
+            perturb: 0.08,
+            channels: ["p", "x", "y"].map(String::from).to_vec(),
+            diagnose: DiagnoseOptions::default(),
+            jobs: 2,
+        }
+    }
+}
+
+/// The library effects of the plan (checked against the library).
+pub fn effect_names(opts: &VerdictOptions) -> Result<Vec<String>, DiagnoseError> {
+    let known = || {
+        effects_for(&opts.model)
+            .iter()
+            .map(|e| e.name)
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
+    match &opts.effects {
+        None => Ok(effects_for(&opts.model)
+            .iter()
+            .map(|e| e.name.to_string())
+            .collect()),
+        Some(v) => {
+            if let Some(bad) = v.iter().find(|n| effect(n).is_none()) {
+                return Err(DiagnoseError::UnknownEffect {
+                    name: bad.clone(),
+                    known: known(),
+                });
+            }
+            Ok(v.clone())
+        }
+    }
+}
+
+/// The outside causes of the plan (checked).
+pub fn outside_names(opts: &VerdictOptions) -> Result<Vec<String>, DiagnoseError> {
+    let names: Vec<String> = match &opts.outside {
+        None => OUTSIDE.iter().map(|o| o.name.to_string()).collect(),
+        Some(v) => v.clone(),
+    };
+    if let Some(bad) = names.iter().find(|n| outside(n).is_none()) {
+        return Err(DiagnoseError::UnknownEffect {
+            name: bad.clone(),
+            known: OUTSIDE
+                .iter()
+                .map(|o| o.name)
+                .collect::<Vec<_>>()
+                .join(", "),
+        });
+    }
+    Ok(names)
+}
+
+/// The cases of one seed set: effects x strengths x seeds, outside x strengths x seeds, clean.
+fn split_cases(
+    opts: &VerdictOptions,
+    split: Split,
+    effects: &[String],
+    outside: &[String],
+) -> Vec<(Truth, Split, u64)> {
+    let (seeds, clean, base) = match split {
+        Split::Tune => (opts.seeds.0, opts.clean.0, opts.seed),
+        Split::Eval => (opts.seeds.1, opts.clean.1, opts.seed + 1000),
+    };
+    let mut out = Vec::new();
+    for s in 0..seeds as u64 {
+        for name in effects {
+            for &m in &opts.strengths {
+                out.push((
+                    Truth::Effect {
+                        name: name.clone(),
+                        strength: m,
+                    },
+                    split,
+                    base + s,
+                ));
+            }
+        }
+        for name in outside {
+            for &m in &opts.outside_strengths {
+                out.push((
+                    Truth::Outside {
+                        name: name.clone(),
+                        strength: m,
+                    },
+                    split,
+                    base + s,
+                ));
+            }
+        }
+    }
+    // clean records: seeds of their own, after the effect seeds
+    out.extend((0..clean as u64).map(|k| (Truth::Clean, split, base + 500 + k)));
+    out
+}
+
+/// The whole plan, tuning set first; every case's start is perturbed by its own seed.
+pub fn plan(opts: &VerdictOptions) -> Result<Vec<Planned>, DiagnoseError> {
+    let effects = effect_names(opts)?;
+    let outside = outside_names(opts)?;
+    let mut cases = split_cases(opts, Split::Tune, &effects, &outside);
+    cases.extend(split_cases(opts, Split::Eval, &effects, &outside));
+    Ok(cases
+        .into_iter()
+        .enumerate()
+        .map(|(index, (truth, split, seed))| Planned {
+            index,
+            truth,
+            split,
+            seed,
+            perturb_seed: seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) ^ index as u64,
+        })
+        .collect())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_default_plan_meets_the_issue() {
+        let p = plan(&VerdictOptions::default()).unwrap();
+        let n = |f: &dyn Fn(&Planned) -> bool| p.iter().filter(|c| f(c)).count();
+        assert!(p.len() >= 40, "{} records", p.len());
+        assert_eq!(
+            n(&|c| c.truth == Truth::Clean && c.split == Split::Eval),
+            20
+        );
+        assert!(n(&|c| matches!(c.truth, Truth::Outside { .. })) >= 4);
+        // distinct seeds and starts on the clean records
+        let mut seeds: Vec<u64> = p
+            .iter()
+            .filter(|c| c.truth == Truth::Clean)
+            .map(|c| c.seed)
+            .collect();
+        let mut starts: Vec<u64> = p.iter().map(|c| c.perturb_seed).collect();
+        let (ls, lp) = (seeds.len(), starts.len());
+        seeds.dedup();
+        starts.sort();
+        starts.dedup();
+        assert_eq!((seeds.len(), starts.len()), (ls, lp));
+        // the two seed sets share no seed
+        let tune: Vec<u64> = p
+            .iter()
+            .filter(|c| c.split == Split::Tune)
+            .map(|c| c.seed)
+            .collect();
+        assert!(p
+            .iter()
+            .filter(|c| c.split == Split::Eval)
+            .all(|c| !tune.contains(&c.seed)));
+    }
+
+    #[test]
+    fn unknown_names_are_errors() {
+        let o = VerdictOptions {
+            outside: Some(vec!["bounce".into()]),
+            ..Default::default()
+        };
+        assert!(plan(&o).unwrap_err().to_string().contains("bounce"));
+    }
+}

@@ -1,0 +1,118 @@
+//! The verdict self-check as a person reads it (Markdown) and as a program does (JSON).
+
+use std::path::{Path, PathBuf};
+
+use super::outcome::Outcome;
+use super::verdicts::VerdictCheck;
+use crate::diagnose::DiagnoseError;
+
+fn opt(v: Option<f64>) -> String {
+    v.map_or("-".into(), |v| format!("{v:.2}"))
+}
+
+fn pct(v: f64) -> String {
+    if v.is_finite() {
+        format!("{:.1} %", 100.0 * v)
+    } else {
+        "-".into()
+    }
+}
+
+/// One case as a table row (and a progress line).
+pub fn case_row(c: &Outcome) -> String {
+    let right = if c.tuned_verdict == c.expected {
+        "right"
+    } else {
+        "WRONG"
+    };
+    format!(
+        "| {} | {:?} | {} | {} | {} | {} | {} {} [{}, {}] | {} | {:.0} |",
+        c.index,
+        c.split,
+        c.label,
+        c.truth.strength(),
+        c.seed,
+        c.verdict,
+        c.closure_of.as_deref().unwrap_or("-"),
+        opt(c.closure),
+        opt(c.ci_low),
+        opt(c.ci_high),
+        if c.error.is_some() { "error" } else { right },
+        c.seconds
+    )
+}
+
+/// The summary lines: accuracy and false alarms on the evaluation set.
+pub fn headline(v: &VerdictCheck) -> String {
+    let t = &v.tuned.thresholds;
+    format!(
+        "evaluation set: verdicts right {}/{} ({}), false alarms on clean records {}/{} ({}); with the diagnosis's default thresholds {}/{} right, {}/{} false alarms\n\
+         thresholds tuned on {} tuning cases: score level {:.1e} (family-wise), held-out BIC change < {}, closure lower bound > {} ({}/{} right there)\n\
+         {} cases, {:.0} s wall, {:.0} s summed over cases",
+        v.eval.right, v.eval.total, pct(v.eval.accuracy()), v.eval.false_alarms, v.eval.clean, pct(v.eval.false_alarm_rate()),
+        v.eval_default.right, v.eval_default.total, v.eval_default.false_alarms, v.eval_default.clean,
+        v.tuned.total, t.alpha, t.strong_bic, t.min_closure, v.tuned.right, v.tuned.total,
+        v.cases.len(), v.seconds, v.case_seconds
+    )
+}
+
+/// The whole self-check as Markdown.
+pub fn markdown(v: &VerdictCheck) -> String {
+    let mut s = format!(
+        "# Verdict self-check: {} on {} ({} s at {} Hz)\n\n{}\n\n",
+        v.model,
+        v.channels.join(","),
+        v.t_end,
+        v.rate,
+        headline(v).replace('\n', "\n\n")
+    );
+    s += "## Evaluation set, tuned thresholds\n\n";
+    s += &v.eval.markdown();
+    s += "\n## Evaluation set, the diagnosis's default thresholds\n\n";
+    s += &v.eval_default.markdown();
+    s += "\n## Tuning set (thresholds chosen here)\n\n";
+    s += &v.tune.markdown();
+    s += "\n## What each truth does to the record (mean against the clean records)\n\n";
+    s += "| truth | strength | x amplitude | y amplitude | p amplitude | frequency |\n|---|---|---|---|---|---|\n";
+    for g in &v.signatures {
+        s += &format!(
+            "| {} | {} | {:+.1} % | {:+.1} % | {:+.1} % | {:+.2} % |\n",
+            g.label,
+            g.strength,
+            100.0 * g.x_amp,
+            100.0 * g.y_amp,
+            100.0 * g.p_amp,
+            100.0 * g.freq
+        );
+    }
+    s += "\n## Cases\n\n| # | set | truth | strength | seed | verdict (default) | closure of [95 % CI] | tuned verdict | time (s) |\n|---|---|---|---|---|---|---|---|---|\n";
+    for c in &v.cases {
+        s += &case_row(c);
+        s.push('\n');
+    }
+    for c in v.cases.iter().filter(|c| c.error.is_some()) {
+        s += &format!(
+            "\ncase {} failed: {}\n",
+            c.index,
+            c.error.as_deref().unwrap_or("")
+        );
+    }
+    s
+}
+
+/// Write `selfcheck.json` and `selfcheck.md` into `dir` (created); returns their paths.
+pub fn write(v: &VerdictCheck, dir: &Path) -> Result<[PathBuf; 2], DiagnoseError> {
+    let io = |path: &Path| {
+        let path = path.to_path_buf();
+        move |source| DiagnoseError::Io { path, source }
+    };
+    std::fs::create_dir_all(dir).map_err(io(dir))?;
+    let (json, md) = (dir.join("selfcheck.json"), dir.join("selfcheck.md"));
+    let text = serde_json::to_string_pretty(v).map_err(|e| DiagnoseError::Io {
+        path: json.clone(),
+        source: std::io::Error::other(e),
+    })?;
+    std::fs::write(&json, text).map_err(io(&json))?;
+    std::fs::write(&md, markdown(v)).map_err(io(&md))?;
+    Ok([json, md])
+}
