@@ -19,6 +19,8 @@ mod adapter;
 pub mod block_lu;
 /// Periodic motion: settling, the cycle figures.
 pub mod cycle;
+/// Dense-output helpers of the step loop (crossings, step hook, error mapping).
+mod dense_output;
 /// The step loop.
 pub mod integrate;
 /// The monodromy matrix without the `n (n + 1)`-state variational system.
