@@ -27,6 +27,8 @@ pub mod integrate;
 pub mod monodromy;
 /// The nonphysical-state check run after every accepted step.
 pub mod physical;
+/// Forward sensitivities by the staggered corrector (diffsol's sensitivity BDF).
+pub mod sens;
 /// Limit cycles by single shooting.
 pub mod shooting;
 /// The ODE systems the integrator runs.
@@ -43,6 +45,7 @@ pub use integrate::{
     SimOptions, SolverStats, Trajectory, SPARSE_THRESHOLD,
 };
 pub use physical::PhysicalCheck;
+pub use sens::{integrate_sens, SensSystem};
 pub use shooting::{
     floquet_multipliers, floquet_multipliers_scaled, flow_with_monodromy, flow_with_monodromy_by,
     shoot, LimitCycle, MonodromyMethod, ShootingOptions,
