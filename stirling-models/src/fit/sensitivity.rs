@@ -9,7 +9,7 @@
 
 use stirling_dsl::{JacSink, Model};
 
-use crate::sim::{integrate, integrate_sens, Hooks, OdeSystem, SensSystem, SimError, SimOptions};
+use crate::sim::OdeSystem;
 
 /// A prescribed signal: cubic Hermite through uniform samples of a value and its derivative.
 #[derive(Clone, Debug)]
@@ -133,7 +133,7 @@ impl Driven<'_> {
 impl Driven<'_> {
     /// The rate of every prescribed state per unit of column `c` at `t` (empty when the
     /// column moves no prescribed state: parameters and initial states).
-    fn input_rates(&self, c: &Column, t: f64) -> Vec<f64> {
+    pub(super) fn input_rates(&self, c: &Column, t: f64) -> Vec<f64> {
         match c {
             Column::Param { .. } | Column::Initial { .. } => Vec::new(),
             Column::Input { du, scale } => du.iter().map(|d| d * scale).collect(),
@@ -254,131 +254,5 @@ impl OdeSystem for Driven<'_> {
             s.extend_from_slice(&self.zscale);
         }
         s
-    }
-}
-
-impl Driven<'_> {
-    /// Integrate from the free states `z0` to `t_end`; one row per sample: `[z, vec(S)]`
-    /// (`z` alone without columns). The columns go through the staggered corrector
-    /// ([`crate::sim::sens`]): the free states by BDF Newton, every column with the same
-    /// `nz x nz` factorization.
-    pub fn integrate(
-        &self,
-        z0: &[f64],
-        t_end: f64,
-        samples: &[f64],
-        opts: &SimOptions,
-    ) -> Result<Vec<Vec<f64>>, SimError> {
-        let states = States(self);
-        if self.columns.is_empty() {
-            let traj = integrate(&states, z0, t_end, samples, opts, Hooks::default())?;
-            return Ok(traj.x);
-        }
-        integrate_sens(&states, self, z0, t_end, samples, opts)
-    }
-
-    /// The free states' Jacobian block `J_zz` (column-major `nz x nz`) and the full dense
-    /// Jacobian at `t` with free states `z`.
-    fn jacobians(&self, t: f64, z: &[f64]) -> (Vec<f64>, Vec<f64>) {
-        let nz = self.free.len();
-        let n = self.model.n_states();
-        let x = self.full_state(t, z);
-        let j = self.model.jacobian_dense(&self.p, &x, t);
-        let mut jzz = vec![0.0; nz * nz];
-        for (c, &ic) in self.free.iter().enumerate() {
-            for (r, &ir) in self.free.iter().enumerate() {
-                jzz[r + c * nz] = j[ir + n * ic];
-            }
-        }
-        (jzz, j)
-    }
-}
-
-/// The free states of a [`Driven`] system alone (its sensitivities go to [`SensSystem`]).
-struct States<'d, 'a>(&'d Driven<'a>);
-
-impl OdeSystem for States<'_, '_> {
-    fn dim(&self) -> usize {
-        self.0.free.len()
-    }
-
-    fn rhs(&self, t: f64, z: &[f64], out: &mut [f64]) {
-        let d = self.0;
-        let x = d.full_state(t, z);
-        let mut f = vec![0.0; d.model.n_states()];
-        d.model.rhs(&d.p, &x, t, &mut f);
-        for (k, &i) in d.free.iter().enumerate() {
-            out[k] = f[i];
-        }
-    }
-
-    fn jac(&self, t: f64, z: &[f64], jac: &mut [f64]) {
-        let (jzz, _) = self.0.jacobians(t, z);
-        jac.iter_mut().zip(&jzz).for_each(|(a, b)| *a += b);
-    }
-
-    fn scale(&self) -> Vec<f64> {
-        self.0.zscale.clone()
-    }
-}
-
-impl SensSystem for Driven<'_> {
-    fn n_sens(&self) -> usize {
-        self.columns.len()
-    }
-
-    /// Column `c`: `f_p[:, index] scale` (parameter), `0` (initial state), or
-    /// `f_u du/dtheta` (prescribed inputs), restricted to the free rows.
-    fn sens_forcing(&self, t: f64, z: &[f64], out: &mut [f64]) {
-        let (nz, n) = (self.free.len(), self.model.n_states());
-        out.fill(0.0);
-        let x = self.full_state(t, z);
-        let need_p = self.columns.iter().any(|c| matches!(c, Column::Param { .. }));
-        let jp = if need_p {
-            self.model.param_jacobian_dense(&self.p, &x, t)
-        } else {
-            Vec::new()
-        };
-        let need_u = self
-            .columns
-            .iter()
-            .any(|c| matches!(c, Column::Input { .. } | Column::Signals { .. }));
-        let j = if need_u {
-            self.model.jacobian_dense(&self.p, &x, t)
-        } else {
-            Vec::new()
-        };
-        for (k, c) in self.columns.iter().enumerate() {
-            let o = &mut out[k * nz..(k + 1) * nz];
-            match c {
-                Column::Param { index, scale } => {
-                    for (r, &ir) in self.free.iter().enumerate() {
-                        o[r] = jp[ir + n * index] * scale;
-                    }
-                }
-                Column::Initial { .. } => {}
-                _ => {
-                    let du = self.input_rates(c, t);
-                    for (r, &ir) in self.free.iter().enumerate() {
-                        o[r] = self
-                            .given
-                            .iter()
-                            .zip(&du)
-                            .map(|(g, d)| j[ir + n * g.state] * d)
-                            .sum();
-                    }
-                }
-            }
-        }
-    }
-
-    fn sens_initial(&self, out: &mut [f64]) {
-        let nz = self.free.len();
-        out.fill(0.0);
-        for (k, c) in self.columns.iter().enumerate() {
-            if let Column::Initial { pos, scale } = c {
-                out[k * nz + pos] = *scale;
-            }
-        }
     }
 }

@@ -16,8 +16,8 @@ use serde::Serialize;
 use stirling_dsl::Model;
 
 use super::adapter::{Backend, DenseM, Eqn, SparseM};
-use super::dense_output::{crossing_between, map_err, on_step};
 use super::block_lu::BlockLu;
+use super::dense_output::{crossing_between, map_err, on_step};
 use super::system::{ModelSystem, OdeSystem};
 use super::SimError;
 

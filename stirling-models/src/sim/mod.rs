@@ -23,6 +23,8 @@ pub mod cycle;
 mod dense_output;
 /// The step loop.
 pub mod integrate;
+/// A dense LU solving many right-hand-side lanes at once (the sensitivity columns).
+pub mod lane_lu;
 /// The monodromy matrix without the `n (n + 1)`-state variational system.
 pub mod monodromy;
 /// The nonphysical-state check run after every accepted step.

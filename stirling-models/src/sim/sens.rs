@@ -14,13 +14,13 @@
 //! Dense storage only: the driven subsystems the fit integrates have a few states.
 
 use diffsol::{
-    ConstantOpSens, Matrix, NalgebraLU, NonLinearOpSens, OdeBuilder, OdeSolverMethod,
-    OdeSolverStopReason,
+    ConstantOpSens, Matrix, NonLinearOpSens, OdeBuilder, OdeSolverMethod, OdeSolverStopReason,
 };
 
 use super::adapter::{Backend, DenseM, Eqn, Init, Rhs};
 use super::dense_output::map_err;
 use super::integrate::SimOptions;
+use super::lane_lu::LaneLu;
 use super::system::OdeSystem;
 use super::SimError;
 
@@ -135,9 +135,7 @@ pub fn integrate_sens(
     problem.ode_options.min_timestep = opts.min_step;
     // as in `integrate`: Newton failures are counted over the run; the step-size floor stops
     problem.ode_options.max_nonlinear_solver_failures = opts.max_steps;
-    let mut solver = problem
-        .bdf_sens::<NalgebraLU<f64>>()
-        .map_err(|e| map_err(e, 0.0))?;
+    let mut solver = problem.bdf_sens::<LaneLu>().map_err(|e| map_err(e, 0.0))?;
     solver.set_stop_time(t_end).map_err(|e| map_err(e, 0.0))?;
     let mut rows = Vec::with_capacity(samples.len());
     let mut next = 0;
