@@ -24,8 +24,14 @@ fn bench(c: &mut Criterion) {
             scale: p[model.param_index(q).unwrap()],
         })
         .collect();
-    columns.push(Column::Initial { pos: 0, scale: 1e-3 });
-    columns.push(Column::Initial { pos: 1, scale: 1e-2 });
+    columns.push(Column::Initial {
+        pos: 0,
+        scale: 1e-3,
+    });
+    columns.push(Column::Initial {
+        pos: 1,
+        scale: 1e-2,
+    });
     let sys = Driven {
         model: model.as_ref(),
         p: p.clone(),
