@@ -20,7 +20,7 @@ use super::sensors::lag_columns;
 use super::vars::{Output, Var, VarKind, MIN_RATIO};
 use super::FitError;
 use crate::signal::project_drift;
-use crate::sim::{integrate, state_scale, Hooks, LinearSolverKind, SimOptions};
+use crate::sim::{state_scale, SimOptions};
 
 /// A driven-subsystem fitting problem on a uniform record.
 #[derive(Clone)]
@@ -223,22 +223,13 @@ impl Stage<'_> {
         z0: &[f64],
         steps: usize,
     ) -> Result<Vec<Vec<f64>>, FitError> {
-        let x0 = sys.initial(z0);
         let samples: Vec<f64> = (0..=steps).map(|k| k as f64 * self.dt).collect();
         let t_end = samples[samples.len() - 1].max(self.dt);
-        let mut sim = self.sim;
-        if sim.linear_solver == LinearSolverKind::Auto && sys.columns.len() >= 2 {
-            // block-diagonal Newton matrix: the sparse LU factors the blocks one by one
-            sim.linear_solver = LinearSolverKind::Sparse;
-        }
-        let traj =
-            integrate(sys, &x0, t_end, &samples, &sim, Hooks::default()).map_err(|source| {
-                FitError::Sim {
-                    stage: self.name.to_string(),
-                    source,
-                }
-            })?;
-        Ok(traj.x)
+        sys.integrate(z0, t_end, &samples, &self.sim)
+            .map_err(|source| FitError::Sim {
+                stage: self.name.to_string(),
+                source,
+            })
     }
 
     /// The model parameters, initial free states, prescribed states and sensitivity columns

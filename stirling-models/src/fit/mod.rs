@@ -44,6 +44,8 @@ pub mod sensitivity;
 pub mod sensors;
 /// Fitting one driven stage.
 pub mod stage_fit;
+/// The driven subsystems' sensitivities by the staggered corrector.
+pub mod staggered;
 /// The static response of the bodies to a pressure offset.
 pub mod static_shift;
 /// Pressures the mechanics need but the record lacks.

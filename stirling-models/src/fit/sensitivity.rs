@@ -133,7 +133,7 @@ impl Driven<'_> {
 impl Driven<'_> {
     /// The rate of every prescribed state per unit of column `c` at `t` (empty when the
     /// column moves no prescribed state: parameters and initial states).
-    fn input_rates(&self, c: &Column, t: f64) -> Vec<f64> {
+    pub(super) fn input_rates(&self, c: &Column, t: f64) -> Vec<f64> {
         match c {
             Column::Param { .. } | Column::Initial { .. } => Vec::new(),
             Column::Input { du, scale } => du.iter().map(|d| d * scale).collect(),

@@ -17,6 +17,7 @@ use diffsol::{
 };
 use faer::sparse::{Pair, SymbolicSparseColMat};
 
+use super::sens::SensSystem;
 use super::system::OdeSystem;
 
 /// A diffsol matrix type the adapter can fill.
@@ -115,12 +116,17 @@ pub(crate) fn scatter(
 /// A system with its initial state and call counters.
 pub(crate) struct Eqn<'s, M: Backend> {
     pub sys: &'s dyn OdeSystem,
+    /// The forward sensitivities diffsol integrates alongside (staggered), if any.
+    pub sens: Option<&'s dyn SensSystem>,
     pub y0: Vec<f64>,
     pub ctx: M::C,
     pub sparsity: Option<M::Sparsity>,
     pub n_rhs: Cell<usize>,
     pub n_jac: Cell<usize>,
     trip: RefCell<Vec<(usize, usize, f64)>>,
+    /// `df/dx` as triplets at the `(t, x)` of the last Jacobian-vector product: the
+    /// sensitivity corrector multiplies every column by the Jacobian at one state per step.
+    jmul: RefCell<(f64, Vec<f64>, Vec<(usize, usize, f64)>)>,
 }
 
 impl<'s, M: Backend> Eqn<'s, M> {
@@ -128,18 +134,33 @@ impl<'s, M: Backend> Eqn<'s, M> {
         let sparsity = M::pattern(sys, &y0);
         Self {
             sys,
+            sens: None,
             y0,
             ctx: M::new_ctx(),
             sparsity,
             n_rhs: Cell::new(0),
             n_jac: Cell::new(0),
             trip: RefCell::new(Vec::new()),
+            jmul: RefCell::new((f64::NAN, Vec::new(), Vec::new())),
         }
+    }
+
+    /// [`Eqn::new`] with forward sensitivities.
+    pub fn with_sens(sys: &'s dyn OdeSystem, sens: &'s dyn SensSystem, y0: Vec<f64>) -> Self {
+        Self {
+            sens: Some(sens),
+            ..Self::new(sys, y0)
+        }
+    }
+
+    /// Number of sensitivity columns (diffsol's parameters).
+    fn n_sens(&self) -> usize {
+        self.sens.map_or(0, |s| s.n_sens())
     }
 }
 
-pub(crate) struct Rhs<'a, 's, M: Backend>(&'a Eqn<'s, M>);
-pub(crate) struct Init<'a, 's, M: Backend>(&'a Eqn<'s, M>);
+pub(crate) struct Rhs<'a, 's, M: Backend>(pub(crate) &'a Eqn<'s, M>);
+pub(crate) struct Init<'a, 's, M: Backend>(pub(crate) &'a Eqn<'s, M>);
 
 macro_rules! impl_op {
     ($t:ident) => {
@@ -158,7 +179,7 @@ macro_rules! impl_op {
                 self.0.y0.len()
             }
             fn nparams(&self) -> usize {
-                0
+                self.0.n_sens()
             }
             fn statistics(&self) -> OpStatistics {
                 let mut s = OpStatistics::default();
@@ -180,14 +201,24 @@ impl<M: Backend> NonLinearOp for Rhs<'_, '_, M> {
 }
 
 impl<M: Backend> NonLinearOpJacobian for Rhs<'_, '_, M> {
+    /// `y = J(x) v` for every lane of `v` (the sensitivity corrector passes all columns at
+    /// once, `n` entries a lane); `J` is kept for repeated products at one `(t, x)`.
     fn jac_mul_inplace(&self, x: &M::V, t: f64, v: &M::V, y: &mut M::V) {
-        let mut trip = self.0.trip.borrow_mut();
-        trip.clear();
-        self.0.sys.jac_triplets(t, M::slice(x), &mut trip);
+        let x = M::slice(x);
+        let mut cache = self.0.jmul.borrow_mut();
+        let (tc, xc, trip) = &mut *cache;
+        if *tc != t || xc.as_slice() != x {
+            trip.clear();
+            self.0.sys.jac_triplets(t, x, trip);
+            (*tc, *xc) = (t, x.to_vec());
+        }
+        let n = self.0.y0.len();
         let (v, y) = (M::slice(v), M::slice_mut(y));
         y.fill(0.0);
-        for &(r, c, a) in trip.iter() {
-            y[r] += a * v[c];
+        for o in (0..v.len()).step_by(n.max(1)) {
+            for &(r, c, a) in trip.iter() {
+                y[o + r] += a * v[o + c];
+            }
         }
     }
     fn jacobian_inplace(&self, x: &M::V, t: f64, y: &mut M) {
@@ -220,7 +251,7 @@ impl<M: Backend> Op for Eqn<'_, M> {
         self.y0.len()
     }
     fn nparams(&self) -> usize {
-        0
+        self.n_sens()
     }
 }
 

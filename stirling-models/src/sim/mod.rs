@@ -19,12 +19,18 @@ mod adapter;
 pub mod block_lu;
 /// Periodic motion: settling, the cycle figures.
 pub mod cycle;
+/// Dense-output helpers of the step loop (crossings, step hook, error mapping).
+mod dense_output;
 /// The step loop.
 pub mod integrate;
+/// A dense LU solving many right-hand-side lanes at once (the sensitivity columns).
+pub mod lane_lu;
 /// The monodromy matrix without the `n (n + 1)`-state variational system.
 pub mod monodromy;
 /// The nonphysical-state check run after every accepted step.
 pub mod physical;
+/// Forward sensitivities by the staggered corrector (diffsol's sensitivity BDF).
+pub mod sens;
 /// Limit cycles by single shooting.
 pub mod shooting;
 /// The ODE systems the integrator runs.
@@ -41,6 +47,7 @@ pub use integrate::{
     SimOptions, SolverStats, Trajectory, SPARSE_THRESHOLD,
 };
 pub use physical::PhysicalCheck;
+pub use sens::{integrate_sens, SensSystem};
 pub use shooting::{
     floquet_multipliers, floquet_multipliers_scaled, flow_with_monodromy, flow_with_monodromy_by,
     shoot, LimitCycle, MonodromyMethod, ShootingOptions,
