@@ -1,6 +1,8 @@
 //! Which free parameter belongs to which stage: a parameter whose column of the parameter
 //! Jacobian touches a body's velocity row is mechanical (stage 1), one that touches a gas
-//! row is a gas parameter (stage 2).
+//! row is a gas parameter (stage 2). Walls with a heat capacity are integrated by the gas
+//! stage, so a parameter that enters only wall rows (a matrix's or a heater head's inverse
+//! capacity, inert at its null) is a gas parameter too.
 
 use stirling_dsl::{Model, StateKind};
 
@@ -39,7 +41,10 @@ pub fn classify(
             .zip(col)
             .any(|(s, v)| matches!(s.kind, StateKind::Velocity(_)) && *v != 0.0);
         let g = st.iter().zip(col).any(|(s, v)| {
-            matches!(s.kind, StateKind::Pressure(_) | StateKind::Mass(_)) && *v != 0.0
+            matches!(
+                s.kind,
+                StateKind::Pressure(_) | StateKind::Mass(_) | StateKind::WallTemperature(_)
+            ) && *v != 0.0
         });
         if !body && !g {
             return Err(FitError::NotInEquations {

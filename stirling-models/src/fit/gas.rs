@@ -65,7 +65,10 @@ pub fn stage<'a>(
     let mut vars = Var::params(model, p, free, opts.prior);
     let outputs = pressure_outputs(layout, rec, &eq, &shift, &mut vars);
     let x_start = initial_state(model, layout, rec, p, &eq, x_off);
-    let z0: Vec<f64> = layout.gas.iter().map(|&i| x_start[i]).collect();
+    // the gas stage integrates the walls with a heat capacity too (after the gas states, so
+    // the gas positions stay those of `layout.gas`): a wall is driven by the gas it touches
+    let free: Vec<usize> = layout.gas.iter().chain(&layout.walls).copied().collect();
+    let z0: Vec<f64> = free.iter().map(|&i| x_start[i]).collect();
     let (tr, dt) = (rec.tr, rec.dt);
     let burn = ((opts.burn_in / dt).round() as usize).min(tr.1 - tr.0 - 5);
     let stage = Stage {
@@ -76,7 +79,7 @@ pub fn stage<'a>(
         model,
         p: p.to_vec(),
         base: eq,
-        free: layout.gas.clone(),
+        free,
         given,
         signals: vec![sx, sy],
         z0,
