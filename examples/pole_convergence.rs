@@ -14,7 +14,7 @@ use stirling::models::linear::{dynamic_poles, NewtonOptions, PoleRoute};
 
 const NS: [usize; 13] = [1, 2, 5, 10, 20, 50, 100, 200, 500, 1000, 2000, 5000, 10_000];
 
-fn main() -> anyhow::Result<()> {
+fn main() -> Result<(), Box<dyn std::error::Error>> {
     let args: Vec<String> = std::env::args().collect();
     let ns: Vec<usize> = match args.iter().position(|a| a == "--ns") {
         Some(i) => args[i + 1].split(',').map(str::parse).collect::<Result<_, _>>()?,
@@ -33,7 +33,7 @@ fn main() -> anyhow::Result<()> {
             .poles
             .iter()
             .find(|q| q.im > 0.0)
-            .ok_or_else(|| anyhow::anyhow!("n = {n}: no complex pole"))?;
+            .ok_or_else(|| format!("n = {n}: no complex pole"))?;
         let change = prev.map_or("-".to_string(), |(re, im)| {
             format!("{:.2e}", (top.re - re).hypot(top.im - im) / top.re.hypot(top.im))
         });

@@ -21,7 +21,7 @@ use super::LinearError;
 /// The smallest state count that takes the sparse dominant route under [`PoleRequest::Auto`].
 pub const DOMINANT_FROM: usize = 401;
 /// Dominant poles kept by [`PoleRequest::Auto`] on the sparse route.
-pub const DOMINANT_K: usize = 8;
+pub const DOMINANT_K: usize = 5;
 
 /// Which poles are wanted.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]

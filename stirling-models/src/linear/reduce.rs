@@ -184,7 +184,11 @@ pub fn reduce_sparse(j: &super::sparse::SparseMatrix, mass: &[usize]) -> Reducti
         };
     };
     let n = j.n;
-    let is_mass = |i: usize| mass.contains(&i);
+    let mut flag = vec![false; n];
+    for &i in mass {
+        flag[i] = true;
+    }
+    let is_mass = |i: usize| flag[i];
     let (mut cj, mut ccj) = (vec![0.0; n], 0.0);
     for &(_, c, v) in j.entries.iter().filter(|e| is_mass(e.0)) {
         cj[c] += v;
