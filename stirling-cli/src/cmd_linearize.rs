@@ -40,6 +40,13 @@ pub struct LinearizeArgs {
     /// Overwrite existing figures and an existing --ss file
     #[arg(long)]
     pub force: bool,
+    /// All poles by the dense route at any size (default: all up to 400 states, above that the
+    /// dominant ones by sparse shift-invert Arnoldi)
+    #[arg(long, conflicts_with = "dominant")]
+    pub all_poles: bool,
+    /// The K rightmost poles by the sparse route at any size
+    #[arg(long, value_name = "K", value_parser = clap::value_parser!(u32).range(1..=200))]
+    pub dominant: Option<u32>,
 }
 
 /// `--json`: the report with the state-space export.
@@ -59,8 +66,14 @@ pub fn run(a: &LinearizeArgs) -> anyhow::Result<()> {
         files::prepare_file(f, a.force, "--ss")?;
     }
     let (model, p) = a.model.load()?;
+    let poles = match (a.all_poles, a.dominant) {
+        (true, _) => linear::PoleRequest::All,
+        (false, Some(k)) => linear::PoleRequest::Dominant(k as usize),
+        (false, None) => linear::PoleRequest::Auto,
+    };
     let opts = LinearOptions {
         channel: a.channel.clone(),
+        poles,
         ..Default::default()
     };
     let lin = linear::linearize(model.as_ref(), &p, &opts)
@@ -131,6 +144,7 @@ fn print_text(o: &mut impl Write, r: &LinearReport) -> io::Result<()> {
             inv.eigenvalue, inv.conservation_defect
         )?;
     }
+    writeln!(o, "poles: {}", r.route.describe(r.n_states))?;
     writeln!(
         o,
         "closed-loop poles ({} in the right half plane):",

@@ -6,6 +6,9 @@
 //! so `J` is singular: the last mass equation is replaced by the inventory constraint
 //! `c x = c x0` (the charge of the guess), which makes the system regular.
 //!
+//! Above [`SPARSE_FROM`] states the Newton system is solved by a faer sparse LU of the
+//! Jacobian triplets (same matrix, same row replacement); below, by the dense LU as before.
+//!
 //! Residuals are scaled per state: `r_i = |f_i| / s_i` with `s_i = max(|x0_i|, floor(kind))`,
 //! i.e. the relative rate of change of each state, in 1/s.
 
@@ -14,6 +17,28 @@ use serde::{Deserialize, Serialize};
 use stirling_dsl::{Model, StateKind};
 
 use super::LinearError;
+
+/// The smallest state count whose Newton systems are solved by the sparse LU.
+pub const SPARSE_FROM: usize = 401;
+
+/// How the Newton system is solved.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum NewtonSolver {
+    /// Dense below [`SPARSE_FROM`] states, sparse from there on.
+    Auto,
+    Dense,
+    Sparse,
+}
+
+impl NewtonSolver {
+    fn sparse(self, n: usize) -> bool {
+        match self {
+            Self::Auto => n >= SPARSE_FROM,
+            Self::Dense => false,
+            Self::Sparse => true,
+        }
+    }
+}
 
 /// Newton settings.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -107,6 +132,18 @@ pub fn solve_from(
     x0: &[f64],
     opts: &NewtonOptions,
 ) -> Result<Equilibrium, LinearError> {
+    solve_with(model, p, x0, opts, NewtonSolver::Auto)
+}
+
+/// [`solve_from`] with the linear solver chosen by the caller.
+pub fn solve_with(
+    model: &dyn Model,
+    p: &[f64],
+    x0: &[f64],
+    opts: &NewtonOptions,
+    solver: NewtonSolver,
+) -> Result<Equilibrium, LinearError> {
+    let sparse = solver.sparse(x0.len());
     let s = state_scales(model, x0);
     let masses = mass_states(model);
     let charge: f64 = masses.iter().map(|&i| x0[i]).sum();
@@ -123,8 +160,12 @@ pub fn solve_from(
             });
         }
         it += 1;
-        let dx = newton_step(model, p, &x, &f, &masses, charge)
-            .ok_or(LinearError::Singular { iteration: it })?;
+        let dx = if sparse {
+            sparse_newton_step(model, p, &x, &f, &masses, charge)
+        } else {
+            newton_step(model, p, &x, &f, &masses, charge)
+        }
+        .ok_or(LinearError::Singular { iteration: it })?;
         let (xn, fnew, rn) = line_search(model, p, &x, &dx, &s, r)?;
         x = xn;
         f = fnew;
@@ -158,6 +199,28 @@ fn newton_step(
         rhs[last] = charge - masses.iter().map(|&i| x[i]).sum::<f64>();
     }
     super::solve::solve(&j, &rhs)
+}
+
+/// The same Newton system as [`newton_step`], as triplets, by the sparse LU.
+fn sparse_newton_step(
+    model: &dyn Model,
+    p: &[f64],
+    x: &[f64],
+    f: &[f64],
+    masses: &[usize],
+    charge: f64,
+) -> Option<DVector<f64>> {
+    let n = x.len();
+    let mut entries = model.jacobian_triplets(p, x, 0.0);
+    let mut rhs: Vec<f64> = f.iter().map(|v| -v).collect();
+    if let Some(&last) = masses.last() {
+        entries.retain(|e| e.0 != last);
+        entries.extend(masses.iter().map(|&i| (last, i, 1.0)));
+        rhs[last] = charge - masses.iter().map(|&i| x[i]).sum::<f64>();
+    }
+    let m = super::sparse::SparseMatrix { n, entries };
+    let dx = super::sparse::solve_real(&m, &rhs).ok()??;
+    Some(DVector::from_vec(dx))
 }
 
 type Trial = (Vec<f64>, Vec<f64>, f64);

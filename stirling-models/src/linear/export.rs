@@ -233,10 +233,19 @@ pub fn export(model: &dyn Model, lin: &Linearization) -> StateSpaceExport {
     let (b, k) = (el.b(&ol.full.b), el.c(&ol.full.k()));
     let input = format!("{} ({})", ol.full.name, ol.full.unit);
     let output = format!("K x, fed back as u = -K x ({})", ol.full.unit);
-    let mut broken = system(&el.a(&ol.full.a), &b, &k, &ol.poles);
+    // The sparse route keeps neither `J` nor `A0` dense: build them here (the export is dense).
+    let j = lin.dynamics.dense_jacobian();
+    let a0 = if ol.full.a.nrows() == j.nrows() {
+        ol.full.a.clone()
+    } else {
+        let mut a0 = j.clone();
+        a0.ger(-1.0, &ol.full.b, &ol.full.c, 1.0);
+        a0
+    };
+    let mut broken = system(&el.a(&a0), &b, &k, &ol.poles);
     broken.input = format!("u: {input}");
     broken.output = output.clone();
-    let mut closed = system(&el.a(&lin.dynamics.jacobian), &b, &k, &lin.dynamics.poles);
+    let mut closed = system(&el.a(&j), &b, &k, &lin.dynamics.poles);
     closed.input = format!("disturbance added to {input}");
     closed.output = output;
     let bode = lin.bode();

@@ -39,7 +39,7 @@ pub struct LoopBreak {
     pub name: String,
     /// Unit of `u` (`Pa` or `N`).
     pub unit: &'static str,
-    /// `A0 = J - B C`.
+    /// `A0 = J - B C` (empty `0 x 0` on the sparse route).
     pub a: DMatrix<f64>,
     /// Input column.
     pub b: DVector<f64>,
@@ -126,6 +126,21 @@ pub fn break_loop(
     j: &DMatrix<f64>,
     channel: Channel,
 ) -> Result<LoopBreak, LinearError> {
+    let mut lb = break_loop_input(model, p, x, channel)?;
+    let mut a = j.clone();
+    a.ger(-1.0, &lb.b, &lb.c, 1.0);
+    lb.a = a;
+    Ok(lb)
+}
+
+/// [`break_loop`] without `A0` (left `0 x 0`): `B` and `C` only, for large models whose
+/// `A0 = J - B C` is used in sparse form.
+pub fn break_loop_input(
+    model: &dyn Model,
+    p: &[f64],
+    x: &[f64],
+    channel: Channel,
+) -> Result<LoopBreak, LinearError> {
     let n = x.len();
     let mut masses = vec![0.0; model.bodies().len()];
     model.body_masses(p, &mut masses);
@@ -152,13 +167,11 @@ pub fn break_loop(
             (b, grad_p, "pressure".to_string(), "Pa")
         }
     };
-    let mut a = j.clone();
-    a.ger(-1.0, &b, &c, 1.0);
     Ok(LoopBreak {
         channel,
         name,
         unit,
-        a,
+        a: DMatrix::zeros(0, 0),
         b,
         c,
     })

@@ -9,6 +9,11 @@
 //!    `L(s) = K (sI - A0)^-1 B` with `A0 - B K = J`, evaluated by [`response`];
 //! 6. [`margins`] of `L(jw)` as MATLAB's `margin`, and [`bode`] / Nyquist data.
 //!
+//! Large models (from [`dynamics::DOMINANT_FROM`] states) take a sparse route: the Newton
+//! system by sparse LU, the dominant poles by shift-invert Arnoldi ([`dominant`]), `L(jw)` by a
+//! sparse solve per frequency on the full state ([`sparse_response`]); [`DynamicPoles::route`]
+//! and [`LinearReport::route`] say which route was taken.
+//!
 //! [`locus`] repeats 1-4 over a parameter range. [`LinearReport`] is the serializable summary
 //! that `stirling linearize --json` prints.
 
@@ -16,6 +21,10 @@
 pub mod balance;
 /// Bode and Nyquist data of `L(jw)` on a frequency grid, and the grid itself.
 pub mod bode;
+/// The dominant poles of a large model by shift-invert Arnoldi on the sparse Jacobian.
+pub mod dominant;
+/// Steps 1-4 (equilibrium, Jacobian, reduction, poles) and the choice of route by size.
+pub mod dynamics;
 /// The equilibrium `f(x*) = 0` by Newton's method with the analytic Jacobian.
 pub mod equilibrium;
 /// The linear results as control engineers use them.
@@ -34,12 +43,20 @@ pub mod reduce;
 pub mod response;
 /// Dense real linear solves `A x = b` by LU with partial pivoting (faer).
 pub mod solve;
+/// Sparse matrices as triplets and faer sparse LU solves, real and complex-shifted.
+pub mod sparse;
+/// `L(jw)` of a large model by sparse solves on the full state.
+pub mod sparse_response;
+#[cfg(test)]
+mod tests_sparse;
 
 use nalgebra::{DMatrix, DVector};
 use serde::{Deserialize, Serialize};
 use stirling_dsl::Model;
 
 pub use bode::{Bode, Nyquist};
+pub use dominant::{dominant_poles, DominantOptions, DominantPoles};
+pub use dynamics::{dynamic_poles, dynamic_poles_with, DynamicPoles, PoleRequest, PoleRoute};
 pub use equilibrium::{Equilibrium, NewtonOptions};
 pub use locus::{Locus, LocusPoint};
 pub use loop_break::{Channel, LoopBreak};
@@ -49,6 +66,7 @@ pub use nalgebra;
 pub use poles::Pole;
 pub use reduce::{InventoryMode, Reduction};
 pub use response::FrequencyResponse;
+pub use sparse_response::{LoopResponse, SparseResponse};
 
 /// Why a linear analysis cannot be done.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
@@ -83,6 +101,18 @@ pub enum LinearError {
     Param(String),
     #[error("eigenvalue computation failed: {0}")]
     Eigen(String),
+    #[error("dominant poles: no Ritz value converged at any shift; the smallest residual {residual:.3e} was at the shift {shift_re} {shift_im:+}j rad/s")]
+    NoDominantPoles {
+        shift_re: f64,
+        shift_im: f64,
+        residual: f64,
+    },
+    #[error("sparse LU of the Jacobian shifted by {shift_re} {shift_im:+}j rad/s failed: {why}")]
+    ShiftFactor {
+        shift_re: f64,
+        shift_im: f64,
+        why: String,
+    },
 }
 
 /// Settings of [`linearize`].
@@ -93,6 +123,8 @@ pub struct LinearOptions {
     pub newton: NewtonOptions,
     /// Grid density for crossovers and Bode data (points per decade).
     pub per_decade: usize,
+    /// All poles (dense) or the dominant ones (sparse); by size unless asked.
+    pub poles: PoleRequest,
 }
 
 impl Default for LinearOptions {
@@ -101,38 +133,9 @@ impl Default for LinearOptions {
             channel: None,
             newton: NewtonOptions::default(),
             per_decade: 100,
+            poles: PoleRequest::Auto,
         }
     }
-}
-
-/// Equilibrium, Jacobian, reduction and poles: steps 1-4 of the pipeline.
-#[derive(Clone, Debug)]
-pub struct DynamicPoles {
-    pub equilibrium: Equilibrium,
-    /// The full Jacobian at the equilibrium.
-    pub jacobian: DMatrix<f64>,
-    pub reduction: Reduction,
-    /// Poles of the reduced Jacobian, sorted.
-    pub poles: Vec<Pole>,
-}
-
-/// Steps 1-4: equilibrium, Jacobian, inventory reduction and poles.
-pub fn dynamic_poles(
-    model: &dyn Model,
-    p: &[f64],
-    newton: &NewtonOptions,
-) -> Result<DynamicPoles, LinearError> {
-    let equilibrium = equilibrium::solve(model, p, newton)?;
-    let n = model.n_states();
-    let jacobian = DMatrix::from_vec(n, n, model.jacobian_dense(p, &equilibrium.x, 0.0));
-    let reduction = reduce::reduce(&jacobian, &equilibrium::mass_states(model));
-    let poles = poles::poles(&reduction.a)?;
-    Ok(DynamicPoles {
-        equilibrium,
-        jacobian,
-        reduction,
-        poles,
-    })
 }
 
 /// The loop broken at one channel, reduced on the inventory.
@@ -140,13 +143,13 @@ pub fn dynamic_poles(
 pub struct OpenLoop {
     /// The triple in full state coordinates.
     pub full: LoopBreak,
-    /// `T' A0 T`, `T' B`, `K T` (the full triple without mass states).
+    /// `T' A0 T` (empty on the sparse route), `T' B`, `K T` (the full triple without mass states).
     pub a: DMatrix<f64>,
     pub b: DVector<f64>,
     pub k: DVector<f64>,
-    /// Poles of the open loop (`eig A0`), sorted.
+    /// Poles of the open loop (`eig A0`), sorted: all, or the dominant ones on the sparse route.
     pub poles: Vec<Pole>,
-    pub response: FrequencyResponse,
+    pub response: LoopResponse,
 }
 
 impl OpenLoop {
@@ -172,28 +175,15 @@ pub fn linearize(
     p: &[f64],
     opts: &LinearOptions,
 ) -> Result<Linearization, LinearError> {
-    let dynamics = dynamic_poles(model, p, &opts.newton)?;
+    let dynamics = dynamic_poles_with(model, p, &opts.newton, opts.poles)?;
     let x = &dynamics.equilibrium.x;
     let channel = match &opts.channel {
         Some(name) => loop_break::parse_channel(model, p, x, name)?,
         None => loop_break::default_channel(model, p, x),
     };
-    let full = loop_break::break_loop(model, p, x, &dynamics.jacobian, channel)?;
-    let red = &dynamics.reduction;
-    let (a, b, k) = (
-        red.reduce(&full.a),
-        red.project(&full.b),
-        red.project(&full.k()),
-    );
-    let ol_poles = poles::poles(&a)?;
-    let response = FrequencyResponse::new(&a, &b, &k);
-    let open_loop = OpenLoop {
-        full,
-        a,
-        b,
-        k,
-        poles: ol_poles,
-        response,
+    let open_loop = match &dynamics.sparse {
+        None => dense_open_loop(model, p, &dynamics, channel)?,
+        Some(j) => sparse_open_loop(model, p, &dynamics, j, channel)?,
     };
     let all: Vec<Pole> = dynamics
         .poles
@@ -213,6 +203,71 @@ pub fn linearize(
         open_loop,
         grid,
         margins,
+    })
+}
+
+fn dense_open_loop(
+    model: &dyn Model,
+    p: &[f64],
+    dynamics: &DynamicPoles,
+    channel: Channel,
+) -> Result<OpenLoop, LinearError> {
+    let x = &dynamics.equilibrium.x;
+    let full = loop_break::break_loop(model, p, x, &dynamics.jacobian, channel)?;
+    let red = &dynamics.reduction;
+    let (a, b, k) = (
+        red.reduce(&full.a),
+        red.project(&full.b),
+        red.project(&full.k()),
+    );
+    let poles = poles::poles(&a)?;
+    let response = LoopResponse::Dense(FrequencyResponse::new(&a, &b, &k));
+    Ok(OpenLoop {
+        full,
+        a,
+        b,
+        k,
+        poles,
+        response,
+    })
+}
+
+/// The open loop of a large model: `A0 = J - B C` stays sparse, its dominant poles by the same
+/// route as the closed loop's, `L(jw)` by sparse solves.
+fn sparse_open_loop(
+    model: &dyn Model,
+    p: &[f64],
+    dynamics: &DynamicPoles,
+    j: &sparse::SparseMatrix,
+    channel: Channel,
+) -> Result<OpenLoop, LinearError> {
+    let x = &dynamics.equilibrium.x;
+    let full = loop_break::break_loop_input(model, p, x, channel)?;
+    let (scales, masses) = (
+        equilibrium::state_scales(model, x),
+        equilibrium::mass_states(model),
+    );
+    let response = SparseResponse::new(j, &full.b, &full.c, &scales, &masses)?;
+    let neg_b: Vec<f64> = full.b.iter().map(|v| -v).collect();
+    let c: Vec<f64> = full.c.iter().copied().collect();
+    let a0 = j.plus_outer(&neg_b, &c);
+    let k = match &dynamics.route {
+        PoleRoute::SparseDominant { k, .. } => *k,
+        PoleRoute::Dense => dynamics::DOMINANT_K,
+    };
+    let opts = DominantOptions {
+        k,
+        ..Default::default()
+    };
+    let poles = dominant::dominant_poles_with(&a0, &scales, &masses, &opts)?.poles;
+    let red = &dynamics.reduction;
+    Ok(OpenLoop {
+        b: red.project(&full.b),
+        k: red.project(&full.k()),
+        full,
+        a: DMatrix::zeros(0, 0),
+        poles,
+        response: LoopResponse::Sparse(response),
     })
 }
 
@@ -238,6 +293,7 @@ impl Linearization {
             state_names: model.state_names(),
             equilibrium: self.dynamics.equilibrium.clone(),
             poles: self.dynamics.poles.clone(),
+            route: self.dynamics.route.clone(),
             rhp_count: self.dynamics.poles.iter().filter(|p| p.rhp).count(),
             inventory_mode: self.dynamics.reduction.inventory.clone(),
             loop_break: LoopReport {
@@ -279,6 +335,9 @@ pub struct LinearReport {
     pub equilibrium: Equilibrium,
     /// Closed-loop (dynamic) poles, sorted by decreasing real part.
     pub poles: Vec<Pole>,
+    /// How the poles were computed (dense: all; sparse: the dominant ones).
+    pub route: PoleRoute,
+    /// Right-half-plane poles among `poles`.
     pub rhp_count: usize,
     pub inventory_mode: Option<InventoryMode>,
     #[serde(rename = "loop")]

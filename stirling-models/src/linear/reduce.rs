@@ -170,3 +170,47 @@ fn unit(n: usize, i: usize) -> DVector<f64> {
     e[i] = 1.0;
     e
 }
+
+/// [`Reduction`] of a large Jacobian given as triplets: the basis `T` and the inventory mode,
+/// without `T' J T` (`a` is empty). The null vector solves the Newton system of
+/// [`super::equilibrium`] (`J r = 0` with the last mass row replaced by `c r = 1`) by sparse LU.
+pub fn reduce_sparse(j: &super::sparse::SparseMatrix, mass: &[usize]) -> Reduction {
+    let empty = DMatrix::zeros(0, 0);
+    let Some(&last) = mass.last() else {
+        return Reduction {
+            a: empty,
+            basis: None,
+            inventory: None,
+        };
+    };
+    let n = j.n;
+    let mut flag = vec![false; n];
+    for &i in mass {
+        flag[i] = true;
+    }
+    let is_mass = |i: usize| flag[i];
+    let (mut cj, mut ccj) = (vec![0.0; n], 0.0);
+    for &(_, c, v) in j.entries.iter().filter(|e| is_mass(e.0)) {
+        cj[c] += v;
+        if is_mass(c) {
+            ccj += v;
+        }
+    }
+    let jmax = j.max_abs().max(f64::MIN_POSITIVE);
+    let mut m = j.clone();
+    m.entries.retain(|e| e.0 != last);
+    m.entries.extend(mass.iter().map(|&i| (last, i, 1.0)));
+    let mut e = vec![0.0; n];
+    e[last] = 1.0;
+    let direction = super::sparse::solve_real(&m, &e).ok().flatten();
+    Reduction {
+        a: empty,
+        basis: Some(KernelBasis::new(n, mass)),
+        inventory: Some(InventoryMode {
+            eigenvalue: ccj / mass.len() as f64,
+            conservation_defect: cj.iter().fold(0.0f64, |a, v| a.max(v.abs())) / jmax,
+            direction: direction.unwrap_or_default(),
+            mass_states: mass.to_vec(),
+        }),
+    }
+}

@@ -1,0 +1,182 @@
+//! Sparse linear algebra of the large-model route: the Jacobian as triplets, its product with a
+//! vector, and faer sparse LU solves of `M x = b` (real) and of `(A - sigma I) z = x` for a
+//! complex shift `sigma = a + j b` through the real `2n` embedding
+//!
+//! ```text
+//! [[A - aI,  bI  ], [u]   [Re x]
+//!  [ -bI,  A - aI]] [v] = [Im x],     z = u + j v
+//! ```
+//!
+//! The symbolic analysis (column ordering, elimination structure) of the embedding is done once
+//! per pattern and reused for every shift, as `sim::monodromy` reuses its stage pattern.
+
+use faer::linalg::solvers::Solve;
+use faer::reborrow::Reborrow;
+use faer::sparse::linalg::solvers::{Lu, SymbolicLu};
+use faer::sparse::{SparseColMat, Triplet};
+use faer::{c64, Mat};
+
+/// A square sparse matrix as coordinate triplets (entries at one position are summed).
+#[derive(Clone, Debug, PartialEq)]
+pub struct SparseMatrix {
+    pub n: usize,
+    pub entries: Vec<(usize, usize, f64)>,
+}
+
+impl SparseMatrix {
+    /// `y = A x` (complex `x`).
+    pub fn mul(&self, x: &[c64]) -> Vec<c64> {
+        let mut y = vec![c64::new(0.0, 0.0); self.n];
+        for &(i, j, v) in &self.entries {
+            y[i] += x[j] * v;
+        }
+        y
+    }
+
+    /// `D^-1 A D` for `D = diag(d)` (a similarity: the same eigenvalues).
+    pub fn scaled(&self, d: &[f64]) -> Self {
+        Self {
+            n: self.n,
+            entries: self
+                .entries
+                .iter()
+                .map(|&(i, j, v)| (i, j, v * d[j] / d[i]))
+                .collect(),
+        }
+    }
+
+    /// `A + b c'` for sparse vectors given densely (only their nonzeros are added).
+    pub fn plus_outer(&self, b: &[f64], c: &[f64]) -> Self {
+        let mut entries = self.entries.clone();
+        for (i, &bi) in b.iter().enumerate().filter(|(_, v)| **v != 0.0) {
+            for (j, &cj) in c.iter().enumerate().filter(|(_, v)| **v != 0.0) {
+                entries.push((i, j, bi * cj));
+            }
+        }
+        Self { n: self.n, entries }
+    }
+
+    /// `max |a_ij|` over the summed entries (an upper bound would do: used for tolerances).
+    pub fn max_abs(&self) -> f64 {
+        self.entries.iter().fold(0.0f64, |m, e| m.max(e.2.abs()))
+    }
+}
+
+/// Why a sparse factorization failed (symbolic or numeric; a singular matrix included).
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+#[error("sparse LU: {why}")]
+pub struct SparseLuError {
+    pub why: String,
+}
+
+fn fail(e: impl std::fmt::Debug) -> SparseLuError {
+    SparseLuError {
+        why: format!("{e:?}"),
+    }
+}
+
+fn assemble(
+    n: usize,
+    entries: &[Triplet<usize, usize, f64>],
+) -> Result<SparseColMat<usize, f64>, SparseLuError> {
+    SparseColMat::try_new_from_triplets(n, n, entries).map_err(fail)
+}
+
+/// Solve the real system `M x = b`; `None` when the result is not finite.
+pub fn solve_real(m: &SparseMatrix, b: &[f64]) -> Result<Option<Vec<f64>>, SparseLuError> {
+    let t: Vec<_> = m
+        .entries
+        .iter()
+        .map(|&(i, j, v)| Triplet::new(i, j, v))
+        .collect();
+    let a = assemble(m.n, &t)?;
+    let lu = a.sp_lu().map_err(fail)?;
+    let rhs = Mat::<f64>::from_fn(m.n, 1, |i, _| b[i]);
+    let x = lu.solve(&rhs);
+    let x: Vec<f64> = (0..m.n).map(|i| x[(i, 0)]).collect();
+    Ok(x.iter().all(|v| v.is_finite()).then_some(x))
+}
+
+/// `(A - sigma I)^-1` for complex shifts of one matrix, by the real embedding.
+#[derive(Clone, Debug)]
+pub struct ShiftedSolver {
+    a: SparseMatrix,
+    /// A row the shift is not applied to (a constraint row such as `c x = 0`).
+    fixed: Option<usize>,
+    symbolic: SymbolicLu<usize>,
+    lu: Option<Lu<usize, f64>>,
+}
+
+impl ShiftedSolver {
+    /// Analyse the pattern of the embedding (diagonal and both off-diagonal identities
+    /// included); the shift is applied to every row but `fixed`.
+    pub fn new(a: &SparseMatrix, fixed: Option<usize>) -> Result<Self, SparseLuError> {
+        let emb = embedding(a, c64::new(1.0, 1.0), fixed);
+        let mat = assemble(2 * a.n, &emb)?;
+        let symbolic = SymbolicLu::try_new(mat.symbolic()).map_err(fail)?;
+        Ok(Self {
+            a: a.clone(),
+            fixed,
+            symbolic,
+            lu: None,
+        })
+    }
+
+    fn lu_at(&self, sigma: c64) -> Result<Lu<usize, f64>, SparseLuError> {
+        let mat = assemble(2 * self.a.n, &embedding(&self.a, sigma, self.fixed))?;
+        Lu::try_new_with_symbolic(self.symbolic.clone(), mat.rb()).map_err(fail)
+    }
+
+    /// Factor `A - sigma I` (the symbolic analysis is reused).
+    pub fn factor(&mut self, sigma: c64) -> Result<(), SparseLuError> {
+        self.lu = Some(self.lu_at(sigma)?);
+        Ok(())
+    }
+
+    /// `z = (A - sigma I)^-1 x` for the last factored `sigma`; `None` if not finite or unfactored.
+    pub fn solve(&self, x: &[c64]) -> Option<Vec<c64>> {
+        solve_embedded(self.lu.as_ref()?, x)
+    }
+
+    /// Factor at `sigma` and solve once, leaving the stored factorization alone.
+    pub fn solve_at(&self, sigma: c64, x: &[c64]) -> Result<Option<Vec<c64>>, SparseLuError> {
+        Ok(solve_embedded(&self.lu_at(sigma)?, x))
+    }
+}
+
+fn solve_embedded(lu: &Lu<usize, f64>, x: &[c64]) -> Option<Vec<c64>> {
+    let n = x.len();
+    let rhs = Mat::<f64>::from_fn(2 * n, 1, |i, _| if i < n { x[i].re } else { x[i - n].im });
+    let s = lu.solve(&rhs);
+    let z: Vec<c64> = (0..n).map(|i| c64::new(s[(i, 0)], s[(n + i, 0)])).collect();
+    z.iter()
+        .all(|v| v.re.is_finite() && v.im.is_finite())
+        .then_some(z)
+}
+
+/// The triplets of the real `2n` embedding of `A - sigma I` (every diagonal entry present,
+/// zero on the `fixed` row).
+fn embedding(
+    a: &SparseMatrix,
+    sigma: c64,
+    fixed: Option<usize>,
+) -> Vec<Triplet<usize, usize, f64>> {
+    let n = a.n;
+    let mut t = Vec::with_capacity(2 * a.entries.len() + 4 * n);
+    for &(i, j, v) in &a.entries {
+        t.push(Triplet::new(i, j, v));
+        t.push(Triplet::new(n + i, n + j, v));
+    }
+    for k in 0..n {
+        let s = if Some(k) == fixed {
+            c64::new(0.0, 0.0)
+        } else {
+            sigma
+        };
+        t.push(Triplet::new(k, k, -s.re));
+        t.push(Triplet::new(n + k, n + k, -s.re));
+        t.push(Triplet::new(k, n + k, s.im));
+        t.push(Triplet::new(n + k, k, -s.im));
+    }
+    t
+}
