@@ -160,12 +160,8 @@ pub fn solve_with(
             });
         }
         it += 1;
-        let dx = if sparse {
-            sparse_newton_step(model, p, &x, &f, &masses, charge)
-        } else {
-            newton_step(model, p, &x, &f, &masses, charge)
-        }
-        .ok_or(LinearError::Singular { iteration: it })?;
+        let dx = newton_step(model, p, &x, &f, (&masses, charge), sparse)
+            .ok_or(LinearError::Singular { iteration: it })?;
         let (xn, fnew, rn) = line_search(model, p, &x, &dx, &s, r)?;
         x = xn;
         f = fnew;
@@ -180,47 +176,41 @@ pub fn solve_with(
     })
 }
 
+/// The Newton step `J dx = -f` with the last mass equation replaced by the inventory
+/// constraint, by the dense LU or (with `sparse`) the sparse LU on the Jacobian triplets.
 fn newton_step(
     model: &dyn Model,
     p: &[f64],
     x: &[f64],
     f: &[f64],
-    masses: &[usize],
-    charge: f64,
+    (masses, charge): (&[usize], f64),
+    sparse: bool,
 ) -> Option<DVector<f64>> {
     let n = x.len();
+    let mut rhs: Vec<f64> = f.iter().map(|v| -v).collect();
+    let last = masses.last().copied();
+    if let Some(last) = last {
+        rhs[last] = charge - masses.iter().map(|&i| x[i]).sum::<f64>();
+    }
+    if sparse {
+        // the same system as triplets, by the sparse LU
+        let mut entries = model.jacobian_triplets(p, x, 0.0);
+        if let Some(last) = last {
+            entries.retain(|e| e.0 != last);
+            entries.extend(masses.iter().map(|&i| (last, i, 1.0)));
+        }
+        let m = super::sparse::SparseMatrix { n, entries };
+        let dx = super::sparse::solve_real(&m, &rhs).ok()??;
+        return Some(DVector::from_vec(dx));
+    }
     let mut j = DMatrix::from_vec(n, n, model.jacobian_dense(p, x, 0.0));
-    let mut rhs = DVector::from_iterator(n, f.iter().map(|v| -v));
-    if let Some(&last) = masses.last() {
+    if let Some(last) = last {
         j.row_mut(last).fill(0.0);
         for &i in masses {
             j[(last, i)] = 1.0;
         }
-        rhs[last] = charge - masses.iter().map(|&i| x[i]).sum::<f64>();
     }
-    super::solve::solve(&j, &rhs)
-}
-
-/// The same Newton system as [`newton_step`], as triplets, by the sparse LU.
-fn sparse_newton_step(
-    model: &dyn Model,
-    p: &[f64],
-    x: &[f64],
-    f: &[f64],
-    masses: &[usize],
-    charge: f64,
-) -> Option<DVector<f64>> {
-    let n = x.len();
-    let mut entries = model.jacobian_triplets(p, x, 0.0);
-    let mut rhs: Vec<f64> = f.iter().map(|v| -v).collect();
-    if let Some(&last) = masses.last() {
-        entries.retain(|e| e.0 != last);
-        entries.extend(masses.iter().map(|&i| (last, i, 1.0)));
-        rhs[last] = charge - masses.iter().map(|&i| x[i]).sum::<f64>();
-    }
-    let m = super::sparse::SparseMatrix { n, entries };
-    let dx = super::sparse::solve_real(&m, &rhs).ok()??;
-    Some(DVector::from_vec(dx))
+    super::solve::solve(&j, &DVector::from_vec(rhs))
 }
 
 type Trial = (Vec<f64>, Vec<f64>, f64);

@@ -7,7 +7,6 @@ use std::time::Instant;
 use stirling_dsl::Model;
 
 use super::{settings, truth_value, Case, SelfCheckOptions};
-use crate::data::{read_csv, write_csv};
 use crate::diagnose::run::diagnose;
 use crate::diagnose::types::Diagnosis;
 use crate::diagnose::DiagnoseError;
@@ -97,14 +96,7 @@ impl Bench<'_> {
             truth: truth.to_string(),
             source,
         })?;
-        let path = self.dir.join(format!("case{k}.csv"));
-        write_csv(&path, &out.data, &[]).map_err(|source| DiagnoseError::Io {
-            path: path.clone(),
-            source,
-        })?;
-        drop(out);
-        let data = read_csv(&path)?;
-        let _ = std::fs::remove_file(&path);
+        let data = super::record::through_csv(out, &self.dir, k)?;
         let d = diagnose(self.model, &self.p0, &data, &opts.diagnose)?;
         let mut case = self.read_case(d, truth, strength, set);
         case.seconds = t.elapsed().as_secs_f64();

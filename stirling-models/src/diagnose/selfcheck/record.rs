@@ -67,7 +67,13 @@ pub fn record(opts: &VerdictOptions, c: &Planned, dir: &Path) -> Result<Measured
         truth: c.truth.label(),
         source,
     })?;
-    let path = dir.join(format!("case{}.csv", c.index));
+    through_csv(out, dir, c.index)
+}
+
+/// A rig record written to `dir/case<k>.csv` and read back (the diagnosis sees only what a
+/// user's CSV holds); the file is removed after reading.
+pub fn through_csv(out: rig::RigOutput, dir: &Path, k: usize) -> Result<Measured, DiagnoseError> {
+    let path = dir.join(format!("case{k}.csv"));
     write_csv(&path, &out.data, &[]).map_err(|source| DiagnoseError::Io {
         path: path.clone(),
         source,
