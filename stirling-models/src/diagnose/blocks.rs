@@ -2,7 +2,11 @@
 
 use super::{DiagnoseError, DiagnoseOptions};
 use crate::data::Measured;
-use crate::signal::cycle_frequency;
+use crate::signal::{cycle_frequency, noise_sigma};
+
+/// The held-out motion must exceed the noise by this factor (rms of the mean-removed signal
+/// against the noise's standard deviation): below it the crossings are the noise's.
+const MOTION_OVER_NOISE: f64 = 5.0;
 
 /// Training and held-out blocks (times and sample ranges) of a record.
 pub(super) struct Blocks {
@@ -40,9 +44,15 @@ pub(super) fn blocks(data: &Measured, opts: &DiagnoseOptions) -> Result<Blocks, 
             need: 50,
         });
     }
-    let motion = data.x.as_ref().or(data.p.as_ref());
-    if let Some(v) = motion {
-        if cycle_frequency(&v[hold_idx.0..hold_idx.1], dt).is_none() {
+    let motion = match (&data.x, &data.p) {
+        (Some(x), _) => Some(("x", x)),
+        (None, Some(p)) => Some(("p", p)),
+        _ => None,
+    };
+    if let Some((channel, v)) = motion {
+        let held = &v[hold_idx.0..hold_idx.1];
+        check_motion(data, channel, held, holdout)?;
+        if cycle_frequency(held, dt).is_none() {
             return Err(DiagnoseError::HoldoutCycles {
                 file: data.source.clone(),
                 from: holdout.0,
@@ -55,5 +65,29 @@ pub(super) fn blocks(data: &Measured, opts: &DiagnoseOptions) -> Result<Blocks, 
         holdout,
         train_idx,
         hold_idx,
+    })
+}
+
+/// Refuse a held-out block whose motion is buried in the noise (an engine that stopped).
+fn check_motion(
+    data: &Measured,
+    channel: &'static str,
+    held: &[f64],
+    holdout: (f64, f64),
+) -> Result<(), DiagnoseError> {
+    let mean = held.iter().sum::<f64>() / held.len() as f64;
+    let rms = (held.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / held.len() as f64).sqrt();
+    let noise = noise_sigma(held);
+    if rms > MOTION_OVER_NOISE * noise {
+        return Ok(());
+    }
+    Err(DiagnoseError::NoMotion {
+        file: data.source.clone(),
+        from: holdout.0,
+        to: holdout.1,
+        channel,
+        rms,
+        noise,
+        need: MOTION_OVER_NOISE,
     })
 }

@@ -32,6 +32,16 @@ pub enum DiagnoseError {
     },
     #[error("{file}: the held-out block {from:.3}:{to:.3} s holds fewer than two cycles: too few to hold out (a longer record, or --train/--holdout)")]
     HoldoutCycles { file: String, from: f64, to: f64 },
+    #[error("{file}: the motion dies out: over the held-out block {from:.3}:{to:.3} s channel `{channel}` varies by {rms:.3e} rms against a noise of {noise:.3e} (at least {need}x the noise is needed to read a cycle); the engine has stopped, so there is no cycle to diagnose (diagnose the part of the record where it runs, with --train/--holdout)")]
+    NoMotion {
+        file: String,
+        from: f64,
+        to: f64,
+        channel: &'static str,
+        rms: f64,
+        noise: f64,
+        need: f64,
+    },
     #[error("unknown effect `{name}`: expected one of {known}")]
     UnknownEffect { name: String, known: String },
     #[error("effect `{effect}` does not apply to `{model}` (it applies to {applies})")]
