@@ -51,7 +51,6 @@ pub(super) fn blocks(data: &Measured, opts: &DiagnoseOptions) -> Result<Blocks, 
     };
     if let Some((channel, v)) = motion {
         let held = &v[hold_idx.0..hold_idx.1];
-        check_motion(data, channel, held, holdout)?;
         if cycle_frequency(held, dt).is_none() {
             return Err(DiagnoseError::HoldoutCycles {
                 file: data.source.clone(),
@@ -59,6 +58,8 @@ pub(super) fn blocks(data: &Measured, opts: &DiagnoseOptions) -> Result<Blocks, 
                 to: holdout.1,
             });
         }
+        // crossings of the noise count as cycles: the motion must stand above it too
+        check_motion(data, channel, held, holdout)?;
     }
     Ok(Blocks {
         train,
