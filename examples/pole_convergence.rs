@@ -17,7 +17,10 @@ const NS: [usize; 13] = [1, 2, 5, 10, 20, 50, 100, 200, 500, 1000, 2000, 5000, 1
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let args: Vec<String> = std::env::args().collect();
     let ns: Vec<usize> = match args.iter().position(|a| a == "--ns") {
-        Some(i) => args[i + 1].split(',').map(str::parse).collect::<Result<_, _>>()?,
+        Some(i) => args[i + 1]
+            .split(',')
+            .map(str::parse)
+            .collect::<Result<_, _>>()?,
         None => NS.to_vec(),
     };
     println!("| n | states | route | re (1/s) | im (rad/s) | f (Hz) | change of s from previous n | time |");
@@ -35,7 +38,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             .find(|q| q.im > 0.0)
             .ok_or_else(|| format!("n = {n}: no complex pole"))?;
         let change = prev.map_or("-".to_string(), |(re, im)| {
-            format!("{:.2e}", (top.re - re).hypot(top.im - im) / top.re.hypot(top.im))
+            format!(
+                "{:.2e}",
+                (top.re - re).hypot(top.im - im) / top.re.hypot(top.im)
+            )
         });
         let route = match d.route {
             PoleRoute::Dense => "dense",

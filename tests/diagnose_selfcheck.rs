@@ -208,5 +208,8 @@ fn reduced_verdict_self_check_gets_the_verdicts_right() {
     // the outside cause moved the record at least as much as the friction did
     let sig = |l: &str| v.signatures.iter().find(|s| s.label == l).unwrap().clone();
     let (f, o) = (sig("coulomb"), sig("outside:spring_cubic"));
-    assert!(o.freq.abs().max(o.x_amp.abs()) >= f.freq.abs().max(f.x_amp.abs()), "{o:?} vs {f:?}");
+    assert!(
+        o.freq.abs().max(o.x_amp.abs()) >= f.freq.abs().max(f.x_amp.abs()),
+        "{o:?} vs {f:?}"
+    );
 }

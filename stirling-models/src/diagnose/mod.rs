@@ -32,13 +32,13 @@ pub mod joint;
 pub mod localize;
 /// Which: fit and rank the screened candidates.
 pub mod rank;
-/// The score screen of one candidate at the effect's null.
-pub mod screen;
 /// The Markdown report and its figures.
 pub mod report;
 mod run;
 /// The robust score test of an effect at its null.
 pub mod score;
+/// The score screen of one candidate at the effect's null.
+pub mod screen;
 /// The self-check on rig records whose effect is withheld.
 pub mod selfcheck;
 /// The simulated gap: held-out cycle features of the free run, before and after.

@@ -10,12 +10,11 @@ use super::context::{predict, Context, Eval, Prediction};
 use super::gap::gap_before;
 use super::types::{Diagnosis, RankEntry};
 use super::{
-    closure, joint, localize, rank, score, screen, sim_gap, verdict, DiagnoseError,
-    DiagnoseOptions,
+    closure, joint, localize, rank, score, screen, sim_gap, verdict, DiagnoseError, DiagnoseOptions,
 };
 use crate::data::Measured;
-use crate::fit::free_run::SensorOffsets;
 use crate::effects::{EffectInfo, EffectTarget};
+use crate::fit::free_run::SensorOffsets;
 use crate::fit::{self, FitOptions, FittedStage, Identification};
 use crate::signal::noise_sigma;
 
@@ -235,7 +234,13 @@ fn assess_all(
     report_progress(opts, || {
         let sig = screened.iter().filter(|s| s.significant(level)).count();
         let fitted = screened.iter().filter(|s| fit(s)).count();
-        screen_line(screened.len(), (sig, fitted, level), nom.absorbed, opts, clock)
+        screen_line(
+            screened.len(),
+            (sig, fitted, level),
+            nom.absorbed,
+            opts,
+            clock,
+        )
     });
     let mut assessed: Vec<rank::Assessed> = screened
         .into_par_iter()

@@ -18,7 +18,6 @@
 //! differences along the regenerator, mass shares) make the segments' gas initial states
 //! nearly collinear (reported in the warnings) although the model parameters stay separable.
 
-
 mod problem;
 mod setup;
 
