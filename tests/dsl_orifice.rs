@@ -63,24 +63,8 @@ fn fd_check(m: &dyn Model, seed: u64) -> f64 {
     let mut report = Vec::new();
     let mut worst = 0.0f64;
     for (label, x) in states(m, seed) {
-        for b in common::check_jacobians_from(m, &p, &x, &STARTS, 0.0) {
-            if (b.col == "P_bounce" || b.col == "m_bounce") && b.row.contains("_r[") {
-                continue;
-            }
-            let rel = (b.analytic - b.fd).abs() / b.analytic.abs().max(b.fd.abs());
-            worst = worst.max(rel);
-            let tol = if m.n() >= 50 && b.col == "param mdot_eps" {
-                1e-5 // the chains' switches at n = 50, as in tests/dsl_sections.rs
-            } else {
-                common::REL
-            };
-            if rel > tol {
-                report.push(format!(
-                    "{label}: d {}/d {}: {:e} vs {:e} ({rel:.1e})",
-                    b.row, b.col, b.analytic, b.fd
-                ));
-            }
-        }
+        let w = common::arrow_fd_errors(m, &p, &x, &STARTS, &label, &mut report);
+        worst = worst.max(w);
     }
     assert!(
         report.is_empty(),

@@ -56,32 +56,9 @@ fn fd_check(m: &dyn Model, seed: u64) -> f64 {
     for spread in [common::Spread::Wide, common::Spread::Balanced] {
         for k in 0..3 {
             let x = common::random_state(m, &p, spread, &mut rng);
-            let by_hand = |b: &common::Mismatch| {
-                (b.col == "P_bounce" || b.col == "m_bounce") && b.row.contains("_r[")
-            };
-            for b in common::check_jacobians_from(m, &p, &x, &STARTS, 0.0) {
-                if by_hand(&b) {
-                    continue;
-                }
-                let rel = (b.analytic - b.fd).abs() / b.analytic.abs().max(b.fd.abs());
-                worst = worst.max(rel);
-                // at n = 50 the chains' upwind switches (0.02 Pa wide) make `d P_j'/d mdot_eps`
-                // curve on 1 % of `mdot_eps` while the row is 1e7 Pa/s: central differences
-                // scatter by 5e-6 between steps 1e-7 and 4e-9 (`mdot_eps` 1e-5), so that
-                // column is held to 1e-5 there (the entry is the chains', checked to 1e-6
-                // at n <= 10; a misplaced term shows as 1e-4 or more)
-                let tol = if m.n() >= 50 && b.col == "param mdot_eps" {
-                    1e-5
-                } else {
-                    common::REL
-                };
-                if rel > tol {
-                    report.push(format!(
-                        "{spread:?} {k}: d {}/d {}: {:e} vs {:e} ({rel:.1e})",
-                        b.row, b.col, b.analytic, b.fd
-                    ));
-                }
-            }
+            let label = format!("{spread:?} {k}");
+            let w = common::arrow_fd_errors(m, &p, &x, &STARTS, &label, &mut report);
+            worst = worst.max(w);
         }
     }
     assert!(
