@@ -142,9 +142,9 @@ impl Propagator<'_> {
         let (c, a) = radau3();
         self.stage_jacobians(t0, h, &c, dense)?;
         self.lu += 1;
-        let fail = |why: String| SimError::SolverFailure {
+        let fail = |e: StageError| SimError::SolverFailure {
             t: t0,
-            why: format!("monodromy step: {why}"),
+            why: format!("monodromy step: {e}"),
         };
         let stage = StageStep {
             n: self.n,
@@ -195,9 +195,18 @@ struct StageStep<'t> {
     trip: &'t [Vec<(usize, usize, f64)>; 3],
 }
 
+/// Why one Radau stage solve failed (mapped to [`SimError::SolverFailure`] at the step's time).
+#[derive(Debug, thiserror::Error)]
+enum StageError {
+    #[error("sparse LU of the stage matrix failed: {0}")]
+    Factorization(String),
+    #[error("singular stage matrix")]
+    Singular,
+}
+
 impl StageStep<'_> {
     /// Solve with the sparse LU of `sp`; `phi` becomes the last stage.
-    fn solve_sparse(&self, sp: &mut SparseStage, phi: &mut [f64]) -> Result<(), String> {
+    fn solve_sparse(&self, sp: &mut SparseStage, phi: &mut [f64]) -> Result<(), StageError> {
         let (n, h, a) = (self.n, self.h, self.a);
         let (sym, vals) = sp.mat.parts_mut();
         vals.fill(0.0);
@@ -225,7 +234,7 @@ impl StageStep<'_> {
                 MemStack::new(&mut sp.factor_scratch),
                 Default::default(),
             )
-            .map_err(|e| format!("{e:?}"))?;
+            .map_err(|e| StageError::Factorization(format!("{e:?}")))?;
         for col in 0..n {
             for i in 0..3 {
                 for r in 0..n {
@@ -248,7 +257,7 @@ impl StageStep<'_> {
     }
 
     /// Solve with a dense LU; `phi` becomes the last stage.
-    fn solve_dense(&self, phi: &mut [f64]) -> Result<(), String> {
+    fn solve_dense(&self, phi: &mut [f64]) -> Result<(), StageError> {
         let (n, h, a) = (self.n, self.h, self.a);
         let mut mat = DMatrix::<f64>::identity(3 * n, 3 * n);
         for i in 0..3 {
@@ -267,7 +276,7 @@ impl StageStep<'_> {
             }
         }
         if !mat.lu().solve_mut(&mut rhs) {
-            return Err("singular stage matrix".into());
+            return Err(StageError::Singular);
         }
         for col in 0..n {
             for r in 0..n {
