@@ -126,6 +126,28 @@ pub fn base_strength(name: &str) -> f64 {
     }
 }
 
+/// The verdict self-check's unit strength (on `nsection` n = 2, `p,x,y`), as a multiple of
+/// the typical value. One rule for every model effect: the unit moves the record's end
+/// stroke by roughly 15 to 50 %, so that twice the unit still leaves an engine that runs (a
+/// record without motion is refused, not diagnosed). Coulomb friction at the rank check's
+/// unit (0.1) takes 15 % of the stroke and at 2x stops the engine (-99.7 %): the unit is
+/// half that. The leak at the rank check's unit (3, `Gleak` 6e-8) takes 80 % of the stroke
+/// and 2x leaves almost nothing: the unit is 0.5 (`Gleak` 1e-8, -16 %; 2x -32 %). Quadratic
+/// regenerator friction keeps the rank check's unit (-52 %; 2x -67 %). The end stops keep
+/// their travels (2 mm and 1.1 mm: a stop is a travel, not a strength; -87 %).
+pub fn verdict_unit(name: &str) -> f64 {
+    match name {
+        "coulomb" => 0.05,
+        "leak" => 0.5,
+        _ => base_strength(name),
+    }
+}
+
+/// Rig settings for an effect at `m` times its verdict self-check unit ([`verdict_unit`]).
+pub fn verdict_settings(name: &str, m: f64) -> Vec<String> {
+    settings(name, m * verdict_unit(name) / base_strength(name))
+}
+
 /// Rig settings for an effect at `m` times its self-check unit strength.
 pub fn settings(name: &str, m: f64) -> Vec<String> {
     let Some(e) = effect(name) else { return vec![] };

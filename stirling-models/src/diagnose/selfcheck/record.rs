@@ -9,7 +9,7 @@ use serde::Serialize;
 use stirling_dsl::Model;
 
 use super::plan::{Planned, Truth, VerdictOptions};
-use super::settings;
+use super::verdict_settings;
 use crate::data::{read_csv, write_csv, Measured};
 use crate::diagnose::DiagnoseError;
 use crate::outside::outside;
@@ -44,7 +44,7 @@ pub fn rig_config(opts: &VerdictOptions, c: &Planned) -> RigConfig {
     match &c.truth {
         Truth::Clean => base,
         Truth::Effect { name, strength } => RigConfig {
-            effects: settings(name, *strength),
+            effects: verdict_settings(name, *strength),
             ..base
         },
         Truth::Outside { name, strength } => {
