@@ -26,7 +26,7 @@ pub fn case_row(c: &Outcome) -> String {
         "WRONG"
     };
     format!(
-        "| {} | {:?} | {} | {} | {} | {} | {} {} [{}, {}] | {} | {:.0} |",
+        "| {} | {:?} | {} | {} | {} | {} | {} {} [{}, {}] | {} ({}) | {:.0} |",
         c.index,
         c.split,
         c.label,
@@ -37,6 +37,7 @@ pub fn case_row(c: &Outcome) -> String {
         opt(c.closure),
         opt(c.ci_low),
         opt(c.ci_high),
+        c.tuned_verdict,
         if c.error.is_some() { "error" } else { right },
         c.seconds
     )
@@ -85,7 +86,7 @@ pub fn markdown(v: &VerdictCheck) -> String {
             100.0 * g.freq
         );
     }
-    s += "\n## Cases\n\n| # | set | truth | strength | seed | verdict (default) | closure of [95 % CI] | tuned verdict | time (s) |\n|---|---|---|---|---|---|---|---|---|\n";
+    s += "\n## Cases\n\n| # | set | truth | strength | seed | verdict (default) | closure of [95 % CI] | tuned verdict (right?) | time (s) |\n|---|---|---|---|---|---|---|---|---|\n";
     for c in &v.cases {
         s += &case_row(c);
         s.push('\n');
