@@ -172,6 +172,12 @@ pub fn minimize_split(
                 accepted = true;
                 break;
             }
+            if step.amax() < opts.xtol {
+                // rejected below the step tolerance: the further damped steps are shorter
+                // still, and one accepted would stop the fit as converged anyway, less than
+                // `xtol` away (they were most of a fit's trials, each a whole run)
+                break;
+            }
             lambda *= nu;
             nu *= 2.0;
         }
