@@ -35,6 +35,7 @@ pub mod rank;
 /// The Markdown report and its figures.
 pub mod report;
 mod run;
+mod schedule;
 /// The robust score test of an effect at its null.
 pub mod score;
 /// The score screen of one candidate at the effect's null.

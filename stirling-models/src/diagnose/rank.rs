@@ -37,7 +37,14 @@ fn solve(joint: &Joint, u0: &[f64], fixed: &[usize], opts: &LmOptions) -> Option
         }
         Some((r, j))
     };
-    let mut res = lm::minimize(&mut eval, u0, opts)?;
+    let mut resid = |u: &[f64]| {
+        let mut u = u.to_vec();
+        fixed.iter().for_each(|&i| u[i] = u0[i]);
+        joint.trial_residuals(&u).ok()
+    };
+    // trial points by their residuals alone: most are rejected (the last iterations of a
+    // converged fit try up to 30 damped steps), and the sensitivities cost several runs
+    let mut res = lm::minimize_split(&mut eval, Some(&mut resid), u0, opts)?;
     fixed.iter().for_each(|&i| res.x[i] = u0[i]);
     Some(res)
 }
@@ -145,6 +152,7 @@ pub fn assess(
         score,
         shapes,
         mut entry,
+        ..
     } = screened;
     let Some(score) = score else {
         return Assessed { entry, eval: None };
@@ -211,6 +219,24 @@ fn fit_candidate(
     Ok(Some(ev))
 }
 
+/// The starts of a joint fit (see [`best_fit`]): a fixed strength (else the one-step
+/// estimate), and whether the nominal parameters are reset.
+fn starts(e: &EffectInfo, shapes: &[(&'static str, f64)]) -> Vec<(Option<f64>, bool)> {
+    let mut starts: Vec<(Option<f64>, bool)> = vec![(None, false)];
+    if !shapes.is_empty() {
+        starts.extend([(Some(0.3), false), (Some(1.0), false)]);
+    }
+    if e.target == EffectTarget::Model {
+        starts.push((Some(1.0), true));
+    }
+    starts
+}
+
+/// How many starts the joint fit of `e` runs.
+pub fn start_count(e: &EffectInfo, shapes: &[(&'static str, f64)]) -> usize {
+    starts(e, shapes).len()
+}
+
 /// The joint fit from every start, the lowest cost kept. Starts: from the nominal optimum at
 /// the one-step estimate; a strength with a shape (end stops) is not smooth in its strength,
 /// so also at fixed strengths; and for a model effect the typical strength with the nominal
@@ -227,13 +253,7 @@ fn best_fit(
     opts: &LmOptions,
 ) -> Result<(lm::LmResult, Vec<usize>), DiagnoseError> {
     use rayon::prelude::*;
-    let mut starts: Vec<(Option<f64>, bool)> = vec![(None, false)];
-    if !shapes.is_empty() {
-        starts.extend([(Some(0.3), false), (Some(1.0), false)]);
-    }
-    if e.target == EffectTarget::Model {
-        starts.push((Some(1.0), true));
-    }
+    let starts = starts(e, shapes);
     let results: Vec<Result<(lm::LmResult, Vec<usize>), DiagnoseError>> = starts
         .par_iter()
         .map(|&(s0, reset)| {

@@ -10,7 +10,8 @@ use super::context::{predict, Context, Eval, Prediction};
 use super::gap::gap_before;
 use super::types::{Diagnosis, RankEntry};
 use super::{
-    closure, joint, localize, rank, score, screen, sim_gap, verdict, DiagnoseError, DiagnoseOptions,
+    closure, joint, localize, rank, schedule, score, screen, sim_gap, verdict, DiagnoseError,
+    DiagnoseOptions,
 };
 use crate::data::Measured;
 use crate::effects::{EffectInfo, EffectTarget};
@@ -242,16 +243,13 @@ fn assess_all(
             clock,
         )
     });
-    let mut assessed: Vec<rank::Assessed> = screened
-        .into_par_iter()
-        .map(|s| {
-            if fit(&s) {
-                rank::assess(ctx, stages, s2, nominal, s, &lm)
-            } else {
-                s.unfitted("not fitted: its score is not significant (--fit-all fits it)")
-            }
-        })
-        .collect();
+    let mut assessed = schedule::longest_first(screened, |s| {
+        if fit(&s) {
+            rank::assess(ctx, stages, s2, nominal, s, &lm)
+        } else {
+            s.unfitted("not fitted: its score is not significant (--fit-all fits it)")
+        }
+    });
     rank::sort(&mut assessed, level);
     attach_closures(ctx, nominal, &mut assessed, opts);
     assessed

@@ -58,6 +58,8 @@ pub struct Screened {
     /// The shape setting (end-stop travels) with the largest statistic.
     pub shapes: Vec<(&'static str, f64)>,
     pub entry: RankEntry,
+    /// Seconds of one evaluation of the joint problem (the screen's mean), for scheduling.
+    pub eval_seconds: f64,
 }
 
 impl Screened {
@@ -139,6 +141,7 @@ pub fn screen_candidate(
         effect: e,
         score,
         shapes,
+        eval_seconds: entry.seconds / grid.len().max(1) as f64,
         entry,
     }
 }

@@ -309,11 +309,13 @@ pub fn simulation_gap(
 ) -> Result<SimulationGap, SimGapError> {
     let param = |n: &str| model.param_index(n).map_or(0.0, |i| before.p[i]);
     let area = (param("A"), param("Ar"));
-    let (meas_c, sim_bc) = simulate_rows(model, data, off, block, before, "calibrated", area)?;
-    let sim_ac = match after {
-        Some((_, m)) => Some(simulate_rows(model, data, off, block, m, "effect", area)?.1),
-        None => None,
-    };
+    // the two free runs are independent: in parallel
+    let (calibrated, effect) = rayon::join(
+        || simulate_rows(model, data, off, block, before, "calibrated", area),
+        || after.map(|(_, m)| simulate_rows(model, data, off, block, m, "effect", area)),
+    );
+    let (meas_c, sim_bc) = calibrated?;
+    let sim_ac = effect.transpose()?.map(|r| r.1);
     let phase_residuals = phase_residuals(&meas_c, &sim_bc, sim_ac.as_ref());
     let (meas, sim_b, sim_a) = (meas_c.rows, sim_bc.rows, sim_ac.map(|s| s.rows));
     let k = common_cycles(&meas, &sim_b, sim_a.as_deref())?;

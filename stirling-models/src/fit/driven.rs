@@ -91,10 +91,10 @@ fn check_floor(v: &Var, val: f64) -> Result<(), FitError> {
 }
 
 /// Set variable `v` to `val` in `pr`; its sensitivity column, if it has one.
-fn set_var(pr: &mut Prepared, v: &Var, val: f64, sens: bool) -> Result<Option<Column>, FitError> {
+fn set_var(pr: &mut Prepared, v: &Var, val: f64, trial: bool) -> Result<Option<Column>, FitError> {
     Ok(match &v.kind {
         VarKind::Param(i) => {
-            if sens {
+            if trial {
                 check_floor(v, val)?;
             }
             pr.p[*i] = val;
@@ -163,6 +163,19 @@ impl Stage<'_> {
         last: usize,
         sens: bool,
     ) -> Result<StageRun, FitError> {
+        self.run_checked(u, first, last, sens, sens)
+    }
+
+    /// [`Stage::run`]; `trial`: an optimizer's trial point, whose positive parameters must
+    /// stay above their floor ([`check_floor`]).
+    fn run_checked(
+        &self,
+        u: &[f64],
+        first: usize,
+        last: usize,
+        sens: bool,
+        trial: bool,
+    ) -> Result<StageRun, FitError> {
         let th = self.values(u);
         let Prepared {
             p,
@@ -170,7 +183,7 @@ impl Stage<'_> {
             mut given,
             mut columns,
             col_of,
-        } = self.prepare(&th, sens)?;
+        } = self.prepare(&th, trial)?;
         if !sens {
             columns.clear();
         }
@@ -233,8 +246,9 @@ impl Stage<'_> {
     }
 
     /// The model parameters, initial free states, prescribed states and sensitivity columns
-    /// at the variable values `th` (with the column of each variable, if it has one).
-    fn prepare(&self, th: &[f64], sens: bool) -> Result<Prepared, FitError> {
+    /// at the variable values `th` (with the column of each variable, if it has one);
+    /// `trial`: check the parameter floors.
+    fn prepare(&self, th: &[f64], trial: bool) -> Result<Prepared, FitError> {
         let mut pr = Prepared {
             p: self.p.clone(),
             z0: self.z0.clone(),
@@ -243,7 +257,7 @@ impl Stage<'_> {
             col_of: vec![None; self.vars.len()],
         };
         for (k, (v, &val)) in self.vars.iter().zip(th).enumerate() {
-            if let Some(c) = set_var(&mut pr, v, val, sens)? {
+            if let Some(c) = set_var(&mut pr, v, val, trial)? {
                 pr.column(k, c);
             }
         }
@@ -300,6 +314,27 @@ impl Stage<'_> {
         keep: &[usize],
     ) -> Result<Vec<f64>, FitError> {
         let run = self.run(u, first, last, false)?;
+        Ok(self.output_residuals(&run, first, keep))
+    }
+
+    /// The residuals of [`Stage::residuals`] (with the prior rows) without the Jacobian: an
+    /// optimizer's trial point, tested before its sensitivities are computed (the parameter
+    /// floors are checked as in [`Stage::residuals`]).
+    pub fn trial_residuals(
+        &self,
+        u: &[f64],
+        first: usize,
+        last: usize,
+        keep: &[usize],
+    ) -> Result<Vec<f64>, FitError> {
+        let run = self.run_checked(u, first, last, false, true)?;
+        let mut r = self.output_residuals(&run, first, keep);
+        r.extend(super::prior::prior_rows(&self.vars, u).iter().map(|p| p.r));
+        Ok(r)
+    }
+
+    /// Every output's weighted, drift-projected residuals of a run on the samples `keep`.
+    fn output_residuals(&self, run: &StageRun, first: usize, keep: &[usize]) -> Vec<f64> {
         let mut r = Vec::with_capacity(keep.len() * self.outputs.len());
         for (o, out) in self.outputs.iter().enumerate() {
             let start = r.len();
@@ -311,7 +346,7 @@ impl Stage<'_> {
                 project_drift(&mut r[start..], self.drift);
             }
         }
-        Ok(r)
+        r
     }
 
     /// Weighted residuals and Jacobian on the sample indices `keep` (within `first..=last`):

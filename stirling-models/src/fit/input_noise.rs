@@ -21,51 +21,66 @@ impl Stage<'_> {
         draws: usize,
         seed: u64,
     ) -> Result<Vec<Vec<f64>>, FitError> {
-        use rand::{rngs::StdRng, Rng, SeedableRng};
         if self.input_noise.is_empty() || draws == 0 {
             return Ok(Vec::new());
         }
         let base = self.run(u, first, last, false)?;
+        // the noise records are drawn in turn (the same records as one draw after the
+        // other), the runs are independent: in parallel
+        let noisy: Vec<Stage> = self.noisy_stages(draws, seed);
+        use rayon::prelude::*;
+        noisy
+            .par_iter()
+            .map(|st| {
+                let run = st.run(u, first, last, false)?;
+                let mut dr = Vec::with_capacity(keep.len() * self.outputs.len());
+                for (o, out) in self.outputs.iter().enumerate() {
+                    let start = dr.len();
+                    for &i in keep {
+                        let k = i - first;
+                        dr.push((run.yhat[o][k] - base.yhat[o][k]) / out.sigma);
+                    }
+                    if self.drift > 0 {
+                        project_drift(&mut dr[start..], self.drift);
+                    }
+                }
+                // the priors do not see the input noise
+                dr.resize(dr.len() + super::prior::prior_count(&self.vars), 0.0);
+                Ok(dr)
+            })
+            .collect()
+    }
+
+    /// `draws` copies of the stage with noise records (white, smoothed like the signal) added
+    /// to its noisy inputs, drawn in turn from `seed`.
+    fn noisy_stages(&self, draws: usize, seed: u64) -> Vec<Stage<'_>> {
+        use rand::{rngs::StdRng, Rng, SeedableRng};
         let mut rng = StdRng::seed_from_u64(seed);
         let mut gauss = move || {
             let u1: f64 = 1.0 - rng.gen::<f64>();
             let u2: f64 = rng.gen::<f64>();
             (-2.0 * u1.ln()).sqrt() * (2.0 * std::f64::consts::PI * u2).cos()
         };
-        let mut noisy = Stage {
-            input_noise: Vec::new(),
-            ..self.clone()
-        };
-        let mut out = Vec::with_capacity(draws);
-        for _ in 0..draws {
-            for &(s, sd, h) in &self.input_noise {
-                let e: Vec<f64> = (0..self.signals[s].val.len())
-                    .map(|_| sd * gauss())
-                    .collect();
-                let (ev, ed) = savitzky_golay(&e, self.dt, h, 4);
-                let sig = &mut noisy.signals[s];
-                for k in 0..ev.len() {
-                    sig.val[k] = self.signals[s].val[k] + ev[k];
-                    sig.der[k] = self.signals[s].der[k] + ed[k];
+        (0..draws)
+            .map(|_| {
+                let mut noisy = Stage {
+                    input_noise: Vec::new(),
+                    ..self.clone()
+                };
+                for &(s, sd, h) in &self.input_noise {
+                    let e: Vec<f64> = (0..self.signals[s].val.len())
+                        .map(|_| sd * gauss())
+                        .collect();
+                    let (ev, ed) = savitzky_golay(&e, self.dt, h, 4);
+                    let sig = &mut noisy.signals[s];
+                    for k in 0..ev.len() {
+                        sig.val[k] = self.signals[s].val[k] + ev[k];
+                        sig.der[k] = self.signals[s].der[k] + ed[k];
+                    }
                 }
-            }
-            let run = noisy.run(u, first, last, false)?;
-            let mut dr = Vec::with_capacity(keep.len() * self.outputs.len());
-            for (o, out) in self.outputs.iter().enumerate() {
-                let start = dr.len();
-                for &i in keep {
-                    let k = i - first;
-                    dr.push((run.yhat[o][k] - base.yhat[o][k]) / out.sigma);
-                }
-                if self.drift > 0 {
-                    project_drift(&mut dr[start..], self.drift);
-                }
-            }
-            // the priors do not see the input noise
-            dr.resize(dr.len() + super::prior::prior_count(&self.vars), 0.0);
-            out.push(dr);
-        }
-        Ok(out)
+                noisy
+            })
+            .collect()
     }
 
     /// Covariance of the fit variables `u` caused by the noise on the prescribed inputs

@@ -83,21 +83,72 @@ fn damped_step(
     Some(step)
 }
 
+/// Residuals alone at a trial point (no Jacobian); `None` when it cannot be evaluated.
+pub type Resid<'a> = dyn FnMut(&[f64]) -> Option<Vec<f64>> + 'a;
+
 /// Minimize `|r(x)|^2 / 2` from `x0`.
 pub fn minimize(eval: &mut Eval, x0: &[f64], opts: &LmOptions) -> Option<LmResult> {
-    let mut x = x0.to_vec();
-    let (mut r, mut jm) = eval(&x)?;
+    minimize_split(eval, None, x0, opts)
+}
+
+/// The current point of the iteration.
+struct Point {
+    x: Vec<f64>,
+    r: Vec<f64>,
+    jm: DMatrix<f64>,
+    c: f64,
+}
+
+fn cost(r: &[f64]) -> f64 {
+    r.iter().map(|v| v * v).sum::<f64>() / 2.0
+}
+
+/// The trial point `xn`: `(residuals, Jacobian)` when its cost is below `c`. With `resid`, the
+/// trial is tested on its residuals alone and the Jacobian computed only when it is accepted.
+fn try_point(
+    eval: &mut Eval,
+    resid: &mut Option<&mut Resid>,
+    xn: &[f64],
+    c: f64,
+    evals: &mut usize,
+) -> Option<(Vec<f64>, DMatrix<f64>, f64)> {
+    *evals += 1;
+    if let Some(res) = resid.as_mut() {
+        let cn = cost(&res(xn)?);
+        if cn >= c {
+            return None;
+        }
+        let (rn, jn) = eval(xn)?;
+        return Some((rn, jn, cn));
+    }
+    let (rn, jn) = eval(xn)?;
+    let cn = cost(&rn);
+    (cn < c).then_some((rn, jn, cn))
+}
+
+/// [`minimize`], with the trial points tested by `resid` (residuals alone, cheaper than
+/// `eval`) when given: `eval` then runs only at the start and at accepted points.
+pub fn minimize_split(
+    eval: &mut Eval,
+    mut resid: Option<&mut Resid>,
+    x0: &[f64],
+    opts: &LmOptions,
+) -> Option<LmResult> {
+    let (r, jm) = eval(x0)?;
+    let mut pt = Point {
+        x: x0.to_vec(),
+        c: cost(&r),
+        r,
+        jm,
+    };
     let mut evals = 1;
-    let cost = |r: &[f64]| r.iter().map(|v| v * v).sum::<f64>() / 2.0;
-    let mut c = cost(&r);
-    let mut lambda = opts.lambda0;
-    let mut nu = 2.0;
+    let (mut lambda, mut nu) = (opts.lambda0, 2.0);
     let mut converged = false;
     let mut it = 0;
     while it < opts.max_iter {
         it += 1;
-        let jtj = jm.transpose() * &jm;
-        let g = jm.transpose() * DVector::from_column_slice(&r);
+        let jtj = pt.jm.transpose() * &pt.jm;
+        let g = pt.jm.transpose() * DVector::from_column_slice(&pt.r);
         let mut accepted = false;
         for _ in 0..30 {
             let Some(step) = damped_step(&jtj, &g, lambda, opts.max_step) else {
@@ -105,27 +156,27 @@ pub fn minimize(eval: &mut Eval, x0: &[f64], opts: &LmOptions) -> Option<LmResul
                 nu *= 2.0;
                 continue;
             };
-            let xn: Vec<f64> = x.iter().zip(step.iter()).map(|(a, b)| a + b).collect();
+            let xn: Vec<f64> = pt.x.iter().zip(step.iter()).map(|(a, b)| a + b).collect();
             let pred = -(step.dot(&g) + 0.5 * (step.transpose() * &jtj * &step)[(0, 0)]);
-            evals += 1;
-            if let Some((rn, jn)) = eval(&xn) {
-                let cn = cost(&rn);
-                if cn < c {
-                    let rho = if pred > 0.0 { (c - cn) / pred } else { 1.0 };
-                    lambda *= (1.0f64 / 3.0).max(1.0 - (2.0 * rho - 1.0).powi(3));
-                    nu = 2.0;
-                    let small_step = step.amax() < opts.xtol;
-                    let small_gain = (c - cn) < opts.ftol * c;
-                    x = xn;
-                    r = rn;
-                    jm = jn;
-                    c = cn;
-                    accepted = true;
-                    if small_step || small_gain {
-                        converged = true;
-                    }
-                    break;
-                }
+            if let Some((rn, jn, cn)) = try_point(eval, &mut resid, &xn, pt.c, &mut evals) {
+                let rho = if pred > 0.0 { (pt.c - cn) / pred } else { 1.0 };
+                lambda *= (1.0f64 / 3.0).max(1.0 - (2.0 * rho - 1.0).powi(3));
+                nu = 2.0;
+                converged = step.amax() < opts.xtol || (pt.c - cn) < opts.ftol * pt.c;
+                pt = Point {
+                    x: xn,
+                    c: cost(&rn),
+                    r: rn,
+                    jm: jn,
+                };
+                accepted = true;
+                break;
+            }
+            if step.amax() < opts.xtol {
+                // rejected below the step tolerance: the further damped steps are shorter
+                // still, and one accepted would stop the fit as converged anyway, less than
+                // `xtol` away (they were most of a fit's trials, each a whole run)
+                break;
             }
             lambda *= nu;
             nu *= 2.0;
@@ -140,10 +191,10 @@ pub fn minimize(eval: &mut Eval, x0: &[f64], opts: &LmOptions) -> Option<LmResul
         }
     }
     Some(LmResult {
-        x,
-        residuals: r,
-        jacobian: jm,
-        cost: c,
+        x: pt.x,
+        residuals: pt.r,
+        jacobian: pt.jm,
+        cost: pt.c,
         iterations: it,
         evaluations: evals,
         converged,
@@ -180,6 +231,33 @@ mod tests {
             "{:?}",
             res.x
         );
+    }
+
+    /// Trial points tested on their residuals alone: the same path and optimum as
+    /// [`minimize`], with the Jacobian evaluated only at the start and at accepted points.
+    #[test]
+    fn split_trials_follow_the_same_path() {
+        let r = |p: &[f64]| vec![10.0 * (p[1] - p[0] * p[0]), 1.0 - p[0]];
+        let j = |p: &[f64]| DMatrix::from_row_slice(2, 2, &[-20.0 * p[0], 10.0, -1.0, 0.0]);
+        let opts = LmOptions {
+            max_iter: 200,
+            ..Default::default()
+        };
+        let mut full = |p: &[f64]| Some((r(p), j(p)));
+        let plain = minimize(&mut full, &[-1.2, 1.0], &opts).unwrap();
+        let mut jac_calls = 0;
+        let mut counted = |p: &[f64]| {
+            jac_calls += 1;
+            Some((r(p), j(p)))
+        };
+        let mut resid = |p: &[f64]| Some(r(p));
+        let split = minimize_split(&mut counted, Some(&mut resid), &[-1.2, 1.0], &opts).unwrap();
+        assert_eq!(plain.x, split.x);
+        assert_eq!(plain.iterations, split.iterations);
+        assert_eq!(plain.evaluations, split.evaluations);
+        // the start and one per accepted iteration, not one per trial
+        assert!(jac_calls <= split.iterations + 1, "{jac_calls}");
+        assert!(jac_calls < split.evaluations, "{jac_calls}");
     }
 
     #[test]

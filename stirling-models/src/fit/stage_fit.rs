@@ -55,7 +55,9 @@ pub fn fit_stage(
         }
     };
     let u0 = vec![0.0; stage.vars.len()];
-    let res = lm::minimize(&mut eval, &u0, &opts.lm)
+    let mut resid = |u: &[f64]| stage.trial_residuals(u, train.0, train.1, &keep).ok();
+    // trial points by their residuals alone, the sensitivities only at accepted ones
+    let res = lm::minimize_split(&mut eval, Some(&mut resid), &u0, &opts.lm)
         .ok_or_else(|| last_err.unwrap_or(FitError::Start(stage.name.into())))?;
     let noise_cov = stage.input_noise_cov(
         &res.x,

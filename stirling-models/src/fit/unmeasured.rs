@@ -144,18 +144,26 @@ pub fn carried_covariance(
     let nv2 = u2.len();
     let mut g = DMatrix::zeros(u1.len(), nv2);
     let values = gas.values(u2);
-    for k in 0..nv2 {
-        // relative to the value, so a parameter far below its start stays positive
-        let v = &gas.vars[k];
-        let h = DU * (values[k].abs() / v.scale.abs().max(1e-300)).clamp(1e-3, 1.0);
-        let (mut ua, mut ub) = (u2.to_vec(), u2.to_vec());
-        ua[k] -= h;
-        ub[k] += h;
-        let (ra, rb) = (residuals_at(&ua)?, residuals_at(&ub)?);
-        let d = DVector::from_iterator(
-            ra.len(),
-            ra.iter().zip(&rb).map(|(a, b)| (b - a) / (2.0 * h)),
-        );
+    use rayon::prelude::*;
+    // the central differences are independent runs: in parallel
+    let cols = (0..nv2)
+        .into_par_iter()
+        .map(|k| {
+            // relative to the value, so a parameter far below its start stays positive
+            let v = &gas.vars[k];
+            let h = DU * (values[k].abs() / v.scale.abs().max(1e-300)).clamp(1e-3, 1.0);
+            let (mut ua, mut ub) = (u2.to_vec(), u2.to_vec());
+            ua[k] -= h;
+            ub[k] += h;
+            let (ra, rb) = rayon::join(|| residuals_at(&ua), || residuals_at(&ub));
+            let (ra, rb) = (ra?, rb?);
+            Ok(DVector::from_iterator(
+                ra.len(),
+                ra.iter().zip(&rb).map(|(a, b)| (b - a) / (2.0 * h)),
+            ))
+        })
+        .collect::<Result<Vec<_>, FitError>>()?;
+    for (k, d) in cols.into_iter().enumerate() {
         let col = -(&inv * (j1.transpose() * d));
         g.set_column(k, &col);
     }

@@ -146,13 +146,16 @@ impl<'a> Joint<'a> {
         &self,
         u: &[f64],
     ) -> Result<(Vec<f64>, DMatrix<f64>, Vec<(usize, usize)>), FitError> {
-        let mut parts = Vec::new();
-        for (k, (_, st)) in self.stages.iter().enumerate() {
-            let (r, j) = st
-                .stage
-                .residuals(&self.stage_u(k, u), st.first, st.last, &st.keep)?;
-            parts.push((r, j));
-        }
+        use rayon::prelude::*;
+        // the stages are independent runs: in parallel
+        let parts = (0..self.stages.len())
+            .into_par_iter()
+            .map(|k| {
+                let st = &self.stages[k].1;
+                st.stage
+                    .residuals(&self.stage_u(k, u), st.first, st.last, &st.keep)
+            })
+            .collect::<Result<Vec<_>, _>>()?;
         let rows: usize = parts.iter().map(|(r, _)| r.len()).sum();
         let mut r = Vec::with_capacity(rows);
         let mut jm = DMatrix::zeros(rows, self.n_vars);
@@ -174,6 +177,32 @@ impl<'a> Joint<'a> {
             blocks.extend((row0 + n_out * per..row0 + rk.len()).map(|i| (i, i + 1)));
         }
         Ok((r, jm, blocks))
+    }
+
+    /// The weighted stacked residuals of [`Joint::residuals`] without the Jacobian (a
+    /// Levenberg-Marquardt trial point, [`crate::fit::lm::minimize_split`]).
+    pub fn trial_residuals(&self, u: &[f64]) -> Result<Vec<f64>, FitError> {
+        use rayon::prelude::*;
+        let parts = (0..self.stages.len())
+            .into_par_iter()
+            .map(|k| {
+                let st = &self.stages[k].1;
+                st.stage
+                    .trial_residuals(&self.stage_u(k, u), st.first, st.last, &st.keep)
+            })
+            .collect::<Result<Vec<_>, _>>()?;
+        let mut r = Vec::new();
+        for (k, rk) in parts.iter().enumerate() {
+            let st = &self.stages[k].1;
+            let n = st.keep.len() * st.stage.outputs.len();
+            let w = self.weight[k];
+            r.extend(
+                rk.iter()
+                    .enumerate()
+                    .map(|(i, v)| if i < n { v * w } else { *v }),
+            );
+        }
+        Ok(r)
     }
 
     /// Stacked, weighted input-noise draws of the joint stages (`per_stage[s][k]`: draw `k`
