@@ -103,6 +103,13 @@ pub trait Model: Send + Sync {
     fn rhs(&self, p: &[f64], x: &[f64], t: f64, out: &mut [f64]);
     /// The analytic Jacobian `df/dx`.
     fn jacobian(&self, p: &[f64], x: &[f64], t: f64, sink: &mut JacSink);
+    /// `out = f(x, p, t)` and the analytic Jacobian `df/dx` in one call, for solvers that
+    /// need both at one point: equal to [`Model::rhs`] then [`Model::jacobian`] (the default),
+    /// a generated model computes the values they share once.
+    fn rhs_and_jacobian(&self, p: &[f64], x: &[f64], t: f64, out: &mut [f64], sink: &mut JacSink) {
+        self.rhs(p, x, t, out);
+        self.jacobian(p, x, t, sink);
+    }
     /// The analytic parameter Jacobian `df/dp` (columns in parameter order).
     fn param_jacobian(&self, p: &[f64], x: &[f64], t: f64, sink: &mut JacSink);
     /// Pressure force on each body.
