@@ -73,7 +73,15 @@ impl Canon {
                 .iter()
                 .map(|&c| self.import(src, c))
                 .collect();
-            self.arena.make(node.with_children(&kids))
+            match (&node, kids.first().and_then(|&k| self.arena.as_const(k))) {
+                // `-c / b` as `-(c / b)` (the same value): one division for `1 / b` and `-1 / b`
+                (Node::Div(..), Some(c)) if c < 0.0 => {
+                    let (c, d) = (self.arena.num(-c), kids[1]);
+                    let q = self.arena.div(c, d);
+                    self.arena.neg(q)
+                }
+                _ => self.arena.make(node.with_children(&kids)),
+            }
         };
         self.memo.insert(id, r);
         r
