@@ -6,7 +6,7 @@
 //! Counted: binary `+ - * /` on `f64` values (index arithmetic inside `[..]` and the row
 //! and column arguments of `sink.add` are integer work and not counted), and calls of
 //! `tanh`, `powi`, `sqrt`, `exp`, `powf`, `ln`. A unary minus is a sign flip and not counted;
-//! `sink.add` and `out[..] =` stores are listed apart.
+//! stores (`out[..] =`, Jacobian entries) are listed apart.
 
 use proc_macro2::{Delimiter, TokenStream, TokenTree};
 
@@ -135,9 +135,6 @@ fn count(ts: TokenStream, c: &mut Counts) {
                 {
                     c.calls.push(name.clone());
                 }
-                if name == "add" && after_dot {
-                    c.stores += 1;
-                }
                 prev_operand = !["let", "mut", "return"].contains(&name.as_str());
             }
             TokenTree::Literal(_) => prev_operand = true,
@@ -148,8 +145,12 @@ fn count(ts: TokenStream, c: &mut Counts) {
                         let store = matches!(toks.get(i + 1), Some(TokenTree::Punct(p)) if p.as_char() == '=');
                         c.stores += store as usize;
                     }
-                    Delimiter::Parenthesis if is_sink_add(&toks, i) => {
+                    Delimiter::Parenthesis if is_call(&toks, i, "add") => {
+                        c.stores += 1;
                         count_values(g.stream(), 2, c)
+                    }
+                    Delimiter::Parenthesis if is_call(&toks, i, "add_all") => {
+                        count_entries(g.stream(), c)
                     }
                     _ => count(g.stream(), c),
                 }
@@ -159,8 +160,22 @@ fn count(ts: TokenStream, c: &mut Counts) {
     }
 }
 
-fn is_sink_add(toks: &[TokenTree], i: usize) -> bool {
-    i >= 2 && matches!(&toks[i - 1], TokenTree::Ident(id) if id == "add")
+fn is_call(toks: &[TokenTree], i: usize, name: &str) -> bool {
+    i >= 2 && matches!(&toks[i - 1], TokenTree::Ident(id) if id == name)
+}
+
+/// The entries `&[(row, col, value), ..]` of `sink.add_all`: one store each.
+fn count_entries(ts: TokenStream, c: &mut Counts) {
+    for t in ts {
+        if let TokenTree::Group(list) = t {
+            for e in list.stream() {
+                if let TokenTree::Group(entry) = e {
+                    c.stores += 1;
+                    count_values(entry.stream(), 2, c);
+                }
+            }
+        }
+    }
 }
 
 /// Count the arguments of a call after the first `skip` ones.

@@ -236,19 +236,22 @@ fn block(
     (lets, outs, more)
 }
 
-/// `out[row] = v;` or `sink.add(row, col, v);` for every entry.
+/// `out[row] = v;` for every value, then one `sink.add_all(&[(row, col, v), ..]);` for the
+/// block's Jacobian entries.
 fn stores(entries: &[Entry], outs: &[TokenStream]) -> Vec<TokenStream> {
-    entries
-        .iter()
-        .zip(outs)
-        .map(|(e, v)| {
-            let row = &e.row;
-            match &e.col {
-                None => quote! { out[#row] = #v; },
-                Some(col) => quote! { sink.add(#row, #col, #v); },
-            }
-        })
-        .collect()
+    let mut stores = Vec::new();
+    let mut jac = Vec::new();
+    for (e, v) in entries.iter().zip(outs) {
+        let row = &e.row;
+        match &e.col {
+            None => stores.push(quote! { out[#row] = #v; }),
+            Some(col) => jac.push(quote! { (#row, #col, #v) }),
+        }
+    }
+    if !jac.is_empty() {
+        stores.push(quote! { sink.add_all(&[#(#jac),*]); });
+    }
+    stores
 }
 
 /// The carried values for the next section, ordered so that a carried value is read

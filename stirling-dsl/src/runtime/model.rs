@@ -77,6 +77,23 @@ impl JacSink<'_> {
     }
 }
 
+impl JacSink<'_> {
+    /// Add the entries `(r, c, v)` in order: one capacity check for a block of triplets (a
+    /// `push` per entry stores the length and loads it again for the next one, a chain
+    /// through memory that costs more than the entry's arithmetic).
+    #[inline(always)]
+    pub fn add_all<const K: usize>(&mut self, entries: &[(usize, usize, f64); K]) {
+        match self {
+            JacSink::Dense { data, nrows } => {
+                for &(r, c, v) in entries {
+                    data[r + *nrows * c] += v;
+                }
+            }
+            JacSink::Triplets(t) => t.extend_from_slice(entries),
+        }
+    }
+}
+
 /// A generated model at a given `n` and closure.
 ///
 /// Callback shape: `(p, x, t, out)`, parameters as a slice in [`Model::params`] order.
