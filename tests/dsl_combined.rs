@@ -2,9 +2,16 @@
 //! exactly what `rhs` and `jacobian` give separately, bit for bit and in the same triplet
 //! order, and its Jacobian matches finite differences of its right-hand side; for the
 //! family members, the test chains and every section count that peels differently
-//! (n = 1, 2, 3 and longer).
+//! (n = 1, 2, 3 and longer), per-section links into a scalar CV (the sums' arrow) and a
+//! wall array.
 
 mod common;
+#[path = "dsl_sections/models.rs"]
+#[allow(dead_code)]
+mod sections;
+#[path = "dsl_walls/models.rs"]
+#[allow(dead_code)]
+mod walls;
 
 use common::models::{Chain, ChainQuad, OneCv, TwoCv};
 use common::{compare, fd_jacobian, fd_steps, random_state, rng, state_scales, Spread};
@@ -109,6 +116,30 @@ fn chains_combined_equals_separate() {
             |c| Box::new(ChainQuad::new(n, c).unwrap()),
             &label,
             30 + n as u64,
+        );
+    }
+}
+
+#[test]
+fn per_section_links_combined_equals_separate() {
+    for n in [1, 2, 3, 6] {
+        let label = format!("leak_to_cv n={n}");
+        both(
+            |c| Box::new(sections::LeakToCv::new(n, c).unwrap()),
+            &label,
+            40 + n as u64,
+        );
+        let label = format!("leak_to_space n={n}");
+        both(
+            |c| Box::new(sections::LeakToSpace::new(n, c).unwrap()),
+            &label,
+            50 + n as u64,
+        );
+        let label = format!("matrix_wall n={n}");
+        both(
+            |c| Box::new(walls::MatrixWall::new(n, c).unwrap()),
+            &label,
+            60 + n as u64,
         );
     }
 }
