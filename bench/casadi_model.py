@@ -77,14 +77,29 @@ def build_graph(topo: Topology):
 
 
 class CasadiModel:
-    def __init__(self, topo: Topology, K=(16, 256)):
+    def __init__(self, topo: Topology, K=(16, 256), compiled=True):
         self.topo = topo
         self.z, self.f = build_graph(topo)
         self.J = ca.jacobian(self.f, self.z)  # sparse SX
         self.F = ca.Function("f", [self.z], [self.f])
         self.Jf = ca.Function("jacf", [self.z], [self.J])
+        # RHS and Jacobian in one function: CasADi's own common-subexpression sharing
+        self.FJ = ca.Function("fj", [self.z], [self.f, self.J])
         self.K = K
-        self._compile()
+        self.compiled = compiled
+        if compiled:
+            self._compile()
+        else:
+            self._vm()
+
+    def _vm(self):
+        """No C: the functions run on CasADi's SX virtual machine (for n where gcc -O3 of the
+        generated C takes too long)."""
+        self.compile_seconds = 0.0
+        self.cF, self.cJ, self.cFJ = self.F, self.Jf, self.FJ
+        self.cFmap = {k: self.F.map(f"f_map{k}", "serial", k, [], []) for k in self.K}
+        self.cJmap = {k: self.Jf.map(f"jacf_map{k}", "serial", k, [], []) for k in self.K}
+        self.cFJmap = {k: self.FJ.map(f"fj_map{k}", "serial", k, [], []) for k in self.K}
 
     def _compile(self):
         os.makedirs(BUILD, exist_ok=True)
@@ -92,9 +107,11 @@ class CasadiModel:
         cg = ca.CodeGenerator(name + ".c", {"with_header": False})
         cg.add(self.F)
         cg.add(self.Jf)
+        cg.add(self.FJ)
         for k in self.K:
             cg.add(self.F.map(f"f_map{k}", "serial", k, [], []))
             cg.add(self.Jf.map(f"jacf_map{k}", "serial", k, [], []))
+            cg.add(self.FJ.map(f"fj_map{k}", "serial", k, [], []))
         cwd = os.getcwd()
         os.chdir(BUILD)
         try:
@@ -108,8 +125,10 @@ class CasadiModel:
         self.lib = so
         self.cF = ca.external("f", so)
         self.cJ = ca.external("jacf", so)
+        self.cFJ = ca.external("fj", so)
         self.cFmap = {k: ca.external(f"f_map{k}", so) for k in self.K}
         self.cJmap = {k: ca.external(f"jacf_map{k}", so) for k in self.K}
+        self.cFJmap = {k: ca.external(f"fj_map{k}", so) for k in self.K}
 
     def rhs(self, zv):
         return np.array(self.cF(zv)).ravel()
@@ -126,7 +145,8 @@ class CasadiModel:
         Z1 = ca.DM(np.tile(zv[:, None], (1, k1)))
         Z2 = ca.DM(np.tile(zv[:, None], (1, k2)))
         out = {}
-        for key, fmap, single in (("rhs", self.cFmap, self.cF), ("jac", self.cJmap, self.cJ)):
+        for key, fmap, single in (("rhs", self.cFmap, self.cF), ("jac", self.cJmap, self.cJ),
+                                  ("rhs_jac", self.cFJmap, self.cFJ)):
             t1 = median_time(lambda: fmap[k1](Z1), reps=31)
             t2 = median_time(lambda: fmap[k2](Z2), reps=31)
             out[key] = max((t2 - t1) / (k2 - k1), 0.0)
@@ -172,15 +192,22 @@ class CasadiModel:
         return res
 
 
-def run(n, params=None, do_sim=True, t_end=1.0, rtol=1e-7, atol=1e-7, jit_sim=True, vm_sim=True):
+def run(n, params=None, do_sim=True, t_end=1.0, rtol=1e-7, atol=1e-7, jit_sim=True, vm_sim=True,
+        c_max_n=None):
+    """`c_max_n`: above this n no C is generated: kernels timed on the SX virtual machine and
+    CVODES run with it only (no jit)."""
     topo = Topology(n, params)
     t0 = time.perf_counter()
-    cm = CasadiModel(topo)
+    compiled = c_max_n is None or n <= c_max_n
+    cm = CasadiModel(topo, compiled=compiled)
+    jit_sim = jit_sim and compiled
+    vm_sim = vm_sim or not compiled
     build_s = time.perf_counter() - t0
     z = topo.fairness_state()
     r, c, vals = cm.jac_triplets(z)
     out = {
         "n": n, "n_states": topo.nx, "build_and_compile_seconds": build_s,
+        "kernels": "C -O3" if compiled else "SX VM",
         "x": z.tolist(), "f": cm.rhs(z).tolist(),
         "jac": [[int(a), int(b), float(v)] for a, b, v in zip(r, c, vals)],
         "timings": cm.kernel_times(z),

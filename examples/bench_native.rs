@@ -10,6 +10,8 @@
 //! in batches so the clock resolution does not matter):
 //! - `rhs`: one right-hand side call;
 //! - `jac`: one analytic Jacobian into triplets (the sparse form; the buffer is reused);
+//! - `rhs_jac`: the right-hand side and the Jacobian (triplets) in one call
+//!   (`Model::rhs_and_jacobian`, which shares their common values);
 //! - `jac_fd`: one forward-difference Jacobian (n_states + 1 RHS calls) into triplets;
 //! - `sim`: one second of engine time from the rest state with the displacer moved by 5 mm
 //!   (as `stirling simulate` does), with the default stiff BDF of `stirling_models::sim`
@@ -163,6 +165,23 @@ fn main() {
                 black_box(&p),
                 black_box(&x),
                 0.0,
+                &mut JacSink::Triplets(&mut trip),
+            );
+            black_box(&trip);
+        },
+        2e-3,
+        51,
+        2.0,
+    );
+    // --- right-hand side and Jacobian (triplets) in one call (`Model::rhs_and_jacobian`)
+    let (t_rhs_jac, _) = time_per_call(
+        || {
+            trip.clear();
+            m.rhs_and_jacobian(
+                black_box(&p),
+                black_box(&x),
+                0.0,
+                black_box(&mut out),
                 &mut JacSink::Triplets(&mut trip),
             );
             black_box(&trip);
@@ -348,6 +367,7 @@ fn main() {
             "timings": {
                 "rhs": t_rhs, "rhs_calls_timed": n_rhs,
                 "jac": t_jac, "jac_calls_timed": n_jac, "jac_nnz": jac_at_x.len(),
+                "rhs_jac": t_rhs_jac,
                 "jac_dense": t_jac_dense,
                 "jac_fd": t_fd, "jac_fd_max_rel_err": fd_err,
             },
@@ -362,6 +382,7 @@ fn main() {
             t_jac * 1e6,
             jac_at_x.len()
         );
+        println!("  rhs + jac    {:>12.3} us (one call)", t_rhs_jac * 1e6);
         println!("  jac dense    {:>12.3} us", t_jac_dense * 1e6);
         println!(
             "  jac FD       {:>12.3} us (x{:.1}, max rel err {:.1e})",

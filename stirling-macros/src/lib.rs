@@ -47,4 +47,6 @@ pub fn stirling_model(input: TokenStream) -> TokenStream {
 }
 
 #[cfg(test)]
+mod flop_count;
+#[cfg(test)]
 mod snapshot_tests;

@@ -1,6 +1,8 @@
 //! The generated functions of one closure (`__rhs_full`, `__jac_full`, ...).
 
-use proc_macro2::{Ident, TokenStream};
+use std::collections::HashSet;
+
+use proc_macro2::{Ident, TokenStream, TokenTree};
 use quote::{format_ident, quote};
 
 use super::layout::Layout;
@@ -8,7 +10,8 @@ use super::rows::{rows_body, Output};
 use super::terms;
 use crate::expr::Arena;
 
-/// Wrap `body` into a method with the standard prologue (`n`, parameters, offsets).
+/// Wrap `body` into a method with the prologue it reads: `n`, one bounds check of the
+/// parameter slice, the parameters and block offsets that occur in `body`.
 fn method(
     name: &Ident,
     args: TokenStream,
@@ -16,16 +19,32 @@ fn method(
     lay: &Layout,
     body: TokenStream,
 ) -> TokenStream {
-    let (params, offsets) = (lay.params(), lay.offsets());
+    let mut used = HashSet::new();
+    idents(&body, &mut used);
+    let (params, offsets) = (lay.params(&used), lay.offsets(&used));
+    let nf = used.contains("nf").then(|| quote!(let nf = n as f64;));
     quote! {
-        #[allow(non_snake_case, unused_variables, unused_parens, clippy::all)]
+        #[allow(non_snake_case, unused_variables, unused_parens, unused_assignments, clippy::all)]
         #[inline(never)]
         fn #name(&self, #args) #ret {
             let n: usize = self.n;
-            let nf = n as f64;
+            #nf
             #params
             #offsets
             #body
+        }
+    }
+}
+
+/// Every identifier in `ts`.
+fn idents(ts: &TokenStream, out: &mut HashSet<String>) {
+    for tt in ts.clone() {
+        match tt {
+            TokenTree::Ident(i) => {
+                out.insert(i.to_string());
+            }
+            TokenTree::Group(g) => idents(&g.stream(), out),
+            _ => {}
         }
     }
 }
@@ -43,16 +62,18 @@ pub fn closure_methods(
     let xp = quote!(p: &[f64], x: &[f64]);
     // the sums over the sections, for every function of the state
     let s = super::sums::prologue(arena, lay, private);
-    let rhs = rows_body(arena, lay, &lay.sys.rows, Output::Value, private);
-    let jac = rows_body(arena, lay, &lay.sys.rows, Output::StateJacobian, private);
-    let pjac = rows_body(arena, lay, &lay.sys.rows, Output::ParamJacobian, private);
+    let rhs = rows_body(arena, lay, &lay.sys.rows, &[Output::Value], private);
+    let jac = rows_body(arena, lay, &lay.sys.rows, &[Output::StateJacobian], private);
+    let pjac = rows_body(arena, lay, &lay.sys.rows, &[Output::ParamJacobian], private);
+    let both = [Output::Value, Output::StateJacobian];
+    let both = rows_body(arena, lay, &lay.sys.rows, &both, private);
     let forces = terms::forces(arena, lay, private);
     let grads = terms::force_gradients(arena, lay, private);
     let init = terms::init(arena, lay, private);
     let vessels = terms::vessels(arena, lay, private);
     let mech = terms::mech(arena, lay, private);
-    let [rhs, jac, pjac, forces, grads, vessels, mech] =
-        [rhs, jac, pjac, forces, grads, vessels, mech].map(|b| quote!(#s #b));
+    let [rhs, jac, both, pjac, forces, grads, vessels, mech] =
+        [rhs, jac, both, pjac, forces, grads, vessels, mech].map(|b| quote!(#s #b));
     let masses = terms::masses(arena, lay, private);
     let n_states = n_states(lay);
     let items = [
@@ -64,6 +85,13 @@ pub fn closure_methods(
             rhs,
         ),
         method(&f("jac"), quote!(#xp, t: f64, #sink), quote!(), lay, jac),
+        method(
+            &f("rhs_jac"),
+            quote!(#xp, t: f64, out: &mut [f64], #sink),
+            quote!(),
+            lay,
+            both,
+        ),
         method(&f("pjac"), quote!(#xp, t: f64, #sink), quote!(), lay, pjac),
         method(
             &f("forces"),

@@ -1,6 +1,8 @@
 //! State layout in generated code: block offsets as functions of `n`, and how
 //! symbols read the state vector, the parameters and the section index.
 
+use std::collections::HashSet;
+
 use proc_macro2::{Ident, Literal, Span, TokenStream};
 use quote::{format_ident, quote};
 
@@ -26,18 +28,22 @@ impl Layout<'_> {
             .unwrap_or_else(|| panic!("internal: state block {sym} has no state in this closure"))
     }
 
-    /// `let o_x: usize = 0; ...` for every block, as `scalars + arrays * n`.
-    pub fn offsets(&self) -> TokenStream {
+    /// `let o_x: usize = 0; ...` for every block named in `used`, as `scalars + arrays * n`.
+    pub fn offsets(&self, used: &HashSet<String>) -> TokenStream {
         let (mut s, mut a) = (0usize, 0usize);
         let mut out = TokenStream::new();
         for b in &self.sys.blocks {
             let id = format_ident!("o_{}", b.name);
             let (sl, al) = (Literal::usize_unsuffixed(s), Literal::usize_unsuffixed(a));
-            out.extend(match a {
-                0 => quote! { let #id: usize = #sl; },
-                1 => quote! { let #id: usize = #sl + n; },
-                _ => quote! { let #id: usize = #sl + #al * n; },
-            });
+            if used.contains(&id.to_string()) {
+                out.extend(match (s, a) {
+                    (_, 0) => quote! { let #id: usize = #sl; },
+                    (0, 1) => quote! { let #id: usize = n; },
+                    (_, 1) => quote! { let #id: usize = #sl + n; },
+                    (0, _) => quote! { let #id: usize = #al * n; },
+                    _ => quote! { let #id: usize = #sl + #al * n; },
+                });
+            }
             if b.array {
                 a += 1;
             } else {
@@ -47,17 +53,28 @@ impl Layout<'_> {
         out
     }
 
-    /// `let R = p[0]; ...` for every parameter.
-    pub fn params(&self) -> TokenStream {
+    /// One bounds check of the parameter slice, then `let R = p[0]; ...` for every
+    /// parameter named in `used`.
+    pub fn params(&self, used: &HashSet<String>) -> TokenStream {
+        let count = Literal::usize_unsuffixed(self.topo.params.len());
         let mut out = TokenStream::new();
         for (i, p) in self.topo.params.iter().enumerate() {
+            if !used.contains(&p.name) {
+                continue;
+            }
             let (id, k) = (
                 Ident::new(&p.name, Span::call_site()),
                 Literal::usize_unsuffixed(i),
             );
             out.extend(quote! { let #id: f64 = p[#k]; });
         }
-        out
+        if out.is_empty() {
+            return out;
+        }
+        quote! {
+            let p: &[f64; #count] = p.first_chunk().expect("one value per declared parameter");
+            #out
+        }
     }
 
     /// Index expression of a state element.

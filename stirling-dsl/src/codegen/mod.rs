@@ -1,11 +1,13 @@
 //! Rust emission of a whole model: the struct, its parameter struct and the
 //! [`crate::Model`] implementation, for both inventory closures.
 
+mod canon;
 mod equations;
 mod functions;
 mod info;
 mod layout;
 mod rows;
+mod sections;
 mod sums;
 mod terms;
 
@@ -190,6 +192,7 @@ fn model_impl(topo: &Topology, spec: &ModelSpec, st: &Statics) -> TokenStream {
     };
     let rhs = call("rhs", quote!(p, x, t, out));
     let jac = call("jac", quote!(p, x, t, sink));
+    let both = call("rhs_jac", quote!(p, x, t, out, sink));
     let pjac = call("pjac", quote!(p, x, t, sink));
     let forces = call("forces", quote!(p, x, out));
     let grad = call("force_grad", quote!(k, p, x, out));
@@ -223,6 +226,7 @@ fn model_impl(topo: &Topology, spec: &ModelSpec, st: &Statics) -> TokenStream {
             fn vessel_names(&self) -> Vec<String> { #vn }
             fn rhs(&self, p: &[f64], x: &[f64], t: f64, out: &mut [f64]) { #rhs }
             fn jacobian(&self, p: &[f64], x: &[f64], t: f64, sink: &mut #krate::JacSink) { #jac }
+            fn rhs_and_jacobian(&self, p: &[f64], x: &[f64], t: f64, out: &mut [f64], sink: &mut #krate::JacSink) { #both }
             fn param_jacobian(&self, p: &[f64], x: &[f64], t: f64, sink: &mut #krate::JacSink) { #pjac }
             fn pressure_forces(&self, p: &[f64], x: &[f64], out: &mut [f64]) { #forces }
             fn pressure_force_gradient(&self, k: usize, p: &[f64], x: &[f64], out: &mut [f64]) {

@@ -1,14 +1,13 @@
 //! The right-hand side, the analytic Jacobian and the parameter Jacobian of one
-//! system as Rust: one straight-line block for the scalar rows, and one loop over
-//! the sections whose body dispatches on the section's [`Variant`].
+//! system as Rust: the outputs of every row, emitted as one program by
+//! [`super::sections::program`].
 
 use proc_macro2::{Literal, TokenStream};
 use quote::quote;
 
 use super::layout::Layout;
-use crate::expr::emit::emit_block;
 use crate::expr::{Arena, At, Id, Sym};
-use crate::topology::{Row, Variant, VARIANTS};
+use crate::topology::Row;
 
 /// What a generated function computes for each row expression.
 #[derive(Clone, Copy, PartialEq, Eq)]
@@ -22,120 +21,63 @@ pub enum Output {
 }
 
 /// One output line: the value to emit and where it goes.
-struct Entry {
-    id: Id,
-    row: TokenStream,
-    col: Option<TokenStream>,
+pub(super) struct Entry {
+    pub(super) id: Id,
+    pub(super) row: TokenStream,
+    pub(super) col: Option<TokenStream>,
 }
 
-/// The body of a generated rhs / Jacobian function (after the prologue).
+/// The body of a generated function (after the prologue) that computes every output of
+/// `whats` (the right-hand side and the Jacobian in one pass share their values).
 pub fn rows_body(
     arena: &mut Arena,
     lay: &Layout,
     rows: &[Row],
-    what: Output,
+    whats: &[Output],
     private: &TokenStream,
 ) -> TokenStream {
     let scalar: Vec<(usize, Id)> = rows
         .iter()
         .enumerate()
-        .filter_map(|(i, r)| {
-            if let Row::Scalar(id) = r {
-                Some((i, *id))
-            } else {
-                None
-            }
+        .filter_map(|(i, r)| match r {
+            Row::Scalar(id) => Some((i, *id)),
+            Row::Array(_) => None,
         })
         .collect();
-    let grads = (what != Output::Value && !lay.sys.sums.is_empty()).then(|| {
-        let ids: Vec<Id> = scalar.iter().map(|&(_, id)| id).collect();
-        super::sums::gradients(arena, lay, &ids, what, private)
-    });
-    let entries = entries(arena, lay, &scalar, what, false, grads.as_ref());
-    let mut scalar_code = grads.as_ref().map(|g| g.code.clone()).unwrap_or_default();
-    scalar_code.extend(block(arena, lay, &entries, what, private));
-    if grads.is_some() {
-        let rows: Vec<(TokenStream, Id)> = scalar
-            .iter()
-            .map(|&(b, id)| (lay.index(lay.sys.blocks[b].sym, At::Scalar), id))
-            .collect();
-        scalar_code.extend(super::sums::jacobian(arena, lay, &rows, what, private));
-    }
     let arrays: Vec<(usize, [Id; 4])> = rows
         .iter()
         .enumerate()
-        .filter_map(|(i, r)| {
-            if let Row::Array(v) = r {
-                Some((i, *v))
-            } else {
-                None
-            }
+        .filter_map(|(i, r)| match r {
+            Row::Array(v) => Some((i, *v)),
+            Row::Scalar(_) => None,
         })
         .collect();
-    if arrays.is_empty() {
-        return scalar_code;
-    }
-    let arms = variant_arms(arena, lay, &arrays, what, private);
-    quote! {
-        { #scalar_code }
-        for j in 0..n {
-            let jf = j as f64;
-            let _ = jf;
-            #arms
-        }
-    }
-}
-
-/// Group the variants that give the same expressions and emit one arm per group.
-fn variant_arms(
-    arena: &mut Arena,
-    lay: &Layout,
-    arrays: &[(usize, [Id; 4])],
-    what: Output,
-    private: &TokenStream,
-) -> TokenStream {
-    let mut groups: Vec<(Vec<Variant>, Vec<Id>)> = Vec::new();
-    for (k, v) in VARIANTS.iter().enumerate() {
-        let ids: Vec<Id> = arrays.iter().map(|(_, r)| r[k]).collect();
-        match groups.iter_mut().find(|g| g.1 == ids) {
-            Some(g) => g.0.push(*v),
-            None => groups.push((vec![*v], ids)),
-        }
-    }
-    let bodies: Vec<TokenStream> = groups
-        .iter()
-        .map(|(_, ids)| {
-            let rows: Vec<(usize, Id)> = arrays
+    let (mut head, mut tail) = (TokenStream::new(), TokenStream::new());
+    let mut entries_s = Vec::new();
+    let mut entries_a: [Vec<Entry>; 4] = Default::default();
+    for &what in whats {
+        let grads = (what != Output::Value && !lay.sys.sums.is_empty()).then(|| {
+            let ids: Vec<Id> = scalar.iter().map(|&(_, id)| id).collect();
+            super::sums::gradients(arena, lay, &ids, what, private)
+        });
+        entries_s.extend(entries(arena, lay, &scalar, what, false, grads.as_ref()));
+        if let Some(g) = &grads {
+            head.extend(g.code.clone());
+            let rows: Vec<(TokenStream, Id)> = scalar
                 .iter()
-                .zip(ids)
-                .map(|((i, _), id)| (*i, *id))
+                .map(|&(b, id)| (lay.index(lay.sys.blocks[b].sym, At::Scalar), id))
                 .collect();
-            let entries = entries(arena, lay, &rows, what, true, None);
-            block(arena, lay, &entries, what, private)
-        })
-        .collect();
-    if groups.len() == 1 {
-        let b = &bodies[0];
-        return quote! { #b };
-    }
-    let arms = groups.iter().zip(&bodies).map(|((vs, _), body)| {
-        let pats = vs.iter().map(|v| variant_path(*v, private));
-        quote! { #(#pats)|* => { #body } }
-    });
-    quote! {
-        match #private::Variant::of(j, n) {
-            #(#arms)*
+            tail.extend(super::sums::jacobian(arena, lay, &rows, what, private));
+        }
+        for (k, list) in entries_a.iter_mut().enumerate() {
+            let rows: Vec<(usize, Id)> = arrays.iter().map(|(i, r)| (*i, r[k])).collect();
+            list.extend(entries(arena, lay, &rows, what, true, None));
         }
     }
-}
-
-fn variant_path(v: Variant, private: &TokenStream) -> TokenStream {
-    match v {
-        Variant::Single => quote!(#private::Variant::Single),
-        Variant::First => quote!(#private::Variant::First),
-        Variant::Interior => quote!(#private::Variant::Interior),
-        Variant::Last => quote!(#private::Variant::Last),
-    }
+    let arrays = (!arrays.is_empty()).then_some(&entries_a);
+    // the sums' chain rule right after the scalar rows, as before the sections
+    let body = super::sections::program(arena, lay, (&entries_s, tail), arrays, private);
+    quote! { #head { #body } }
 }
 
 /// The outputs of `rows` for `what`: values, or nonzero derivatives with their columns.
@@ -183,25 +125,4 @@ fn entries(
         }
     }
     out
-}
-
-fn block(
-    arena: &Arena,
-    lay: &Layout,
-    entries: &[Entry],
-    what: Output,
-    private: &TokenStream,
-) -> TokenStream {
-    let roots: Vec<Id> = entries.iter().map(|e| e.id).collect();
-    let leaf = |s: Sym| lay.leaf(s);
-    let b = emit_block(arena, &roots, &leaf, private);
-    let lets = b.lets;
-    let stores = entries.iter().zip(b.outputs).map(|(e, v)| {
-        let row = &e.row;
-        match (&e.col, what) {
-            (None, _) => quote! { out[#row] = #v; },
-            (Some(col), _) => quote! { sink.add(#row, #col, #v); },
-        }
-    });
-    quote! { #(#lets)* #(#stores)* }
 }

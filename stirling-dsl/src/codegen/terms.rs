@@ -52,7 +52,7 @@ pub fn force_gradients(arena: &mut Arena, lay: &Layout, private: &TokenStream) -
 
 /// The equilibrium guess as `out[...] = ...` over all blocks.
 pub fn init(arena: &mut Arena, lay: &Layout, private: &TokenStream) -> TokenStream {
-    rows_body(arena, lay, &lay.sys.init, Output::Value, private)
+    rows_body(arena, lay, &lay.sys.init, &[Output::Value], private)
 }
 
 /// Calls `f(element, [P, V, E, Q, boundary, m, T])` for every vessel element:

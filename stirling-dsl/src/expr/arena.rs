@@ -52,6 +52,28 @@ impl Arena {
         id
     }
 
+    /// The id of `node` if the arena holds it (no folding, nothing added).
+    pub fn find(&self, node: &Node) -> Option<Id> {
+        self.dedup.get(node).copied()
+    }
+
+    /// `node` through the folding constructors (a `Named` node is interned as it is).
+    pub fn make(&mut self, node: Node) -> Id {
+        match node {
+            Node::Const(bits) => self.num(f64::from_bits(bits)),
+            Node::Sym(s) => self.sym(s),
+            Node::Add(a, b) => self.add(a, b),
+            Node::Sub(a, b) => self.sub(a, b),
+            Node::Mul(a, b) => self.mul(a, b),
+            Node::Div(a, b) => self.div(a, b),
+            Node::Neg(a) => self.neg(a),
+            Node::Powi(a, k) => self.powi(a, k),
+            Node::Powf(a, b) => self.powf(a, b),
+            Node::Func(f, a) => self.func(f, a),
+            Node::Named(..) => self.intern(node),
+        }
+    }
+
     /// A constant.
     pub fn num(&mut self, v: f64) -> Id {
         // one representation of zero, so that folding sees it

@@ -280,3 +280,132 @@ fn number(v: f64) -> (TokenStream, u8) {
         (quote!(#lit), P_ATOM)
     }
 }
+
+/// Emission of nested blocks that read each other's names: a prologue, then blocks that
+/// see its `let`s (and values carried in from outside) and name only what is left.
+pub struct Scope<'a> {
+    em: Emitter<'a>,
+    /// The name of every node computed in an enclosing block.
+    names: Vec<Option<Ident>>,
+    taken: std::collections::HashSet<String>,
+    preferred: Vec<Option<String>>,
+    temps: usize,
+}
+
+/// What a [`Scope`] has named, to return to after a block.
+pub type Saved = (Vec<Option<Ident>>, std::collections::HashSet<String>);
+
+impl<'a> Scope<'a> {
+    /// A scope over `arena` with the preferred name of every node.
+    pub fn new(
+        arena: &'a Arena,
+        leaf: &'a dyn Fn(Sym) -> TokenStream,
+        private: &'a TokenStream,
+        mut preferred: Vec<Option<String>>,
+    ) -> Self {
+        preferred.resize(arena.len(), None);
+        Self {
+            em: Emitter {
+                arena,
+                leaf,
+                private,
+            },
+            names: vec![None; arena.len()],
+            taken: Default::default(),
+            preferred,
+            temps: 0,
+        }
+    }
+
+    /// The names, to [`Scope::restore`] after a block.
+    pub fn save(&self) -> Saved {
+        (self.names.clone(), self.taken.clone())
+    }
+
+    /// Forget what the block since [`Scope::save`] named.
+    pub fn restore(&mut self, s: Saved) {
+        (self.names, self.taken) = s;
+    }
+
+    /// Reserve a fresh identifier for `id` (its preferred name, else `base`).
+    pub fn name(&mut self, id: Id, base: &str) -> Ident {
+        let base = self.preferred[id.index()]
+            .as_deref()
+            .map(sanitize)
+            .unwrap_or_else(|| base.to_string());
+        let ident = fresh(base, &mut self.taken);
+        self.names[id.index()] = Some(ident.clone());
+        ident
+    }
+
+    /// The arena the scope emits from.
+    pub fn arena(&self) -> &'a Arena {
+        self.em.arena
+    }
+
+    /// Read `id` as `name` in this scope.
+    pub fn set(&mut self, id: Id, name: &Ident) {
+        self.names[id.index()] = Some(name.clone());
+    }
+
+    /// Whether `id` has a name in this scope.
+    pub fn is_named(&self, id: Id) -> bool {
+        self.names[id.index()].is_some()
+    }
+
+    /// Whether `id` has a preferred name.
+    pub fn has_preferred(&self, id: Id) -> bool {
+        self.preferred[id.index()].is_some()
+    }
+
+    /// Parents of every node reachable from `roots` without entering named nodes (a root
+    /// counts once more).
+    pub fn uses(&self, roots: &[Id]) -> Vec<u32> {
+        let arena = self.em.arena;
+        let mut uses = vec![0u32; arena.len()];
+        let mut seen = vec![false; arena.len()];
+        let mut stack: Vec<Id> = Vec::new();
+        for &r in roots {
+            uses[r.index()] += 1;
+            stack.push(r);
+        }
+        while let Some(i) = stack.pop() {
+            if std::mem::replace(&mut seen[i.index()], true) || self.is_named(i) {
+                continue;
+            }
+            for c in arena.node(i).children() {
+                uses[c.index()] += 1;
+                stack.push(c);
+            }
+        }
+        uses
+    }
+
+    /// Whether a node used `uses` times is worth a `let` of its own (not a constant or a
+    /// symbol).
+    pub fn worth_a_let(&self, id: Id, uses: u32) -> bool {
+        needs_let(self.em.arena, id, uses) || (uses > 0 && self.has_preferred(id))
+    }
+
+    /// `let`s, in arena order, for the unnamed nodes with uses that `want` picks.
+    pub fn lets(&mut self, uses: &[u32], want: &dyn Fn(Id, u32) -> bool) -> Vec<TokenStream> {
+        let mut lets = Vec::new();
+        for i in 0..self.em.arena.len() {
+            let id = Id(i as u32);
+            let trivial = matches!(self.em.arena.node(id), Node::Const(_) | Node::Sym(_));
+            if uses[i] == 0 || trivial || self.is_named(id) || !want(id, uses[i]) {
+                continue;
+            }
+            let value = self.em.go(id, &self.names).0;
+            let name = self.name(id, &format!("t{}", self.temps));
+            self.temps += 1;
+            lets.push(quote! { let #name = #value; });
+        }
+        lets
+    }
+
+    /// `id` as an expression over the names in scope.
+    pub fn expr(&self, id: Id) -> TokenStream {
+        self.em.go(id, &self.names).0
+    }
+}

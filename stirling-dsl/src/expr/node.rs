@@ -143,4 +143,20 @@ impl Node {
             Node::Neg(a) | Node::Powi(a, _) | Node::Func(_, a) | Node::Named(_, a) => vec![a],
         }
     }
+
+    /// The same node over other children (`kids` in [`Node::children`] order).
+    pub fn with_children(&self, kids: &[Id]) -> Node {
+        match *self {
+            Node::Const(_) | Node::Sym(_) => self.clone(),
+            Node::Add(..) => Node::Add(kids[0], kids[1]),
+            Node::Sub(..) => Node::Sub(kids[0], kids[1]),
+            Node::Mul(..) => Node::Mul(kids[0], kids[1]),
+            Node::Div(..) => Node::Div(kids[0], kids[1]),
+            Node::Powf(..) => Node::Powf(kids[0], kids[1]),
+            Node::Neg(_) => Node::Neg(kids[0]),
+            Node::Powi(_, k) => Node::Powi(kids[0], k),
+            Node::Func(f, _) => Node::Func(f, kids[0]),
+            Node::Named(n, _) => Node::Named(n, kids[0]),
+        }
+    }
 }

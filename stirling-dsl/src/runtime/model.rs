@@ -77,6 +77,23 @@ impl JacSink<'_> {
     }
 }
 
+impl JacSink<'_> {
+    /// Add the entries `(r, c, v)` in order: one capacity check for a block of triplets (a
+    /// `push` per entry stores the length and loads it again for the next one, a chain
+    /// through memory that costs more than the entry's arithmetic).
+    #[inline(always)]
+    pub fn add_all<const K: usize>(&mut self, entries: &[(usize, usize, f64); K]) {
+        match self {
+            JacSink::Dense { data, nrows } => {
+                for &(r, c, v) in entries {
+                    data[r + *nrows * c] += v;
+                }
+            }
+            JacSink::Triplets(t) => t.extend_from_slice(entries),
+        }
+    }
+}
+
 /// A generated model at a given `n` and closure.
 ///
 /// Callback shape: `(p, x, t, out)`, parameters as a slice in [`Model::params`] order.
@@ -103,6 +120,13 @@ pub trait Model: Send + Sync {
     fn rhs(&self, p: &[f64], x: &[f64], t: f64, out: &mut [f64]);
     /// The analytic Jacobian `df/dx`.
     fn jacobian(&self, p: &[f64], x: &[f64], t: f64, sink: &mut JacSink);
+    /// `out = f(x, p, t)` and the analytic Jacobian `df/dx` in one call, for solvers that
+    /// need both at one point: equal to [`Model::rhs`] then [`Model::jacobian`] (the default),
+    /// a generated model computes the values they share once.
+    fn rhs_and_jacobian(&self, p: &[f64], x: &[f64], t: f64, out: &mut [f64], sink: &mut JacSink) {
+        self.rhs(p, x, t, out);
+        self.jacobian(p, x, t, sink);
+    }
     /// The analytic parameter Jacobian `df/dp` (columns in parameter order).
     fn param_jacobian(&self, p: &[f64], x: &[f64], t: f64, sink: &mut JacSink);
     /// Pressure force on each body.

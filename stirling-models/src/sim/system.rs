@@ -63,6 +63,15 @@ pub struct ModelSystem<'m> {
     pub p: &'m [f64],
 }
 
+impl ModelSystem<'_> {
+    /// `out = f(t, x)` and `df/dx` added to `jac` (as [`OdeSystem::jac`]) in one pass.
+    pub fn rhs_and_jac(&self, t: f64, x: &[f64], out: &mut [f64], jac: &mut [f64]) {
+        let nrows = self.dim();
+        let sink = &mut JacSink::Dense { data: jac, nrows };
+        self.model.rhs_and_jacobian(self.p, x, t, out, sink);
+    }
+}
+
 impl OdeSystem for ModelSystem<'_> {
     fn dim(&self) -> usize {
         self.model.n_states()
@@ -156,9 +165,8 @@ impl OdeSystem for VariationalSystem<'_> {
     }
     fn rhs(&self, t: f64, x: &[f64], out: &mut [f64]) {
         let n = self.inner.dim();
-        self.inner.rhs(t, &x[..n], &mut out[..n]);
         let mut j = vec![0.0; n * n];
-        self.inner.jac(t, &x[..n], &mut j);
+        self.inner.rhs_and_jac(t, &x[..n], &mut out[..n], &mut j);
         for k in 0..n {
             let phi = &x[n + k * n..n + (k + 1) * n];
             let o = &mut out[n + k * n..n + (k + 1) * n];
