@@ -14,7 +14,7 @@ use std::time::Instant;
 
 use stirling::dsl::Closure;
 use stirling::models::sim::{
-    self, shoot, shoot_krylov, KrylovOptions, LimitCycle, ShootingOptions, SimOptions,
+    self, shoot, shoot_krylov_counted, KrylovOptions, LimitCycle, ShootingOptions, SimOptions,
 };
 
 fn arg<T: std::str::FromStr>(args: &[String], name: &str) -> Option<T> {
@@ -88,16 +88,14 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             t.elapsed().as_secs_f64()
         );
         let t = Instant::now();
-        let k = shoot_krylov(
-            model,
-            &p,
-            &st.x0,
-            st.period,
-            &opts,
-            &KrylovOptions::default(),
-        )?;
+        let kopts = KrylovOptions::default();
+        let (k, c) = shoot_krylov_counted(model, &p, &st.x0, st.period, &opts, &kopts)?;
         let tk = t.elapsed().as_secs_f64();
         show("krylov", &k, tk);
+        println!(
+            "          {} GMRES products, {} Arnoldi products; {} Radau steps, {} with stored factors",
+            c.gmres_products, c.arnoldi_products, c.steps, c.cached_steps
+        );
         println!("          peak RSS so far {:.0} MB", peak_rss_mb());
         if model.n_states() <= dense_max {
             let t = Instant::now();

@@ -39,7 +39,8 @@ pub struct KrylovOptions {
     pub restart: usize,
     /// Most GMRES products per Newton iteration.
     pub max_products: usize,
-    /// Memory for stored stage LU factors (bytes); past it the steps are refactored per product.
+    /// Memory for stored stage LU factors (bytes); past it the steps are refactored per
+    /// product (same numbers, slower). Default: [`default_cache_bytes`].
     pub cache_bytes: usize,
     /// The leading multipliers.
     pub arnoldi: ArnoldiOptions,
@@ -51,9 +52,24 @@ impl Default for KrylovOptions {
             gmres_tol: 1e-10,
             restart: 60,
             max_products: 300,
-            cache_bytes: 2 << 30,
+            cache_bytes: default_cache_bytes(),
             arnoldi: ArnoldiOptions::default(),
         }
+    }
+}
+
+/// Half the memory the system reports available (`/proc/meminfo`), at most 8 GiB; 2 GiB
+/// where that cannot be read. nsection n = 1000 stores all of its ~1800 steps in ~5 GB;
+/// past the budget every product refactors the remaining steps (a few times slower).
+pub fn default_cache_bytes() -> usize {
+    let available_kb = std::fs::read_to_string("/proc/meminfo").ok().and_then(|s| {
+        s.lines()
+            .find(|l| l.starts_with("MemAvailable:"))
+            .and_then(|l| l.split_whitespace().nth(1)?.parse::<usize>().ok())
+    });
+    match available_kb {
+        Some(kb) => (kb * 512).min(8 << 30),
+        None => 2 << 30,
     }
 }
 
@@ -111,6 +127,18 @@ fn add_tangent(stats: &mut SolverStats, tf: &TangentFlow) {
     stats.lu_factorizations += tf.factorizations;
 }
 
+/// Work counters of [`shoot_krylov_counted`].
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct KrylovCounts {
+    /// Monodromy-vector products by GMRES, all Newton iterations.
+    pub gmres_products: usize,
+    /// Products by the Arnoldi run of the multipliers.
+    pub arnoldi_products: usize,
+    /// Radau steps of the last orbit, and how many kept their stage factors.
+    pub steps: usize,
+    pub cached_steps: usize,
+}
+
 /// Newton-Krylov shooting from `(x0, period)`; the cycle's `monodromy` is empty and
 /// `floquet` holds the leading multipliers ([`ArnoldiOptions::k`], largest modulus first).
 pub fn shoot_krylov(
@@ -121,6 +149,18 @@ pub fn shoot_krylov(
     opts: &ShootingOptions,
     kopts: &KrylovOptions,
 ) -> Result<LimitCycle, SimError> {
+    Ok(shoot_krylov_counted(model, p, x0, period, opts, kopts)?.0)
+}
+
+/// [`shoot_krylov`] with its work counters.
+pub fn shoot_krylov_counted(
+    model: &dyn Model,
+    p: &[f64],
+    x0: &[f64],
+    period: f64,
+    opts: &ShootingOptions,
+    kopts: &KrylovOptions,
+) -> Result<(LimitCycle, KrylovCounts), SimError> {
     let n = model.n_states();
     let sec = Section::of(model, p, x0)?;
     let substeps = match opts.monodromy {
@@ -131,6 +171,7 @@ pub fn shoot_krylov(
     let mut stats = SolverStats::default();
     let mut f = vec![0.0; n];
     let mut res = f64::INFINITY;
+    let mut counts = KrylovCounts::default();
     for it in 1..=opts.max_iter {
         let (phi, mut tf, st) =
             flow_with_tangent(model, p, &x, t_per, &opts.sim, substeps, kopts.cache_bytes)?;
@@ -138,9 +179,11 @@ pub fn shoot_krylov(
         let r: Vec<f64> = (0..n).map(|i| (phi[i] - x[i]) / sec.s[i]).collect();
         res = r.iter().fold(0.0f64, |a, v| a.max(v.abs()));
         if res < opts.tol {
-            let (floquet, _) = leading_multipliers(&mut |v| tf.apply(v), n, &kopts.arnoldi)?;
+            let (floquet, products) = leading_multipliers(&mut |v| tf.apply(v), n, &kopts.arnoldi)?;
             add_tangent(&mut stats, &tf);
-            return Ok(LimitCycle {
+            counts.arnoldi_products = products;
+            (counts.steps, counts.cached_steps) = (tf.steps(), tf.cached_steps());
+            let cycle = LimitCycle {
                 x0: x,
                 period: t_per,
                 monodromy: vec![],
@@ -148,7 +191,8 @@ pub fn shoot_krylov(
                 iterations: it,
                 residual: res,
                 stats,
-            });
+            };
+            return Ok((cycle, counts));
         }
         model.rhs(p, &phi, t_per, &mut f);
         let sys = Bordered::new(&sec, &f, t_per);
@@ -162,6 +206,7 @@ pub fn shoot_krylov(
             kopts.max_products,
         )?;
         add_tangent(&mut stats, &tf);
+        counts.gmres_products += sol.iterations;
         if !(sol.relative_residual < 1e-3) {
             return Err(SimError::ShootingFailed {
                 iterations: it,

@@ -59,7 +59,7 @@ pub use integrate::{
     check_physical, integrate, simulate, uniform_samples, Crossing, Hooks, LinearSolverKind,
     SimOptions, SolverStats, Trajectory, SPARSE_THRESHOLD,
 };
-pub use krylov_shooting::{shoot_krylov, KrylovOptions};
+pub use krylov_shooting::{shoot_krylov, shoot_krylov_counted, KrylovCounts, KrylovOptions};
 pub use physical::PhysicalCheck;
 pub use sens::{integrate_sens, SensSystem};
 pub use shooting::{
