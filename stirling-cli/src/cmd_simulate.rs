@@ -54,6 +54,30 @@ pub struct SimulateArgs {
     /// Run until periodic, refine by shooting, report the cycle
     #[arg(long)]
     pub limit_cycle: bool,
+    /// Shooting route of --limit-cycle: auto (dense monodromy up to 400 states, Newton-Krylov
+    /// with the leading Floquet multipliers up to 2100, none above), dense, krylov, or none
+    #[arg(long, value_enum, default_value_t = ShootingArg::Auto, requires = "limit_cycle")]
+    pub shooting: ShootingArg,
+}
+
+/// `--shooting`.
+#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ShootingArg {
+    Auto,
+    Dense,
+    Krylov,
+    None,
+}
+
+impl From<ShootingArg> for sim::Shooting {
+    fn from(a: ShootingArg) -> Self {
+        match a {
+            ShootingArg::Auto => sim::Shooting::Auto,
+            ShootingArg::Dense => sim::Shooting::Dense,
+            ShootingArg::Krylov => sim::Shooting::Krylov,
+            ShootingArg::None => sim::Shooting::Never,
+        }
+    }
 }
 
 pub fn run(args: &SimulateArgs) -> anyhow::Result<()> {
@@ -108,8 +132,18 @@ fn simulate(
         ..Default::default()
     };
     if args.limit_cycle {
-        let lc = sim::limit_cycle(model, p, x0, args.t_end, &samples, &opts, Some(progress))
-            .with_context(|| format!("limit cycle of `{}`", model.name()))?;
+        let shooting = args.shooting.into();
+        let lc = sim::limit_cycle_with(
+            model,
+            p,
+            x0,
+            args.t_end,
+            &samples,
+            &opts,
+            shooting,
+            Some(progress),
+        )
+        .with_context(|| format!("limit cycle of `{}`", model.name()))?;
         let tr = lc.settled.trajectory.clone();
         let s = SimSummary::from_run(model, &tr).with_cycle(&lc);
         return Ok((tr, s, Some(lc)));
@@ -293,6 +327,16 @@ fn print_summary(o: &mut impl Write, s: &SimSummary) -> std::io::Result<()> {
                 })
                 .collect();
             writeln!(o, "Floquet multipliers (largest): {}", fl.join(", "))?;
+        }
+        if let Some(route) = s.shooting {
+            let how = match route {
+                sim::ShootingRoute::Dense => "dense monodromy (all multipliers)",
+                sim::ShootingRoute::Krylov => {
+                    "Newton-Krylov (GMRES), leading multipliers by Arnoldi"
+                }
+                sim::ShootingRoute::Settled => "none (the settled cycle as measured)",
+            };
+            writeln!(o, "shooting: {how}")?;
         }
     } else {
         let x: Vec<String> = s.final_state.iter().map(|v| format!("{v:.6e}")).collect();

@@ -8,11 +8,15 @@
 //! - [`shooting`]: Newton on the return map, monodromy matrix, Floquet multipliers.
 //! - [`work`]: `closed-integral P dV` per vessel, indicated power.
 //!
-//! [`limit_cycle`] chains them: settle from a perturbed state, shoot, measure
-//! (above [`SHOOTING_MAX_STATES`] states it measures the settled cycle without
-//! shooting; [`limit_cycle_with`] chooses).
+//! [`limit_cycle`] chains them: settle from a perturbed state, shoot, measure.
+//! Up to [`SHOOTING_MAX_STATES`] states it shoots with the dense monodromy, above
+//! (up to [`KRYLOV_SHOOTING_MAX_STATES`]) by Newton-Krylov with the leading Floquet
+//! multipliers by Arnoldi, above that it measures the settled cycle; [`limit_cycle_with`]
+//! chooses.
 //!
 //! - [`monodromy`]: the monodromy by Radau IIA along the BDF trajectory.
+//! - [`tangent`]: monodromy-vector products along a recorded BDF trajectory.
+//! - [`krylov_shooting`], [`gmres`], [`floquet_arnoldi`]: the matrix-free route.
 
 mod adapter;
 /// A linear solver for block-diagonal Newton matrices whose blocks repeat.
@@ -21,8 +25,14 @@ pub mod block_lu;
 pub mod cycle;
 /// Dense-output helpers of the step loop (crossings, step hook, error mapping).
 mod dense_output;
+/// Leading Floquet multipliers by Arnoldi on monodromy-vector products.
+pub mod floquet_arnoldi;
+/// Restarted GMRES on a matrix-free operator.
+pub mod gmres;
 /// The step loop.
 pub mod integrate;
+/// Newton-Krylov shooting (large cycles).
+pub mod krylov_shooting;
 /// A dense LU solving many right-hand-side lanes at once (the sensitivity columns).
 pub mod lane_lu;
 /// The monodromy matrix without the `n (n + 1)`-state variational system.
@@ -35,6 +45,8 @@ pub mod sens;
 pub mod shooting;
 /// The ODE systems the integrator runs.
 pub mod system;
+/// Monodromy-vector products without the monodromy matrix.
+pub mod tangent;
 /// Cycle work.
 pub mod work;
 
@@ -42,10 +54,12 @@ use serde::Serialize;
 use stirling_dsl::Model;
 
 pub use cycle::{figures, periodic, settle, CycleFigures, Settled};
+pub use floquet_arnoldi::ArnoldiOptions;
 pub use integrate::{
     check_physical, integrate, simulate, uniform_samples, Crossing, Hooks, LinearSolverKind,
     SimOptions, SolverStats, Trajectory, SPARSE_THRESHOLD,
 };
+pub use krylov_shooting::{shoot_krylov, shoot_krylov_counted, KrylovCounts, KrylovOptions};
 pub use physical::PhysicalCheck;
 pub use sens::{integrate_sens, SensSystem};
 pub use shooting::{
@@ -80,6 +94,8 @@ pub enum SimError {
         residual: f64,
         why: String,
     },
+    #[error("the leading Floquet multipliers did not settle in {products} Arnoldi steps (last change {change:.2e})")]
+    FloquetNotConverged { products: usize, change: f64 },
     #[error("{0}")]
     BadOption(String),
 }
@@ -95,24 +111,67 @@ pub struct LimitCycleReport {
     pub orbit: Vec<Vec<f64>>,
     /// Counters of the settling run, the shooting and the orbit run together.
     pub stats: SolverStats,
+    /// How the cycle was refined.
+    pub route: ShootingRoute,
 }
 
-/// Above this many states [`Shooting::Auto`] skips shooting: the monodromy is
-/// dense `n x n` and each Radau step solves for all `n` columns (nsection n = 100,
-/// 208 states: about 16 s for the whole `limit_cycle` in release; n = 1000 would
-/// take hours).
+/// Above this many states [`Shooting::Auto`] shoots by Newton-Krylov instead of the
+/// dense monodromy: that is dense `n x n` and each Radau step solves for all `n` columns
+/// (nsection n = 100, 208 states: about 16 s for the whole `limit_cycle` in release;
+/// n = 1000 would take hours).
 pub const SHOOTING_MAX_STATES: usize = 400;
 
-/// Whether [`limit_cycle_with`] refines the settled cycle by shooting (and so
+/// Above this many states [`Shooting::Auto`] measures the settled cycle without shooting
+/// (nsection n = 1000 has 2008 states).
+pub const KRYLOV_SHOOTING_MAX_STATES: usize = 2100;
+
+/// Whether and how [`limit_cycle_with`] refines the settled cycle by shooting (and so
 /// reports Floquet multipliers).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum Shooting {
-    /// Shoot up to [`SHOOTING_MAX_STATES`] states, measure the settled cycle above.
+    /// Dense up to [`SHOOTING_MAX_STATES`] states, Krylov up to
+    /// [`KRYLOV_SHOOTING_MAX_STATES`], the settled cycle above.
     #[default]
     Auto,
+    /// Shoot at any size: dense up to [`SHOOTING_MAX_STATES`] states, Krylov above.
     Always,
+    /// The dense monodromy route at any size (all multipliers).
+    Dense,
+    /// The Newton-Krylov route at any size (the leading multipliers).
+    Krylov,
     /// Measure the cycle from the last simulated period (no Floquet multipliers).
     Never,
+}
+
+/// The route [`limit_cycle_with`] took.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum ShootingRoute {
+    /// Gauss-Newton on the dense monodromy; all Floquet multipliers.
+    #[default]
+    Dense,
+    /// Newton-Krylov on monodromy-vector products; the leading multipliers by Arnoldi.
+    Krylov,
+    /// No shooting: the settled cycle as measured.
+    Settled,
+}
+
+impl Shooting {
+    /// The route for a model of `n_states` states.
+    pub fn route(self, n_states: usize) -> ShootingRoute {
+        let by_size = if n_states <= SHOOTING_MAX_STATES {
+            ShootingRoute::Dense
+        } else {
+            ShootingRoute::Krylov
+        };
+        match self {
+            Shooting::Auto if n_states > KRYLOV_SHOOTING_MAX_STATES => ShootingRoute::Settled,
+            Shooting::Auto | Shooting::Always => by_size,
+            Shooting::Dense => ShootingRoute::Dense,
+            Shooting::Krylov => ShootingRoute::Krylov,
+            Shooting::Never => ShootingRoute::Settled,
+        }
+    }
 }
 
 /// Settle from `x0` (at most `t_max`), refine by shooting, and measure the cycle.
@@ -173,11 +232,7 @@ pub fn limit_cycle_with(
     progress: Option<&mut dyn FnMut(f64)>,
 ) -> Result<LimitCycleReport, SimError> {
     let settled = settle(model, p, x0, t_max, samples, 3, 1e-3, opts, progress)?;
-    let do_shoot = match shooting {
-        Shooting::Auto => model.n_states() <= SHOOTING_MAX_STATES,
-        Shooting::Always => true,
-        Shooting::Never => false,
-    };
+    let route = shooting.route(model.n_states());
     let sh = ShootingOptions {
         sim: SimOptions {
             linear_solver: opts.linear_solver,
@@ -186,8 +241,19 @@ pub fn limit_cycle_with(
         ..ShootingOptions::default()
     };
     let n_orbit = 512;
-    let (cycle, orbit_run) = if do_shoot {
-        let cycle = shoot(model, p, &settled.x0, settled.period, &sh)?;
+    let shot = match route {
+        ShootingRoute::Dense => Some(shoot(model, p, &settled.x0, settled.period, &sh)?),
+        ShootingRoute::Krylov => Some(shoot_krylov(
+            model,
+            p,
+            &settled.x0,
+            settled.period,
+            &sh,
+            &KrylovOptions::default(),
+        )?),
+        ShootingRoute::Settled => None,
+    };
+    let (cycle, orbit_run) = if let Some(cycle) = shot {
         let orbit_t = uniform_samples(cycle.period, n_orbit);
         let orbit_run = simulate(model, p, &cycle.x0, cycle.period, &orbit_t, &sh.sim)?;
         (cycle, orbit_run)
@@ -206,6 +272,7 @@ pub fn limit_cycle_with(
         work,
         orbit: orbit_run.x,
         stats,
+        route,
     })
 }
 
@@ -236,9 +303,13 @@ pub struct SimSummary {
     pub work_per_vessel_j: Option<Vec<(String, f64)>>,
     #[serde(skip_serializing_if = "Option::is_none")]
     pub power_w: Option<f64>,
-    /// Floquet multipliers `[re, im]`, largest modulus first.
+    /// Floquet multipliers `[re, im]`, largest modulus first (all of them by the dense
+    /// route, the leading ones by the Krylov route).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub floquet: Option<Vec<[f64; 2]>>,
+    /// How the limit cycle was refined: `dense`, `krylov` or `settled`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub shooting: Option<ShootingRoute>,
     pub steps: usize,
     pub rhs_calls: usize,
     pub jacobian_calls: usize,
@@ -284,6 +355,7 @@ impl SimSummary {
         self.power_w = Some(indicated_power(lc.work.total, f.frequency_hz));
         self.floquet = (!lc.cycle.floquet.is_empty())
             .then(|| lc.cycle.floquet.iter().map(|&(re, im)| [re, im]).collect());
+        self.shooting = Some(lc.route);
         self.steps = lc.stats.steps;
         self.rhs_calls = lc.stats.rhs_calls;
         self.jacobian_calls = lc.stats.jacobian_calls;

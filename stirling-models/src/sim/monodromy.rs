@@ -24,7 +24,7 @@
 
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::reborrow::Reborrow;
-use faer::sparse::linalg::lu::{factorize_symbolic_lu, NumericLu, SymbolicLu};
+use faer::sparse::linalg::lu::{factorize_symbolic_lu, LuRef, NumericLu, SymbolicLu};
 use faer::sparse::{Pair, SparseColMat, SymbolicSparseColMat};
 use faer::{Conj, Mat, Par};
 use nalgebra::DMatrix;
@@ -36,7 +36,7 @@ use super::system::{state_scale, ModelSystem, OdeSystem};
 use super::SimError;
 
 /// Radau IIA, 3 stages: nodes and coefficients.
-fn radau3() -> ([f64; 3], [[f64; 3]; 3]) {
+pub(super) fn radau3() -> ([f64; 3], [[f64; 3]; 3]) {
     let s6 = 6f64.sqrt();
     let c = [(4.0 - s6) / 10.0, (4.0 + s6) / 10.0, 1.0];
     let a = [
@@ -55,18 +55,19 @@ fn radau3() -> ([f64; 3], [[f64; 3]; 3]) {
     (c, a)
 }
 
-/// Sparse stage-matrix storage: pattern, symbolic LU, scratch, reused every step.
-struct SparseStage {
+/// Sparse stage-matrix storage: pattern, symbolic LU, scratch, reused every step
+/// (right-hand sides of `cols` columns).
+pub(super) struct SparseStage {
     mat: SparseColMat<usize, f64>,
-    symbolic: SymbolicLu<usize>,
-    numeric: NumericLu<usize, f64>,
+    pub(super) symbolic: SymbolicLu<usize>,
+    pub(super) numeric: NumericLu<usize, f64>,
     factor_scratch: MemBuffer,
-    solve_scratch: MemBuffer,
-    rhs: Mat<f64>,
+    pub(super) solve_scratch: MemBuffer,
+    pub(super) rhs: Mat<f64>,
 }
 
 impl SparseStage {
-    fn new(n: usize, pattern: &[(usize, usize)]) -> Result<Self, SimError> {
+    pub(super) fn new(n: usize, cols: usize, pattern: &[(usize, usize)]) -> Result<Self, SimError> {
         let mut idx = Vec::with_capacity(9 * pattern.len() + 3 * n);
         for bi in 0..3 {
             for bj in 0..3 {
@@ -89,7 +90,7 @@ impl SparseStage {
         let factor_scratch = MemBuffer::new(
             symbolic.factorize_numeric_lu_scratch::<f64>(Par::Seq, Default::default()),
         );
-        let solve_scratch = MemBuffer::new(symbolic.solve_in_place_scratch::<f64>(n, Par::Seq));
+        let solve_scratch = MemBuffer::new(symbolic.solve_in_place_scratch::<f64>(cols, Par::Seq));
         let nnz = sym.row_idx().len();
         Ok(Self {
             mat: SparseColMat::new(sym, vec![0.0; nnz]),
@@ -97,7 +98,7 @@ impl SparseStage {
             numeric: NumericLu::new(),
             factor_scratch,
             solve_scratch,
-            rhs: Mat::zeros(3 * n, n),
+            rhs: Mat::zeros(3 * n, cols),
         })
     }
 }
@@ -176,28 +177,39 @@ impl Propagator<'_> {
                     why: "no dense output for the monodromy stage".into(),
                 });
             }
-            self.trip[j].clear();
-            self.sys.jac_triplets(tj, &self.x, &mut self.trip[j]);
-            for e in self.trip[j].iter_mut() {
-                e.2 *= self.scale[e.1] / self.scale[e.0];
-            }
+            scaled_triplets(&self.sys, tj, &self.x, &self.scale, &mut self.trip[j]);
             self.jac_calls += 1;
         }
         Ok(())
     }
 }
 
+/// The scaled Jacobian `D^-1 J D` at `(t, x)` as triplets in `out` (cleared first).
+pub(super) fn scaled_triplets(
+    sys: &ModelSystem<'_>,
+    t: f64,
+    x: &[f64],
+    scale: &[f64],
+    out: &mut Vec<(usize, usize, f64)>,
+) {
+    out.clear();
+    sys.jac_triplets(t, x, out);
+    for e in out.iter_mut() {
+        e.2 *= scale[e.1] / scale[e.0];
+    }
+}
+
 /// The stage system of one Radau step: `(I - h A (x) J_j) K = Phi` stacked three times.
-struct StageStep<'t> {
-    n: usize,
-    h: f64,
-    a: &'t [[f64; 3]; 3],
-    trip: &'t [Vec<(usize, usize, f64)>; 3],
+pub(super) struct StageStep<'t> {
+    pub(super) n: usize,
+    pub(super) h: f64,
+    pub(super) a: &'t [[f64; 3]; 3],
+    pub(super) trip: &'t [Vec<(usize, usize, f64)>; 3],
 }
 
 /// Why one Radau stage solve failed (mapped to [`SimError::SolverFailure`] at the step's time).
 #[derive(Debug, thiserror::Error)]
-enum StageError {
+pub(super) enum StageError {
     #[error("sparse LU of the stage matrix failed: {0}")]
     Factorization(String),
     #[error("singular stage matrix")]
@@ -205,8 +217,8 @@ enum StageError {
 }
 
 impl StageStep<'_> {
-    /// Solve with the sparse LU of `sp`; `phi` becomes the last stage.
-    fn solve_sparse(&self, sp: &mut SparseStage, phi: &mut [f64]) -> Result<(), StageError> {
+    /// Assemble the stage matrix into `sp` and factorize it into `sp.numeric`.
+    pub(super) fn factor_sparse(&self, sp: &mut SparseStage) -> Result<(), StageError> {
         let (n, h, a) = (self.n, self.h, self.a);
         let (sym, vals) = sp.mat.parts_mut();
         vals.fill(0.0);
@@ -225,8 +237,7 @@ impl StageStep<'_> {
             shifted.extend((0..n).map(|k| (i * n + k, i * n + k, 1.0)));
             scatter(sym.col_ptr(), sym.row_idx(), vals, &shifted);
         }
-        let lu = sp
-            .symbolic
+        sp.symbolic
             .factorize_numeric_lu(
                 &mut sp.numeric,
                 sp.mat.rb(),
@@ -235,24 +246,14 @@ impl StageStep<'_> {
                 Default::default(),
             )
             .map_err(|e| StageError::Factorization(format!("{e:?}")))?;
-        for col in 0..n {
-            for i in 0..3 {
-                for r in 0..n {
-                    sp.rhs[(i * n + r, col)] = phi[r + col * n];
-                }
-            }
-        }
-        lu.solve_in_place_with_conj(
-            Conj::No,
-            sp.rhs.as_mut(),
-            Par::Seq,
-            MemStack::new(&mut sp.solve_scratch),
-        );
-        for col in 0..n {
-            for r in 0..n {
-                phi[r + col * n] = sp.rhs[(2 * n + r, col)];
-            }
-        }
+        Ok(())
+    }
+
+    /// Solve with the sparse LU of `sp`; `phi` becomes the last stage.
+    fn solve_sparse(&self, sp: &mut SparseStage, phi: &mut [f64]) -> Result<(), StageError> {
+        self.factor_sparse(sp)?;
+        let lu = LuRef::new_unchecked(&sp.symbolic, &sp.numeric);
+        solve_stages(self.n, lu, &mut sp.rhs, &mut sp.solve_scratch, phi);
         Ok(())
     }
 
@@ -287,6 +288,31 @@ impl StageStep<'_> {
     }
 }
 
+/// Solve the stage system factored in `lu` for the columns of `phi` (`n` rows each, as many
+/// columns as `rhs` has); `phi` becomes the last stage.
+pub(super) fn solve_stages(
+    n: usize,
+    lu: LuRef<'_, usize, f64>,
+    rhs: &mut Mat<f64>,
+    scratch: &mut MemBuffer,
+    phi: &mut [f64],
+) {
+    let cols = rhs.ncols();
+    for col in 0..cols {
+        for i in 0..3 {
+            for r in 0..n {
+                rhs[(i * n + r, col)] = phi[r + col * n];
+            }
+        }
+    }
+    lu.solve_in_place_with_conj(Conj::No, rhs.as_mut(), Par::Seq, MemStack::new(scratch));
+    for col in 0..cols {
+        for r in 0..n {
+            phi[r + col * n] = rhs[(2 * n + r, col)];
+        }
+    }
+}
+
 /// The flow `phi(x0, T)` and its monodromy matrix (column-major `n x n`), with
 /// `substeps` Radau IIA steps per accepted BDF step.
 pub fn flow_with_monodromy_radau(
@@ -300,7 +326,7 @@ pub fn flow_with_monodromy_radau(
     let n = model.n_states();
     let sys = ModelSystem { model, p };
     let sparse = if opts.linear_solver.use_sparse(n, true) {
-        Some(SparseStage::new(n, &model.sparsity(p))?)
+        Some(SparseStage::new(n, n, &model.sparsity(p))?)
     } else {
         None
     };

@@ -163,17 +163,17 @@ pub fn flow_with_monodromy_variational(
 
 /// What closes the shooting system besides the return map: the Poincare section (the
 /// piston position `iy` at zero) and, with mass states, the conserved inventory `m_total`.
-struct Section {
+pub(super) struct Section {
     /// State scales.
-    s: Vec<f64>,
-    iy: usize,
-    masses: Vec<usize>,
-    m_total: f64,
+    pub(super) s: Vec<f64>,
+    pub(super) iy: usize,
+    pub(super) masses: Vec<usize>,
+    pub(super) m_total: f64,
 }
 
 impl Section {
     /// The section of `model` at `p`, with the inventory of the start `x0`.
-    fn of(model: &dyn Model, p: &[f64], x0: &[f64]) -> Result<Section, SimError> {
+    pub(super) fn of(model: &dyn Model, p: &[f64], x0: &[f64]) -> Result<Section, SimError> {
         let masses = crate::layout::StateLayout::of(model).masses;
         let m_total: f64 = masses.iter().map(|&i| x0[i]).sum();
         Ok(Section {

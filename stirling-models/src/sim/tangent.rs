@@ -1,0 +1,212 @@
+//! Monodromy-vector products `Phi v` without the monodromy matrix: the directional
+//! (one-column) form of [`super::monodromy`].
+//!
+//! [`flow_with_tangent`] integrates the state once by the adaptive BDF and records, for
+//! every accepted step (split into `substeps` equal parts), the step `(t0, h)` and the
+//! state at the three Radau IIA stage times from the dense output. [`TangentFlow::apply`]
+//! then advances one vector `v` along the recorded steps by the same 3-stage Radau IIA
+//! stage system as the dense route,
+//!
+//! ```text
+//! (I - h A (x) J_s(t0 + c_j h)) K = (v, v, v),   v <- K_3,
+//! ```
+//!
+//! in state-scaled form (`J_s = D^-1 J D`), so a product is `D^-1 Phi D v` with the
+//! same discrete `Phi` as [`super::monodromy::flow_with_monodromy_radau`] (to round-off:
+//! same steps, same stage states, same stage matrices). The stage matrix is factored by a
+//! faer sparse LU (symbolic analysis once); the numeric factors of the first steps are kept
+//! up to [`TangentFlow`]'s memory budget, so repeated products (GMRES, Arnoldi) cost one
+//! triangular solve per step there and a refactorization only past the budget.
+//!
+//! Why this route and not the staggered sensitivities of [`super::sens`]: those
+//! re-run the corrector of the BDF for every direction (a full nonlinear run per
+//! product), while here a product is linear work on stored data, and it reproduces the
+//! dense route's `Phi` exactly, which the route-equality test relies on.
+
+use faer::sparse::linalg::lu::{LuRef, NumericLu};
+use stirling_dsl::Model;
+
+use super::integrate::{integrate, Hooks, SimOptions, SolverStats};
+use super::monodromy::{radau3, scaled_triplets, solve_stages, SparseStage, StageStep};
+use super::system::{state_scale, ModelSystem};
+use super::SimError;
+
+/// Bytes of one stored numeric LU factor per stage-matrix nonzero (values and indices of
+/// `L` and `U` with the fill measured on `nsection`: about 3x the stage matrix's nonzeros).
+const LU_BYTES_PER_NNZ: usize = 48;
+
+/// The recorded orbit and the operator `v -> D^-1 Phi D v`.
+pub struct TangentFlow<'m> {
+    sys: ModelSystem<'m>,
+    n: usize,
+    /// `(t0, h)` of every Radau step.
+    steps: Vec<(f64, f64)>,
+    /// The states at the three stage times, `3 n` per step.
+    stage_x: Vec<f64>,
+    sparse: SparseStage,
+    /// Numeric LU factors of the first steps' stage matrices.
+    cache: Vec<NumericLu<usize, f64>>,
+    cache_limit: usize,
+    trip: [Vec<(usize, usize, f64)>; 3],
+    scale: Vec<f64>,
+    /// Products applied so far.
+    pub products: usize,
+    /// Stage-matrix factorizations so far.
+    pub factorizations: usize,
+    /// Jacobian evaluations so far.
+    pub jacobian_calls: usize,
+}
+
+impl TangentFlow<'_> {
+    /// The number of states.
+    pub fn dim(&self) -> usize {
+        self.n
+    }
+
+    /// The number of recorded Radau steps.
+    pub fn steps(&self) -> usize {
+        self.steps.len()
+    }
+
+    /// How many steps keep their stage factors.
+    pub fn cached_steps(&self) -> usize {
+        self.cache.len()
+    }
+
+    /// `v <- D^-1 Phi D v` (`v` of length `n`, state-scaled).
+    pub fn apply(&mut self, v: &mut [f64]) -> Result<(), SimError> {
+        if v.len() != self.n {
+            return Err(SimError::DimensionMismatch {
+                expected: self.n,
+                found: v.len(),
+            });
+        }
+        self.products += 1;
+        for k in 0..self.steps.len() {
+            if k >= self.cache.len() {
+                self.factor(k)?;
+            }
+            let numeric = self.cache.get(k).unwrap_or(&self.sparse.numeric);
+            let lu = LuRef::new_unchecked(&self.sparse.symbolic, numeric);
+            solve_stages(
+                self.n,
+                lu,
+                &mut self.sparse.rhs,
+                &mut self.sparse.solve_scratch,
+                v,
+            );
+        }
+        Ok(())
+    }
+
+    /// Factor step `k`'s stage matrix into `sparse.numeric` (moved into the cache while
+    /// the budget lasts and `k` is the next uncached step).
+    fn factor(&mut self, k: usize) -> Result<(), SimError> {
+        let (c, a) = radau3();
+        let (t0, h) = self.steps[k];
+        let n = self.n;
+        for j in 0..3 {
+            let x = &self.stage_x[(3 * k + j) * n..(3 * k + j + 1) * n];
+            scaled_triplets(&self.sys, t0 + c[j] * h, x, &self.scale, &mut self.trip[j]);
+            self.jacobian_calls += 1;
+        }
+        let stage = StageStep {
+            n,
+            h,
+            a: &a,
+            trip: &self.trip,
+        };
+        stage
+            .factor_sparse(&mut self.sparse)
+            .map_err(|e| SimError::SolverFailure {
+                t: t0,
+                why: format!("tangent step: {e}"),
+            })?;
+        self.factorizations += 1;
+        if k == self.cache.len() && k < self.cache_limit {
+            self.cache.push(std::mem::take(&mut self.sparse.numeric));
+        }
+        Ok(())
+    }
+
+    /// Record the Radau (sub)steps of the BDF step `[t0, t1]`.
+    fn record(
+        &mut self,
+        t0: f64,
+        t1: f64,
+        substeps: usize,
+        dense: &dyn Fn(f64, &mut [f64]),
+    ) -> Result<(), SimError> {
+        let (c, _) = radau3();
+        let m = substeps.max(1);
+        let n = self.n;
+        for k in 0..m {
+            let a = t0 + (t1 - t0) * k as f64 / m as f64;
+            let b = if k + 1 == m {
+                t1
+            } else {
+                t0 + (t1 - t0) * (k + 1) as f64 / m as f64
+            };
+            let h = b - a;
+            if !(h > 0.0) {
+                continue;
+            }
+            for cj in c {
+                let start = self.stage_x.len();
+                self.stage_x.resize(start + n, 0.0);
+                dense(a + cj * h, &mut self.stage_x[start..]);
+                if self.stage_x[start..].iter().any(|v| !v.is_finite()) {
+                    return Err(SimError::SolverFailure {
+                        t: a + cj * h,
+                        why: "no dense output for the tangent stage".into(),
+                    });
+                }
+            }
+            self.steps.push((a, h));
+        }
+        Ok(())
+    }
+}
+
+/// The flow `phi(x0, T)` and the recorded orbit for products with its monodromy, with
+/// `substeps` Radau steps per BDF step and at most `cache_bytes` of stored stage factors.
+pub fn flow_with_tangent<'m>(
+    model: &'m dyn Model,
+    p: &'m [f64],
+    x0: &[f64],
+    period: f64,
+    opts: &SimOptions,
+    substeps: usize,
+    cache_bytes: usize,
+) -> Result<(Vec<f64>, TangentFlow<'m>, SolverStats), SimError> {
+    let n = model.n_states();
+    let pattern = model.sparsity(p);
+    let stage_nnz = 9 * pattern.len() + 3 * n;
+    let mut tf = TangentFlow {
+        sys: ModelSystem { model, p },
+        n,
+        steps: Vec::new(),
+        stage_x: Vec::new(),
+        sparse: SparseStage::new(n, 1, &pattern)?,
+        cache: Vec::new(),
+        cache_limit: cache_bytes / (LU_BYTES_PER_NNZ * stage_nnz).max(1),
+        trip: Default::default(),
+        scale: state_scale(model, p),
+        products: 0,
+        factorizations: 0,
+        jacobian_calls: 0,
+    };
+    let sys = ModelSystem { model, p };
+    let mut on_step =
+        |t0: f64, t1: f64, dense: &dyn Fn(f64, &mut [f64])| tf.record(t0, t1, substeps, dense);
+    let checker = super::physical::PhysicalCheck::new(model, p);
+    let check = |t: f64, x: &[f64]| checker.check(t, x);
+    let hooks = Hooks {
+        check: Some(&check),
+        on_step: Some(&mut on_step),
+        ..Default::default()
+    };
+    let tr = integrate(&sys, x0, period, &[period], opts, hooks)?;
+    let x_end = tr.x.last().cloned().unwrap_or(tr.x_end);
+    Ok((x_end, tf, tr.stats))
+}
