@@ -40,7 +40,11 @@ fn bits(v: &[f64]) -> Vec<u64> {
     v.iter().map(|x| x.to_bits()).collect()
 }
 
-fn check(m: &dyn Model, label: &str, seed: u64) {
+/// `fd`: also check the combined Jacobian against finite differences of the combined RHS
+/// (off for the arrow models: their closed CV's columns are below finite-difference
+/// resolution of a single step; their separate Jacobians are checked in `dsl_sections` and
+/// `dsl_walls` with the multi-step estimate, and the combined one equals them bit for bit).
+fn check(m: &dyn Model, label: &str, seed: u64, fd: bool) {
     let p = m.default_params();
     let mut r = rng(seed);
     let n = m.n_states();
@@ -56,6 +60,9 @@ fn check(m: &dyn Model, label: &str, seed: u64) {
                     .collect::<Vec<_>>()
             };
             assert_eq!(key(&t), key(&u), "{label} {spread:?} {k}: Jacobian differs");
+            if !fd {
+                continue;
+            }
             // the combined Jacobian against finite differences of the combined rhs
             let mut dense = vec![0.0; n * n];
             let mut scratch = vec![0.0; n];
@@ -82,8 +89,12 @@ fn check(m: &dyn Model, label: &str, seed: u64) {
 }
 
 fn both(make: impl Fn(Closure) -> Box<dyn Model>, label: &str, seed: u64) {
+    both_fd(make, label, seed, true)
+}
+
+fn both_fd(make: impl Fn(Closure) -> Box<dyn Model>, label: &str, seed: u64, fd: bool) {
     for c in [Closure::Full, Closure::Frozen] {
-        check(make(c).as_ref(), &format!("{label} ({c})"), seed);
+        check(make(c).as_ref(), &format!("{label} ({c})"), seed, fd);
     }
 }
 
@@ -124,22 +135,25 @@ fn chains_combined_equals_separate() {
 fn per_section_links_combined_equals_separate() {
     for n in [1, 2, 3, 6] {
         let label = format!("leak_to_cv n={n}");
-        both(
+        both_fd(
             |c| Box::new(sections::LeakToCv::new(n, c).unwrap()),
             &label,
             40 + n as u64,
+            false,
         );
         let label = format!("leak_to_space n={n}");
-        both(
+        both_fd(
             |c| Box::new(sections::LeakToSpace::new(n, c).unwrap()),
             &label,
             50 + n as u64,
+            false,
         );
         let label = format!("matrix_wall n={n}");
-        both(
+        both_fd(
             |c| Box::new(walls::MatrixWall::new(n, c).unwrap()),
             &label,
             60 + n as u64,
+            false,
         );
     }
 }
