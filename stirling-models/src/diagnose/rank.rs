@@ -67,7 +67,18 @@ fn fit(
             s.clamp(-2.0, 2.0)
         };
     }
-    let mut fixed: Vec<usize> = Vec::new();
+    fit_from(joint, u0, Vec::new(), opts)
+}
+
+/// Levenberg-Marquardt from `u0` with the variables `fixed` held; a bounded strength that
+/// ends below its null is held there and the fit redone.
+fn fit_from(
+    joint: &Joint,
+    mut u0: Vec<f64>,
+    mut fixed: Vec<usize>,
+    opts: &LmOptions,
+) -> Result<(lm::LmResult, Vec<usize>), DiagnoseError> {
+    let strengths: Vec<&EffectVar> = joint.effect.iter().filter(|v| !v.shape).collect();
     for _ in 0..=strengths.len() {
         let res = solve(joint, &u0, &fixed, opts).ok_or(DiagnoseError::JointStart)?;
         let below: Vec<usize> = strengths
@@ -202,8 +213,9 @@ fn fit_candidate(
     opts: &LmOptions,
     entry: &mut RankEntry,
 ) -> Result<Option<Eval>, DiagnoseError> {
-    let joint = Joint::new(ctx.model, nominal, s2, e, shapes, !shapes.is_empty())?;
-    let (res, fixed) = best_fit(ctx, &joint, nominal, e, score, shapes, opts)?;
+    let mut joint = Joint::new(ctx.model, nominal, s2, e, shapes, !shapes.is_empty())?;
+    let best = best_fit(ctx, &joint, nominal, e, score, shapes, opts)?;
+    let (res, fixed) = settle(&mut joint, best, opts);
     entry.params = estimates(&joint, &res, &fixed);
     let ev = ctx.eval_joint(&joint, &res.x, joint.effect_values(&res.x))?;
     let k = joint.effect.len() - fixed.len();
@@ -217,6 +229,48 @@ fn fit_candidate(
             + prior_change,
     );
     Ok(Some(ev))
+}
+
+/// Rounds of [`settle`] at most.
+const SETTLE_ROUNDS: usize = 4;
+/// A round that moves no scaled variable of the gas stage by more than this (a thousandth of
+/// its starting value, for a parameter) ends [`settle`].
+const SETTLED: f64 = 1e-3;
+
+/// The joint fit taken to the fixed point of the two stages (records without `p_hot`, see
+/// [`Joint::rebase`]): stage 1's pressure differences re-evaluated at the fitted gas stage
+/// and the fit redone from its optimum, until the gas stage stops moving. A round that fails
+/// (a refit that cannot be integrated) leaves the problem and the fit of the round before.
+fn settle(
+    joint: &mut Joint,
+    mut fit: (lm::LmResult, Vec<usize>),
+    opts: &LmOptions,
+) -> (lm::LmResult, Vec<usize>) {
+    if !joint.has_dp_link() {
+        return fit;
+    }
+    for _ in 0..SETTLE_ROUNDS {
+        let mut next = joint.clone();
+        let Some(refit) = settle_round(&mut next, &fit, opts) else {
+            break;
+        };
+        let moved = next.gas_change(&fit.0.x, &refit.0.x);
+        (*joint, fit) = (next, refit);
+        if moved < SETTLED {
+            break;
+        }
+    }
+    fit
+}
+
+/// One round of [`settle`]: rebase `joint` at the fit and fit again from there.
+fn settle_round(
+    joint: &mut Joint,
+    (res, fixed): &(lm::LmResult, Vec<usize>),
+    opts: &LmOptions,
+) -> Option<(lm::LmResult, Vec<usize>)> {
+    joint.rebase(&res.x).ok()?;
+    fit_from(joint, res.x.clone(), fixed.clone(), opts).ok()
 }
 
 /// The starts of a joint fit (see [`best_fit`]): a fixed strength (else the one-step
