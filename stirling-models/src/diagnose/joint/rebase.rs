@@ -17,9 +17,16 @@
 //! on clean records, as they were. Linking the gas parameters into stage 1 instead would make
 //! stage 1's rows estimate them too (a different estimator than the calibration's, whose
 //! optimum is no longer the null of the score test).
+//!
+//! Only where stage 1 sees how the variables it shares with the gas stage move the
+//! differences: a model effect's strength is linked into stage 1 (its first-order derivative
+//! is re-taken at each round), a pressure lag does not move them. A position gain does (the
+//! gas stage reads the positions through it) but has no link, so a round would move stage 1's
+//! input without stage 1's rows seeing why; on the self-check's gain records that drove the
+//! gain away (closure 0.86 to -437), so the joint of a gain keeps the nominal differences.
 
 use super::{is_mechanics, Joint};
-use crate::fit::vars::VarKind;
+use crate::fit::vars::{Sensor, VarKind};
 use crate::fit::{unmeasured, FitError, FittedStage};
 
 /// Where stage 1 of a joint problem reads the gas stage's pressure differences.
@@ -43,6 +50,12 @@ impl DpLink {
             .iter()
             .position(|(_, s)| is_mechanics(s) && !s.stage.derived.is_empty())?;
         let gas = stages.iter().position(|(_, s)| !is_mechanics(s))?;
+        let unlinked = stages[gas].1.stage.vars.iter().any(
+            |v| matches!(&v.kind, VarKind::Sensor(Sensor::Gain { given, .. }) if !given.is_empty()),
+        );
+        if unlinked {
+            return None;
+        }
         let ms = &stages[mech].1.stage;
         let base = ms
             .given
