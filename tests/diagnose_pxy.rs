@@ -77,3 +77,45 @@ fn withheld_quadratic_regenerator_friction_is_the_verdict_on_pxy() {
         "Rq {value:e} [{lo:e}, {hi:e}] vs {truth:e}"
     );
 }
+
+/// A leak at the self-check's 1x strength (`Gleak = 1e-8`, -16 % stroke) on a `p, x, y`
+/// record (evaluation seed, the self-check's record and start), the leak the only candidate:
+/// the calibration absorbs it into the regenerator friction (`Rf` far down) and stage 1 into
+/// doubled damping; fitted, the leak returns `Rf`, and only with stage 1 re-reading the fitted
+/// gas stage's pressure differences (the two stages' fixed point, `diagnose::joint::rebase`)
+/// does `bd` return too and the closure clear the verdict's bound (0.21 before).
+#[test]
+fn withheld_leak_at_the_self_check_strength_is_the_verdict_on_pxy() {
+    use selfcheck::VerdictOptions;
+    let opts = VerdictOptions {
+        effects: Some(vec!["leak".into()]),
+        strengths: vec![1.0],
+        outside: Some(vec![]),
+        seeds: (0, 1),
+        clean: (0, 0),
+        rate: 1000.0,
+        jobs: 1,
+        diagnose: DiagnoseOptions {
+            effects: Some(vec!["leak".into()]),
+            bootstrap: 200,
+            ..Default::default()
+        },
+        ..Default::default()
+    };
+    let progress = |c: &selfcheck::outcome::Outcome, done: usize, total: usize| {
+        eprintln!("[{done}/{total}] {}", selfcheck::report::case_row(c));
+    };
+    let v = selfcheck::run_verdicts(&opts, &progress).unwrap();
+    let c = &v.cases[0];
+    assert!(c.error.is_none(), "{:?}", c.error);
+    let (lo, hi) = (c.ci_low.unwrap(), c.ci_high.unwrap());
+    assert_eq!(c.verdict, "leak", "closure {:?} [{lo}, {hi}]", c.closure);
+    let gleak = &c.ranking[0].params[0];
+    assert!(
+        gleak.ci_low < 1e-8 && 1e-8 < gleak.ci_high,
+        "Gleak {:e} [{:e}, {:e}]",
+        gleak.value,
+        gleak.ci_low,
+        gleak.ci_high
+    );
+}

@@ -28,6 +28,8 @@ pub mod error;
 mod gap;
 /// The joint problem of one candidate: the calibrated stages extended by its variables.
 pub mod joint;
+/// The joint fit of one candidate from one start.
+mod joint_fit;
 /// Where: residuals by channel, harmonic, phase of the cycle and subsystem.
 pub mod localize;
 /// Which: fit and rank the screened candidates.

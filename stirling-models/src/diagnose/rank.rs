@@ -10,7 +10,8 @@
 use nalgebra::DVector;
 
 use super::context::{Context, Eval};
-use super::joint::{EffectVar, Joint};
+use super::joint::Joint;
+use super::joint_fit::{fit, settle};
 use super::score::Score;
 use super::screen::Screened;
 use super::types::{EffectEstimate, RankEntry};
@@ -24,71 +25,6 @@ pub struct Assessed {
     pub entry: RankEntry,
     /// The fitted model's evaluation on the record.
     pub eval: Option<Eval>,
-}
-
-/// Levenberg-Marquardt on the joint problem from `u0`, with the variables `fixed` held.
-fn solve(joint: &Joint, u0: &[f64], fixed: &[usize], opts: &LmOptions) -> Option<lm::LmResult> {
-    let mut eval = |u: &[f64]| {
-        let mut u = u.to_vec();
-        fixed.iter().for_each(|&i| u[i] = u0[i]);
-        let (r, mut j, _) = joint.residuals(&u).ok()?;
-        for &i in fixed {
-            j.column_mut(i).fill(0.0);
-        }
-        Some((r, j))
-    };
-    let mut resid = |u: &[f64]| {
-        let mut u = u.to_vec();
-        fixed.iter().for_each(|&i| u[i] = u0[i]);
-        joint.trial_residuals(&u).ok()
-    };
-    // trial points by their residuals alone: most are rejected (the last iterations of a
-    // converged fit try up to 30 damped steps), and the sensitivities cost several runs
-    let mut res = lm::minimize_split(&mut eval, Some(&mut resid), u0, opts)?;
-    fixed.iter().for_each(|&i| res.x[i] = u0[i]);
-    Some(res)
-}
-
-/// Fit the effect jointly: strengths start at the one-step estimate (kept on their side of
-/// the bound); a bounded strength that ends below its null is held there and the fit redone.
-fn fit(
-    joint: &Joint,
-    start: &[f64],
-    score: &Score,
-    opts: &LmOptions,
-) -> Result<(lm::LmResult, Vec<usize>), DiagnoseError> {
-    let mut u0 = start.to_vec();
-    let strengths: Vec<&EffectVar> = joint.effect.iter().filter(|v| !v.shape).collect();
-    for (v, &s) in strengths.iter().zip(&score.step) {
-        // a strength the screen dropped still gets a small push to explore its side
-        u0[v.index] = if v.bounded {
-            s.clamp(0.05, 2.0)
-        } else {
-            s.clamp(-2.0, 2.0)
-        };
-    }
-    let mut fixed: Vec<usize> = Vec::new();
-    for _ in 0..=strengths.len() {
-        let res = solve(joint, &u0, &fixed, opts).ok_or(DiagnoseError::JointStart)?;
-        let below: Vec<usize> = strengths
-            .iter()
-            .filter(|v| v.bounded && !fixed.contains(&v.index) && res.x[v.index] < 0.0)
-            .map(|v| v.index)
-            .collect();
-        if below.is_empty() {
-            return Ok((res, fixed));
-        }
-        for i in below {
-            u0[i] = 0.0;
-            fixed.push(i);
-        }
-        u0.iter_mut()
-            .zip(&res.x)
-            .enumerate()
-            .filter(|(i, _)| !fixed.contains(i))
-            .for_each(|(_, (a, b))| *a = *b);
-    }
-    Err(DiagnoseError::JointBounds)
 }
 
 /// Estimates with 95 % intervals from the Gauss-Newton covariance at the optimum.
@@ -202,8 +138,9 @@ fn fit_candidate(
     opts: &LmOptions,
     entry: &mut RankEntry,
 ) -> Result<Option<Eval>, DiagnoseError> {
-    let joint = Joint::new(ctx.model, nominal, s2, e, shapes, !shapes.is_empty())?;
-    let (res, fixed) = best_fit(ctx, &joint, nominal, e, score, shapes, opts)?;
+    let mut joint = Joint::new(ctx.model, nominal, s2, e, shapes, !shapes.is_empty())?;
+    let best = best_fit(ctx, &joint, nominal, e, score, shapes, opts)?;
+    let (res, fixed) = settle(&mut joint, best, opts);
     entry.params = estimates(&joint, &res, &fixed);
     let ev = ctx.eval_joint(&joint, &res.x, joint.effect_values(&res.x))?;
     let k = joint.effect.len() - fixed.len();

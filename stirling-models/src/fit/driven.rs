@@ -124,9 +124,9 @@ fn set_var(pr: &mut Prepared, v: &Var, val: f64, trial: bool) -> Result<Option<C
             }
         }
         VarKind::Sensor(_) => None,
-        VarKind::Linked(pairs) => {
+        VarKind::Linked { pairs, at } => {
             for &(g, s) in pairs {
-                pr.given[g].terms.push((s, val - v.initial, false));
+                pr.given[g].terms.push((s, val - at, false));
             }
             Some(Column::Signals {
                 pairs: pairs.clone(),

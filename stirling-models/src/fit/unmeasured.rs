@@ -17,7 +17,7 @@ use super::driven::Stage;
 use super::record::Record;
 use super::report::FitStats;
 use super::sensitivity::Signal;
-use super::vars::{Output, VarKind};
+use super::vars::{Output, Sensor, VarKind};
 use super::FitError;
 use crate::layout::StateLayout;
 
@@ -58,7 +58,38 @@ pub fn difference_sensitivity(
     }))
 }
 
-/// A run of the gas stage whose outputs are every CV's pressure (no offsets).
+/// `P_i - P_cold` of the gas stage at its variables `u` for every CV but the cold one, and
+/// their derivatives with respect to the value of each variable in `vars`, over samples
+/// `0..=last` (held at the first value before `first`): one run, with sensitivities only when
+/// `vars` is not empty.
+pub fn differences_at(
+    gas: &Stage,
+    u: &[f64],
+    vars: &[usize],
+    first: usize,
+    last: usize,
+) -> Result<(Vec<Signal>, Vec<Vec<Signal>>), FitError> {
+    let layout = StateLayout::of(gas.model);
+    let run = pressure_run(gas, u, &layout, first, last, !vars.is_empty())?;
+    let cold = run.yhat.len() - 1;
+    let mut dp = signals(gas, cold, first, last, |i, k| {
+        run.yhat[i][k] - run.yhat[cold][k]
+    });
+    dp.truncate(cold);
+    let sens = vars
+        .iter()
+        .map(|&v| {
+            let scale = gas.vars[v].scale;
+            signals(gas, cold, first, last, |i, k| {
+                (run.dyhat[i][k][v] - run.dyhat[cold][k][v]) / scale
+            })
+        })
+        .collect();
+    Ok((dp, sens))
+}
+
+/// A run of the gas stage whose outputs are every CV's pressure (no offsets, no sensor
+/// distortion of the outputs: the mechanics feel the true pressures).
 fn pressure_run(
     gas: &Stage,
     u: &[f64],
@@ -80,8 +111,12 @@ fn pressure_run(
         .collect();
     // offsets still move the prescribed positions, but no output carries them
     for v in &mut st.vars {
-        if let VarKind::Offset { out, .. } = &mut v.kind {
-            *out = usize::MAX;
+        match &mut v.kind {
+            VarKind::Offset { out, .. } => *out = usize::MAX,
+            VarKind::Sensor(Sensor::Lag { outputs, .. } | Sensor::Gain { outputs, .. }) => {
+                outputs.clear()
+            }
+            _ => {}
         }
     }
     st.run(u, first, last, sens)

@@ -71,9 +71,10 @@ pub enum VarKind {
     Sensor(Sensor),
     /// A parameter of the gas stage seen by the mechanics stage through the pressure
     /// differences it supplies (records without `p_hot`): prescribed state `g` gains
-    /// `(value - initial) s(t)` for each `(g, s)`, `s` the signal of `dP_g / dvalue` (the
-    /// first-order link; see `diagnose::joint`).
-    Linked(Vec<(usize, usize)>),
+    /// `(value - at) s(t)` for each `(g, s)` in `pairs`, `s` the signal of `dP_g / dvalue`
+    /// at the value `at` the differences were computed at (the first-order link; see
+    /// `diagnose::joint`).
+    Linked { pairs: Vec<(usize, usize)>, at: f64 },
 }
 
 /// A sensor distortion fitted as a variable: the data the stage reads through the sensor as

@@ -160,7 +160,10 @@ fn link(
         .sum();
     let base = nominal[mech].stage.signals.len() + queued;
     let var = Var {
-        kind: VarKind::Linked((0..cold).map(|i| (i, base + i)).collect()),
+        kind: VarKind::Linked {
+            pairs: (0..cold).map(|i| (i, base + i)).collect(),
+            at: gvar.initial,
+        },
         prior: None,
         ..gvar.clone()
     };

@@ -18,6 +18,8 @@ use stirling_dsl::Model;
 
 /// The variables an effect adds, and where they enter.
 mod effect_vars;
+/// Stage 1's pressure differences re-evaluated at the fitted gas stage.
+mod rebase;
 
 use super::DiagnoseError;
 use crate::effects::EffectInfo;
@@ -53,6 +55,9 @@ pub struct Joint<'a> {
     pub weight: Vec<f64>,
     pub n_vars: usize,
     pub effect: Vec<EffectVar>,
+    /// Where stage 1 reads the gas stage's pressure differences, when both are in the
+    /// problem (records without `p_hot`; see [`Joint::rebase`]).
+    dp_link: Option<rebase::DpLink>,
 }
 
 /// Whether a stage is the mechanics stage (positions out, pressures in).
@@ -93,12 +98,14 @@ impl<'a> Joint<'a> {
             weight.push(1.0 / s2[si].max(1e-12).sqrt());
             stages.push((si, ext));
         }
+        let dp_link = rebase::DpLink::of(&stages, &map);
         Ok(Joint {
             stages,
             map,
             weight,
             n_vars: n_nom + vars.effect.len(),
             effect: vars.effect,
+            dp_link,
         })
     }
 
