@@ -74,7 +74,11 @@ fn estimates(joint: &Joint, res: &lm::LmResult, fixed: &[usize]) -> Vec<EffectEs
         .collect()
 }
 
-/// Fit one screened candidate jointly and evaluate it on the held-out block.
+/// Fit one screened candidate jointly and evaluate it on the held-out block. `to_fixed_point`:
+/// take the fit to the fixed point of the two stages ([`settle`]); only a significant
+/// candidate can be the verdict and only those rank ahead of the others ([`sort`]), so the
+/// others (fitted for the report, when the calibration absorbed a gap) keep the first fit
+/// and its cost (on the lag record of docs/diagnosis.md the leak's rounds took 17 s of 43 s).
 pub fn assess(
     ctx: &Context,
     nominal: &[FittedStage],
@@ -82,6 +86,7 @@ pub fn assess(
     nominal_eval: &Eval,
     screened: Screened,
     opts: &LmOptions,
+    to_fixed_point: bool,
 ) -> Assessed {
     let Screened {
         effect: e,
@@ -102,7 +107,7 @@ pub fn assess(
         e,
         &score,
         &shapes,
-        opts,
+        (opts, to_fixed_point),
         &mut entry,
     );
     entry.seconds += clock.elapsed().as_secs_f64();
@@ -135,12 +140,16 @@ fn fit_candidate(
     e: &'static EffectInfo,
     score: &Score,
     shapes: &[(&'static str, f64)],
-    opts: &LmOptions,
+    (opts, to_fixed_point): (&LmOptions, bool),
     entry: &mut RankEntry,
 ) -> Result<Option<Eval>, DiagnoseError> {
     let mut joint = Joint::new(ctx.model, nominal, s2, e, shapes, !shapes.is_empty())?;
     let best = best_fit(ctx, &joint, nominal, e, score, shapes, opts)?;
-    let (res, fixed) = settle(&mut joint, best, opts);
+    let (res, fixed) = if to_fixed_point {
+        settle(&mut joint, best, opts)
+    } else {
+        best
+    };
     entry.params = estimates(&joint, &res, &fixed);
     let ev = ctx.eval_joint(&joint, &res.x, joint.effect_values(&res.x))?;
     let k = joint.effect.len() - fixed.len();

@@ -245,7 +245,8 @@ fn assess_all(
     });
     let mut assessed = schedule::longest_first(screened, |s| {
         if fit(&s) {
-            rank::assess(ctx, stages, s2, nominal, s, &lm)
+            let significant = s.significant(level);
+            rank::assess(ctx, stages, s2, nominal, s, &lm, significant)
         } else {
             s.unfitted("not fitted: its score is not significant (--fit-all fits it)")
         }
