@@ -7,10 +7,8 @@
 
 mod common;
 #[path = "dsl_sections/models.rs"]
-#[allow(dead_code)]
 mod sections;
 #[path = "dsl_walls/models.rs"]
-#[allow(dead_code)]
 mod walls;
 
 use common::models::{Chain, ChainQuad, OneCv, TwoCv};

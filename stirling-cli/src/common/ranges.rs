@@ -99,6 +99,21 @@ pub fn cycles(s: &str) -> Parsed<f64> {
     Ok(v)
 }
 
+/// A pair of counts `TUNE:EVAL` (whole numbers >= 0), as `--seeds 1:1`.
+pub fn split_counts(s: &str) -> Parsed<(usize, usize)> {
+    let (a, b) = s.split_once(':').ok_or(RangeError::Outside(
+        "expected TUNE:EVAL, two whole numbers such as 1:1",
+    ))?;
+    let count = |v: &str| -> Parsed<usize> {
+        let x = integer(v)?;
+        if !(0.0..=1e6).contains(&x) {
+            return Err(RangeError::Outside("each count must lie between 0 and 1e6"));
+        }
+        Ok(x as usize)
+    };
+    Ok((count(a)?, count(b)?))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -115,19 +130,4 @@ mod tests {
         assert!(positive("-1").is_err() && positive("inf").is_err());
         assert!(cycles("0.5").is_err() && cycles("2").is_ok());
     }
-}
-
-/// A pair of counts `TUNE:EVAL` (whole numbers >= 0), as `--seeds 1:1`.
-pub fn split_counts(s: &str) -> Parsed<(usize, usize)> {
-    let (a, b) = s.split_once(':').ok_or(RangeError::Outside(
-        "expected TUNE:EVAL, two whole numbers such as 1:1",
-    ))?;
-    let count = |v: &str| -> Parsed<usize> {
-        let x = integer(v)?;
-        if x < 0.0 || x > 1e6 {
-            return Err(RangeError::Outside("each count must lie between 0 and 1e6"));
-        }
-        Ok(x as usize)
-    };
-    Ok((count(a)?, count(b)?))
 }

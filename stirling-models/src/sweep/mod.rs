@@ -102,7 +102,7 @@ pub fn run(
         axes: &opts.axes,
         ties: &opts.ties,
         settle: opts.settle,
-        sim: opts.sim.clone(),
+        sim: opts.sim,
     };
     let points = {
         use rayon::prelude::*;
