@@ -247,16 +247,27 @@ mod tests {
         );
     }
 
+    /// Rosenbrock's residuals and their Jacobian, and options that let it converge.
+    fn rosen_r(p: &[f64]) -> Vec<f64> {
+        vec![10.0 * (p[1] - p[0] * p[0]), 1.0 - p[0]]
+    }
+
+    fn rosen_j(p: &[f64]) -> DMatrix<f64> {
+        DMatrix::from_row_slice(2, 2, &[-20.0 * p[0], 10.0, -1.0, 0.0])
+    }
+
+    fn long_opts() -> LmOptions {
+        LmOptions {
+            max_iter: 200,
+            ..Default::default()
+        }
+    }
+
     /// Trial points tested on their residuals alone: the same path and optimum as
     /// [`minimize`], with the Jacobian evaluated only at the start and at accepted points.
     #[test]
     fn split_trials_follow_the_same_path() {
-        let r = |p: &[f64]| vec![10.0 * (p[1] - p[0] * p[0]), 1.0 - p[0]];
-        let j = |p: &[f64]| DMatrix::from_row_slice(2, 2, &[-20.0 * p[0], 10.0, -1.0, 0.0]);
-        let opts = LmOptions {
-            max_iter: 200,
-            ..Default::default()
-        };
+        let (r, j, opts) = (rosen_r, rosen_j, long_opts());
         let mut full = |p: &[f64]| Some((r(p), j(p)));
         let plain = minimize(&mut full, &[-1.2, 1.0], &opts).unwrap();
         let mut jac_calls = 0;
@@ -281,12 +292,7 @@ mod tests {
     /// than the difference of the two evaluations.
     #[test]
     fn split_trials_race_trials_not_the_full_cost() {
-        let r = |p: &[f64]| vec![10.0 * (p[1] - p[0] * p[0]), 1.0 - p[0]];
-        let j = |p: &[f64]| DMatrix::from_row_slice(2, 2, &[-20.0 * p[0], 10.0, -1.0, 0.0]);
-        let opts = LmOptions {
-            max_iter: 200,
-            ..Default::default()
-        };
+        let (r, j, opts) = (rosen_r, rosen_j, long_opts());
         let mut full = |p: &[f64]| Some((r(p), j(p)));
         let plain = minimize(&mut full, &[-1.2, 1.0], &opts).unwrap();
         let mut resid = |p: &[f64]| Some(r(p).iter().map(|v| 1.1 * v).collect());
@@ -298,20 +304,8 @@ mod tests {
 
     #[test]
     fn rosenbrock() {
-        let mut f = |p: &[f64]| {
-            let r = vec![10.0 * (p[1] - p[0] * p[0]), 1.0 - p[0]];
-            let j = DMatrix::from_row_slice(2, 2, &[-20.0 * p[0], 10.0, -1.0, 0.0]);
-            Some((r, j))
-        };
-        let res = minimize(
-            &mut f,
-            &[-1.2, 1.0],
-            &LmOptions {
-                max_iter: 200,
-                ..Default::default()
-            },
-        )
-        .unwrap();
+        let mut f = |p: &[f64]| Some((rosen_r(p), rosen_j(p)));
+        let res = minimize(&mut f, &[-1.2, 1.0], &long_opts()).unwrap();
         assert!(
             (res.x[0] - 1.0).abs() < 1e-6 && (res.x[1] - 1.0).abs() < 1e-6,
             "{:?}",

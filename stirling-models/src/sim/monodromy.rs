@@ -313,6 +313,34 @@ pub(super) fn solve_stages(
     }
 }
 
+/// The callback of [`Hooks::on_step`]: `(t_prev, t, dense)` after every accepted step.
+pub(super) type OnStep<'a> =
+    dyn FnMut(f64, f64, &dyn Fn(f64, &mut [f64])) -> Result<(), SimError> + 'a;
+
+/// One BDF run of the state over `period` from `x0`, nonphysical states refused, `on_step`
+/// called after every accepted step (the recording of the monodromy and tangent routes);
+/// the end state and the solver counters.
+pub(super) fn run_recorded(
+    model: &dyn Model,
+    p: &[f64],
+    x0: &[f64],
+    period: f64,
+    opts: &SimOptions,
+    on_step: &mut OnStep,
+) -> Result<(Vec<f64>, SolverStats), SimError> {
+    let sys = ModelSystem { model, p };
+    let checker = super::physical::PhysicalCheck::new(model, p);
+    let check = |t: f64, x: &[f64]| checker.check(t, x);
+    let hooks = Hooks {
+        check: Some(&check),
+        on_step: Some(on_step),
+        ..Default::default()
+    };
+    let tr = integrate(&sys, x0, period, &[period], opts, hooks)?;
+    let x_end = tr.x.last().cloned().unwrap_or(tr.x_end);
+    Ok((x_end, tr.stats))
+}
+
 /// The flow `phi(x0, T)` and its monodromy matrix (column-major `n x n`), with
 /// `substeps` Radau IIA steps per accepted BDF step.
 pub fn flow_with_monodromy_radau(
@@ -324,7 +352,6 @@ pub fn flow_with_monodromy_radau(
     substeps: usize,
 ) -> Result<(Vec<f64>, Vec<f64>, SolverStats), SimError> {
     let n = model.n_states();
-    let sys = ModelSystem { model, p };
     let sparse = if opts.linear_solver.use_sparse(n, true) {
         Some(SparseStage::new(n, n, &model.sparsity(p))?)
     } else {
@@ -347,16 +374,7 @@ pub fn flow_with_monodromy_radau(
         lu: 0,
     };
     let mut on_step = |t0: f64, t1: f64, dense: &dyn Fn(f64, &mut [f64])| prop.step(t0, t1, dense);
-    let checker = super::physical::PhysicalCheck::new(model, p);
-    let check = |t: f64, x: &[f64]| checker.check(t, x);
-    let hooks = Hooks {
-        check: Some(&check),
-        on_step: Some(&mut on_step),
-        ..Default::default()
-    };
-    let tr = integrate(&sys, x0, period, &[period], opts, hooks)?;
-    let x_end = tr.x.last().cloned().unwrap_or(tr.x_end);
-    let mut stats = tr.stats;
+    let (x_end, mut stats) = run_recorded(model, p, x0, period, opts, &mut on_step)?;
     stats.jacobian_calls += prop.jac_calls;
     stats.lu_factorizations += prop.lu;
     let mut phi = prop.phi;

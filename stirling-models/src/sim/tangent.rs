@@ -26,8 +26,10 @@
 use faer::sparse::linalg::lu::{LuRef, NumericLu};
 use stirling_dsl::Model;
 
-use super::integrate::{integrate, Hooks, SimOptions, SolverStats};
-use super::monodromy::{radau3, scaled_triplets, solve_stages, SparseStage, StageStep};
+use super::integrate::{SimOptions, SolverStats};
+use super::monodromy::{
+    radau3, run_recorded, scaled_triplets, solve_stages, SparseStage, StageStep,
+};
 use super::system::{state_scale, ModelSystem};
 use super::SimError;
 
@@ -196,17 +198,8 @@ pub fn flow_with_tangent<'m>(
         factorizations: 0,
         jacobian_calls: 0,
     };
-    let sys = ModelSystem { model, p };
     let mut on_step =
         |t0: f64, t1: f64, dense: &dyn Fn(f64, &mut [f64])| tf.record(t0, t1, substeps, dense);
-    let checker = super::physical::PhysicalCheck::new(model, p);
-    let check = |t: f64, x: &[f64]| checker.check(t, x);
-    let hooks = Hooks {
-        check: Some(&check),
-        on_step: Some(&mut on_step),
-        ..Default::default()
-    };
-    let tr = integrate(&sys, x0, period, &[period], opts, hooks)?;
-    let x_end = tr.x.last().cloned().unwrap_or(tr.x_end);
-    Ok((x_end, tf, tr.stats))
+    let (x_end, stats) = run_recorded(model, p, x0, period, opts, &mut on_step)?;
+    Ok((x_end, tf, stats))
 }
