@@ -27,24 +27,30 @@ pub struct Assessed {
     pub eval: Option<Eval>,
 }
 
+/// The diagonal of the Gauss-Newton covariance `(J^T J)^-1` over the columns `free` of `j`
+/// (unit residual variance), from the SVD of `J` (squaring `J` first loses the small singular
+/// values); directions below 1e-12 of the largest singular value count as zero.
+pub fn covariance_diagonal(j: &nalgebra::DMatrix<f64>, free: &[usize]) -> Option<Vec<f64>> {
+    let svd = j.select_columns(free).svd(false, true);
+    let vt = svd.v_t?;
+    let smax = svd.singular_values.max();
+    let inv2 = svd
+        .singular_values
+        .map(|v| if v > 1e-12 * smax { 1.0 / (v * v) } else { 0.0 });
+    Some(
+        (0..free.len())
+            .map(|k| (0..inv2.len()).map(|m| vt[(m, k)].powi(2) * inv2[m]).sum())
+            .collect(),
+    )
+}
+
 /// Estimates with 95 % intervals from the Gauss-Newton covariance at the optimum.
 fn estimates(joint: &Joint, res: &lm::LmResult, fixed: &[usize]) -> Vec<EffectEstimate> {
     let j = &res.jacobian;
     let free: Vec<usize> = (0..j.ncols()).filter(|c| !fixed.contains(c)).collect();
-    let jf = j.select_columns(&free);
     let dof = res.residuals.len().saturating_sub(free.len()).max(1);
     let s2 = DVector::from_column_slice(&res.residuals).norm_squared() / dof as f64;
-    // covariance from the SVD of J (squaring J first loses the small singular values)
-    let cov = {
-        let svd = jf.clone().svd(false, true);
-        svd.v_t.map(|vt| {
-            let smax = svd.singular_values.max();
-            let inv2 = svd
-                .singular_values
-                .map(|v| if v > 1e-12 * smax { 1.0 / (v * v) } else { 0.0 });
-            vt.transpose() * nalgebra::DMatrix::from_diagonal(&inv2) * vt * s2
-        })
-    };
+    let cov = covariance_diagonal(j, &free);
     let values = joint.effect_values(&res.x);
     joint
         .effect
@@ -54,7 +60,7 @@ fn estimates(joint: &Joint, res: &lm::LmResult, fixed: &[usize]) -> Vec<EffectEs
             let se = free
                 .iter()
                 .position(|&c| c == v.index)
-                .and_then(|k| cov.as_ref().map(|c| c[(k, k)]))
+                .and_then(|k| cov.as_ref().map(|c| c[k] * s2))
                 .filter(|c| *c > 0.0)
                 .map(|c| v.scale * c.sqrt())
                 .unwrap_or(if fixed.contains(&v.index) {
@@ -200,6 +206,7 @@ fn best_fit(
 ) -> Result<(lm::LmResult, Vec<usize>), DiagnoseError> {
     use rayon::prelude::*;
     let starts = starts(e, shapes);
+    let null = joint.start(nominal);
     let results: Vec<Result<(lm::LmResult, Vec<usize>), DiagnoseError>> = starts
         .par_iter()
         .map(|&(s0, reset)| {
@@ -213,7 +220,7 @@ fn best_fit(
             } else {
                 joint.start(nominal)
             };
-            fit(joint, &u0, &sc, opts)
+            fit(joint, &u0, &null, &sc, opts)
         })
         .collect();
     let mut best: Option<(lm::LmResult, Vec<usize>)> = None;

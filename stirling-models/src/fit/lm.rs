@@ -17,6 +17,10 @@ pub struct LmOptions {
     pub max_iter: usize,
     /// Stop when the relative decrease of the cost is below this.
     pub ftol: f64,
+    /// Stop when the decrease of the cost is below this (absolute; 0: off). For residuals
+    /// of unit variance the cost is half a chi-square: a decrease far below 1 changes no
+    /// test or interval the fit feeds.
+    pub fatol: f64,
     /// Stop when the step is below this (in the variables' units).
     pub xtol: f64,
     pub lambda0: f64,
@@ -29,6 +33,7 @@ impl Default for LmOptions {
         Self {
             max_iter: 50,
             ftol: 1e-10,
+            fatol: 0.0,
             xtol: 1e-9,
             lambda0: 1e-3,
             max_step: f64::INFINITY,
@@ -175,7 +180,9 @@ pub fn minimize_split(
                 let rho = if pred > 0.0 { (pt.ct - cn) / pred } else { 1.0 };
                 lambda *= (1.0f64 / 3.0).max(1.0 - (2.0 * rho - 1.0).powi(3));
                 nu = 2.0;
-                converged = step.amax() < opts.xtol || (pt.ct - cn) < opts.ftol * pt.ct;
+                converged = step.amax() < opts.xtol
+                    || (pt.ct - cn) < opts.ftol * pt.ct
+                    || (pt.ct - cn) < opts.fatol;
                 pt = Point {
                     x: xn,
                     c: cost(&rn),
@@ -300,6 +307,32 @@ mod tests {
         assert!(split.converged);
         assert_eq!(plain.iterations, split.iterations);
         assert!((split.x[0] - 1.0).abs() < 1e-6 && (split.x[1] - 1.0).abs() < 1e-6);
+    }
+
+    /// The absolute tolerance stops the iteration at the first accepted step that gains
+    /// less than it, well before the relative one would.
+    #[test]
+    fn absolute_tolerance_stops_early() {
+        let mut f = |p: &[f64]| Some((rosen_r(p), rosen_j(p)));
+        let full = minimize(&mut f, &[-1.2, 1.0], &long_opts()).unwrap();
+        let loose = LmOptions {
+            fatol: 1e-3,
+            ..long_opts()
+        };
+        let early = minimize(&mut f, &[-1.2, 1.0], &loose).unwrap();
+        assert!(early.converged);
+        assert!(
+            early.iterations < full.iterations,
+            "{} {}",
+            early.iterations,
+            full.iterations
+        );
+        assert!(
+            early.cost < 1e-2 && early.cost >= full.cost,
+            "{} {}",
+            early.cost,
+            full.cost
+        );
     }
 
     #[test]

@@ -117,14 +117,29 @@ impl Joint<'_> {
         Ok(())
     }
 
-    /// The largest change of the gas stage's (scaled) variables from `a` to `b`.
-    pub fn gas_change(&self, a: &[f64], b: &[f64]) -> f64 {
+    /// The largest change of the gas stage's free variables from `a` to `b`, in standard
+    /// errors at `b` (`jacobian`: the weighted joint Jacobian there, whose residuals have unit
+    /// variance; `fixed`: held variables). Infinite when the covariance cannot be formed.
+    pub fn gas_change(
+        &self,
+        a: &[f64],
+        b: &[f64],
+        jacobian: &nalgebra::DMatrix<f64>,
+        fixed: &[usize],
+    ) -> f64 {
         let Some(link) = &self.dp_link else {
             return 0.0;
         };
+        let free: Vec<usize> = (0..jacobian.ncols())
+            .filter(|c| !fixed.contains(c))
+            .collect();
+        let Some(var) = crate::diagnose::rank::covariance_diagonal(jacobian, &free) else {
+            return f64::INFINITY;
+        };
         self.map[link.gas]
             .iter()
-            .map(|&j| (a[j] - b[j]).abs())
+            .filter_map(|&j| free.iter().position(|&c| c == j).map(|k| (j, var[k])))
+            .map(|(j, v)| (a[j] - b[j]).abs() / v.sqrt().max(1e-300))
             .fold(0.0, f64::max)
     }
 }
