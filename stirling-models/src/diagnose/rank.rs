@@ -80,11 +80,11 @@ fn estimates(joint: &Joint, res: &lm::LmResult, fixed: &[usize]) -> Vec<EffectEs
         .collect()
 }
 
-/// Fit one screened candidate jointly and evaluate it on the held-out block. `to_fixed_point`:
-/// take the fit to the fixed point of the two stages ([`settle`]); only a significant
-/// candidate can be the verdict and only those rank ahead of the others ([`sort`]), so the
-/// others (fitted for the report, when the calibration absorbed a gap) keep the first fit
-/// and its cost (on the lag record of docs/diagnosis.md the leak's rounds took 17 s of 43 s).
+/// Fit one screened candidate jointly and evaluate it on the held-out block. `significant`:
+/// its score is; only such a candidate can be the verdict and only those rank ahead of the
+/// others ([`sort`]), so its fit is taken to the fixed point of the two stages ([`settle`]),
+/// while the others (fitted for the report with `--fit-all`) keep the first fit but get the
+/// start in their own basin that the score cannot see ([`starts`]).
 pub fn assess(
     ctx: &Context,
     nominal: &[FittedStage],
@@ -92,7 +92,7 @@ pub fn assess(
     nominal_eval: &Eval,
     screened: Screened,
     opts: &LmOptions,
-    to_fixed_point: bool,
+    significant: bool,
 ) -> Assessed {
     let Screened {
         effect: e,
@@ -113,7 +113,7 @@ pub fn assess(
         e,
         &score,
         &shapes,
-        (opts, to_fixed_point),
+        (opts, significant),
         &mut entry,
     );
     entry.seconds += clock.elapsed().as_secs_f64();
@@ -146,12 +146,12 @@ fn fit_candidate(
     e: &'static EffectInfo,
     score: &Score,
     shapes: &[(&'static str, f64)],
-    (opts, to_fixed_point): (&LmOptions, bool),
+    (opts, significant): (&LmOptions, bool),
     entry: &mut RankEntry,
 ) -> Result<Option<Eval>, DiagnoseError> {
     let mut joint = Joint::new(ctx.model, nominal, s2, e, shapes, !shapes.is_empty())?;
-    let best = best_fit(ctx, &joint, nominal, e, score, shapes, opts)?;
-    let (res, fixed) = if to_fixed_point {
+    let best = best_fit(ctx, &joint, nominal, (e, !significant), score, shapes, opts)?;
+    let (res, fixed) = if significant {
         settle(&mut joint, best, opts)
     } else {
         best
@@ -172,40 +172,45 @@ fn fit_candidate(
 }
 
 /// The starts of a joint fit (see [`best_fit`]): a fixed strength (else the one-step
-/// estimate), and whether the nominal parameters are reset.
-fn starts(e: &EffectInfo, shapes: &[(&'static str, f64)]) -> Vec<(Option<f64>, bool)> {
+/// estimate), and whether the nominal parameters are reset (`reset`: add that start for a
+/// model effect).
+fn starts(e: &EffectInfo, shapes: &[(&'static str, f64)], reset: bool) -> Vec<(Option<f64>, bool)> {
     let mut starts: Vec<(Option<f64>, bool)> = vec![(None, false)];
     if !shapes.is_empty() {
         starts.extend([(Some(0.3), false), (Some(1.0), false)]);
     }
-    if e.target == EffectTarget::Model {
+    if reset && e.target == EffectTarget::Model {
         starts.push((Some(1.0), true));
     }
     starts
 }
 
-/// How many starts the joint fit of `e` runs.
+/// How many starts the joint fit of a significant `e` runs.
 pub fn start_count(e: &EffectInfo, shapes: &[(&'static str, f64)]) -> usize {
-    starts(e, shapes).len()
+    starts(e, shapes, false).len()
 }
 
 /// The joint fit from every start, the lowest cost kept. Starts: from the nominal optimum at
 /// the one-step estimate; a strength with a shape (end stops) is not smooth in its strength,
-/// so also at fixed strengths; and for a model effect the typical strength with the nominal
-/// parameters at their estimates (the effect's own basin when the calibration absorbed it
-/// into them: the score, a local test, cannot see that basin; sensor effects rescale the data
-/// and are not absorbed that way). The starts are independent and run in parallel.
+/// so also at fixed strengths; and for a model effect whose score is not significant
+/// (`reset`, fitted with `--fit-all`) the typical strength with the nominal parameters at
+/// their estimates (the effect's own basin when the calibration absorbed it into them: the
+/// score, a local test, cannot see that basin; sensor effects rescale the data and are not
+/// absorbed that way). A significant candidate's score already points into its basin: on the
+/// 58 records of the self-check the reset start changed no verdict and no closure (to 0.01)
+/// of a significant candidate, and it was a whole fit (4-5 s on the lag record of
+/// docs/diagnosis.md). The starts are independent and run in parallel.
 fn best_fit(
     ctx: &Context,
     joint: &Joint,
     nominal: &[FittedStage],
-    e: &EffectInfo,
+    (e, reset): (&EffectInfo, bool),
     score: &Score,
     shapes: &[(&'static str, f64)],
     opts: &LmOptions,
 ) -> Result<(lm::LmResult, Vec<usize>), DiagnoseError> {
     use rayon::prelude::*;
-    let starts = starts(e, shapes);
+    let starts = starts(e, shapes, reset);
     let null = joint.start(nominal);
     let results: Vec<Result<(lm::LmResult, Vec<usize>), DiagnoseError>> = starts
         .par_iter()
