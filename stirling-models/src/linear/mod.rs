@@ -267,7 +267,7 @@ fn sparse_open_loop(
         full,
         a: DMatrix::zeros(0, 0),
         poles,
-        response: LoopResponse::Sparse(response),
+        response: LoopResponse::Sparse(Box::new(response)),
     })
 }
 

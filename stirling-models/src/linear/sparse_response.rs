@@ -75,7 +75,7 @@ impl SparseResponse {
 #[derive(Clone, Debug)]
 pub enum LoopResponse {
     Dense(FrequencyResponse),
-    Sparse(SparseResponse),
+    Sparse(Box<SparseResponse>),
 }
 
 impl LoopResponse {
