@@ -194,13 +194,13 @@ fn newton_step(
     }
     if sparse {
         // the same system as triplets, by the sparse LU
-        let mut entries = model.jacobian_triplets(p, x, 0.0);
-        if let Some(last) = last {
-            entries.retain(|e| e.0 != last);
-            entries.extend(masses.iter().map(|&i| (last, i, 1.0)));
-        }
+        let entries = model.jacobian_triplets(p, x, 0.0);
         let m = super::sparse::SparseMatrix { n, entries };
-        let dx = super::sparse::solve_real(&m, &rhs).ok()??;
+        let dx = match last {
+            Some(last) => super::sparse::solve_constrained(&m, last, masses, &rhs),
+            None => super::sparse::solve_real(&m, &rhs),
+        }
+        .ok()??;
         return Some(DVector::from_vec(dx));
     }
     let mut j = DMatrix::from_vec(n, n, model.jacobian_dense(p, x, 0.0));

@@ -197,12 +197,11 @@ pub fn reduce_sparse(j: &super::sparse::SparseMatrix, mass: &[usize]) -> Reducti
         }
     }
     let jmax = j.max_abs().max(f64::MIN_POSITIVE);
-    let mut m = j.clone();
-    m.entries.retain(|e| e.0 != last);
-    m.entries.extend(mass.iter().map(|&i| (last, i, 1.0)));
     let mut e = vec![0.0; n];
     e[last] = 1.0;
-    let direction = super::sparse::solve_real(&m, &e).ok().flatten();
+    let direction = super::sparse::solve_constrained(j, last, mass, &e)
+        .ok()
+        .flatten();
     Reduction {
         a: empty,
         basis: Some(KernelBasis::new(n, mass)),

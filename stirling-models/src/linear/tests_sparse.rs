@@ -4,7 +4,7 @@ use stirling_dsl::{Closure, Model};
 
 use super::dominant::{dominant_poles_with, DominantOptions};
 use super::equilibrium::{self, mass_states, state_scales, NewtonOptions, NewtonSolver};
-use super::sparse::SparseMatrix;
+use super::sparse::{solve_constrained, solve_real, SparseMatrix};
 use super::{dynamic_poles_with, linearize, LinearOptions, PoleRequest, PoleRoute};
 
 fn nsection(n: usize) -> (Box<dyn Model>, Vec<f64>) {
@@ -38,6 +38,38 @@ fn sparse_equilibrium_equals_dense() {
             );
         }
     }
+}
+
+/// The constrained solve (one row replaced by the inventory constraint, by Sherman-Morrison
+/// on a sparse matrix) equals the direct factorization of the matrix with that dense row.
+#[test]
+fn constrained_solve_equals_the_dense_row_system() {
+    let (m, p) = nsection(20);
+    let mut x = vec![0.0; m.n_states()];
+    m.equilibrium_guess(&p, &mut x);
+    let a = SparseMatrix {
+        n: x.len(),
+        entries: m.jacobian_triplets(&p, &x, 0.0),
+    };
+    let masses = mass_states(m.as_ref());
+    let last = *masses.last().unwrap();
+    let b: Vec<f64> = (0..a.n)
+        .map(|i| ((i * 7 % 11) as f64 - 5.0) * 1e-3)
+        .collect();
+    let mut direct = a.clone();
+    direct.entries.retain(|e| e.0 != last);
+    direct
+        .entries
+        .extend(masses.iter().map(|&i| (last, i, 1.0)));
+    let x_direct = solve_real(&direct, &b).unwrap().unwrap();
+    let x_sm = solve_constrained(&a, last, &masses, &b).unwrap().unwrap();
+    let big = x_direct.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    for (i, (u, v)) in x_sm.iter().zip(&x_direct).enumerate() {
+        assert!((u - v).abs() <= 1e-9 * big, "state {i}: {u} vs {v}");
+    }
+    // and it satisfies the constraint row
+    let sum: f64 = masses.iter().map(|&i| x_sm[i]).sum();
+    assert!((sum - b[last]).abs() <= 1e-9 * big.max(b[last].abs()));
 }
 
 /// The dense reference itself is accurate to about `eps |A| kappa / |lambda|` (`|A|` ~ 1e7 1/s
