@@ -111,6 +111,17 @@ pub fn solve_constrained(
     cols: &[usize],
     b: &[f64],
 ) -> Result<Option<Vec<f64>>, SparseLuError> {
+    let weighted: Vec<(usize, f64)> = cols.iter().map(|&i| (i, 1.0)).collect();
+    solve_weighted_constrained(a, row, &weighted, b)
+}
+
+/// [`solve_constrained`] with the constraint row `sum w_i x_i` (`cols`: `(i, w_i)`).
+pub fn solve_weighted_constrained(
+    a: &SparseMatrix,
+    row: usize,
+    cols: &[(usize, f64)],
+    b: &[f64],
+) -> Result<Option<Vec<f64>>, SparseLuError> {
     let n = a.n;
     let mut t: Vec<_> = a
         .entries
@@ -125,13 +136,13 @@ pub fn solve_constrained(
         _ => f64::from(i == row),
     });
     let s = lu.solve(&rhs);
-    let d_dot = |c: usize| cols.iter().map(|&i| s[(i, c)]).sum::<f64>() - s[(row, c)];
+    let d_dot = |c: usize| cols.iter().map(|&(i, w)| w * s[(i, c)]).sum::<f64>() - s[(row, c)];
     let (dz, dy) = (d_dot(0), d_dot(1));
     let y_norm = (0..n).map(|i| s[(i, 1)].abs()).fold(0.0, f64::max);
     if (1.0 + dy).abs() <= 1e-10 * (cols.len() as f64).sqrt() * y_norm.max(1.0) {
         let mut m = a.clone();
         m.entries.retain(|e| e.0 != row);
-        m.entries.extend(cols.iter().map(|&i| (row, i, 1.0)));
+        m.entries.extend(cols.iter().map(|&(i, w)| (row, i, w)));
         return solve_real(&m, b);
     }
     let x: Vec<f64> = (0..n)
