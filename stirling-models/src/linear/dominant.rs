@@ -124,6 +124,7 @@ pub fn dominant_poles_with(
     let mut solver = ShiftedSolver::new(&js, None).map_err(|e| lu_error(c64::new(0.0, 0.0), e))?;
     let mut run = Run {
         js: &js,
+        js_max: js.max_abs(),
         w: &w,
         opts,
         pool: Vec::new(),
@@ -162,9 +163,14 @@ fn scan_shifts(opts: &DominantOptions) -> Vec<c64> {
         .collect()
 }
 
+/// The condition number assumed when merging Ritz values (see [`Run::merge`]).
+const MERGE_KAPPA: f64 = 1e3;
+
 /// The state of one dominant-pole search.
 struct Run<'a> {
     js: &'a SparseMatrix,
+    /// `max |J_s|`.
+    js_max: f64,
     w: &'a [(usize, f64)],
     opts: &'a DominantOptions,
     pool: Vec<Ritz>,
@@ -205,7 +211,13 @@ impl Run<'_> {
         if r.lambda.im.abs() <= 1e-8 * r.lambda.norm() {
             r.lambda.im = 0.0;
         }
-        let near = |q: &Ritz| (q.lambda - r.lambda).norm() <= 1e-6 * r.lambda.norm().max(1e-12);
+        // two values closer than the attainable accuracy of a pole, about `eps |J_s|` times a
+        // condition number (`|J_s|` grows like n^2: at n = 10,000 two shifts returned the
+        // working pair 1.6e-4 apart and it was listed twice), are one pole
+        let floor = MERGE_KAPPA * f64::EPSILON * self.js_max;
+        let near = |q: &Ritz| {
+            (q.lambda - r.lambda).norm() <= (1e-6 * r.lambda.norm()).max(floor).max(1e-12)
+        };
         match self.pool.iter_mut().find(|q| near(q)) {
             Some(q) if q.residual > r.residual => *q = r,
             Some(_) => {}
