@@ -4,7 +4,7 @@
 //! **Operator.** `(J_s - sigma I)^-1` with `J_s = D^-1 J D` (`D` the state scales of
 //! [`super::equilibrium::state_scales`]: a similarity, so the same eigenvalues, but Krylov
 //! vectors whose entries are comparable across pressures, masses and positions), applied by a
-//! faer sparse LU of the real `2n` embedding ([`super::sparse::ShiftedSolver`]; the symbolic
+//! complex faer sparse LU ([`super::sparse::ShiftedSolver`]; the symbolic
 //! analysis is shared by all shifts). A Ritz value `theta` of the operator is the pole
 //! `lambda = sigma + 1/theta`.
 //!
@@ -121,7 +121,7 @@ pub fn dominant_poles_with(
     }
     let js = a.scaled(scales);
     let w: Vec<(usize, f64)> = masses.iter().map(|&i| (i, scales[i])).collect();
-    let mut solver = ShiftedSolver::new(&js, None).map_err(|e| lu_error(c64::new(0.0, 0.0), e))?;
+    let mut solver = ShiftedSolver::new(&js).map_err(|e| lu_error(c64::new(0.0, 0.0), e))?;
     let mut run = Run {
         js: &js,
         js_max: js.max_abs(),

@@ -10,7 +10,7 @@
 //! factorization's fronts dense: `linearize --n 1000` spent 47 s in those solves.) At `s = 0`
 //! alone the constraint is used, by Sherman-Morrison on the sparse matrix
 //! ([`super::sparse::solve_weighted_constrained`]). The system is scaled by
-//! the state scales `D` and solved by the real `2n` embedding of
+//! the state scales `D` and solved by the complex sparse LU of
 //! [`super::sparse::ShiftedSolver`] (symbolic analysis once).
 
 use faer::c64;
@@ -48,7 +48,7 @@ impl SparseResponse {
         let neg_b: Vec<f64> = bs.iter().map(|v| -v).collect();
         let a0 = j.scaled(scales).plus_outer(&neg_b, &cs);
         let rhs: Vec<c64> = neg_b.iter().map(|&v| c64::new(v, 0.0)).collect();
-        let solver = ShiftedSolver::new(&a0, None).map_err(|e| LinearError::ShiftFactor {
+        let solver = ShiftedSolver::new(&a0).map_err(|e| LinearError::ShiftFactor {
             shift_re: 0.0,
             shift_im: 0.0,
             why: e.why,
