@@ -132,8 +132,18 @@ pub fn dominant_poles_with(
         iterations: 0,
         worst: (c64::new(0.0, 0.0), f64::INFINITY),
     };
-    for sigma in scan_shifts(opts) {
-        run.at(&mut solver, sigma)?;
+    // the scan's shifts are independent: factored and run in parallel, their Ritz values
+    // merged in the shifts' order (the same pool as one after the other)
+    let scans: Vec<Result<Scan, LinearError>> = {
+        use rayon::prelude::*;
+        let run = &run;
+        scan_shifts(opts)
+            .into_par_iter()
+            .map(|sigma| run.scan(&mut solver.clone(), sigma))
+            .collect()
+    };
+    for scan in scans {
+        run.absorb(scan?);
     }
     let best = run.rightmost().ok_or(LinearError::NoDominantPoles {
         shift_re: run.worst.0.re,
@@ -180,16 +190,38 @@ struct Run<'a> {
     worst: (c64, f64),
 }
 
+/// One Arnoldi run: its shift, steps and Ritz values.
+struct Scan {
+    sigma: c64,
+    steps: usize,
+    ritz: Vec<Ritz>,
+}
+
 impl Run<'_> {
-    /// One Arnoldi run at `sigma`; its converged Ritz values join the pool.
-    fn at(&mut self, solver: &mut ShiftedSolver, sigma: c64) -> Result<(), LinearError> {
+    /// One Arnoldi run at `sigma` (factoring `solver` there).
+    fn scan(&self, solver: &mut ShiftedSolver, sigma: c64) -> Result<Scan, LinearError> {
         solver.factor(sigma).map_err(|e| lu_error(sigma, e))?;
-        self.shifts.push((sigma.re, sigma.im));
         let v0 = start_vector(self.js.n, self.w);
         let dim = self.js.n - usize::from(!self.w.is_empty());
         let kr = arnoldi(solver, v0, self.opts.krylov.min(dim), self.w);
-        self.iterations += kr.steps;
-        let ritz = ritz_pairs(&kr, sigma)?;
+        Ok(Scan {
+            sigma,
+            steps: kr.steps,
+            ritz: ritz_pairs(&kr, sigma)?,
+        })
+    }
+
+    /// One Arnoldi run at `sigma`; its converged Ritz values join the pool.
+    fn at(&mut self, solver: &mut ShiftedSolver, sigma: c64) -> Result<(), LinearError> {
+        let scan = self.scan(solver, sigma)?;
+        self.absorb(scan);
+        Ok(())
+    }
+
+    /// A run's converged Ritz values join the pool.
+    fn absorb(&mut self, Scan { sigma, steps, ritz }: Scan) {
+        self.shifts.push((sigma.re, sigma.im));
+        self.iterations += steps;
         let smallest = ritz
             .iter()
             .map(|r| r.residual)
@@ -200,7 +232,6 @@ impl Run<'_> {
         for r in ritz.into_iter().filter(|r| r.residual <= self.opts.tol) {
             self.merge(r);
         }
-        Ok(())
     }
 
     /// Add `r` (upper half plane), replacing a duplicate with a larger residual.
