@@ -69,7 +69,7 @@ fn fit_from(
 ) -> Result<(lm::LmResult, Vec<usize>), DiagnoseError> {
     let strengths: Vec<&EffectVar> = joint.effect.iter().filter(|v| !v.shape).collect();
     for _ in 0..=strengths.len() {
-        if strengths.iter().all(|v| fixed.contains(&v.index)) {
+        if all_held(joint, &fixed) {
             let null = null.ok_or(DiagnoseError::JointBounds)?;
             let once = LmOptions {
                 max_iter: 0,
@@ -100,6 +100,16 @@ fn fit_from(
     Err(DiagnoseError::JointBounds)
 }
 
+/// Whether every strength (not the shapes) of the effect is among the `fixed` variables: the
+/// problem is then the nominal calibration.
+fn all_held(joint: &Joint, fixed: &[usize]) -> bool {
+    joint
+        .effect
+        .iter()
+        .filter(|v| !v.shape)
+        .all(|v| fixed.contains(&v.index))
+}
+
 /// Rounds of [`settle`] at most.
 const SETTLE_ROUNDS: usize = 3;
 /// A round that moves no variable of the gas stage by more than this many of its standard
@@ -114,21 +124,15 @@ const SETTLED: f64 = 0.2;
 /// and the fit redone from its optimum, until the gas stage stops moving ([`SETTLED`]) or
 /// after [`SETTLE_ROUNDS`] rounds. The rounds contract slowly where a sensor effect moved the
 /// gas stage far (the lag record of docs/diagnosis.md: 18.6, 10.9, 8.9, 5.5 standard errors
-/// in four rounds); three rounds, not four: the self-check's verdicts are the same (docs/selfcheck-runs/run-e.md) and the fourth cost 3 s there. A round that fails
-/// (a refit that cannot be integrated) leaves the problem and the fit of the round before.
+/// in four rounds); three rounds, not four: the self-check's verdicts are the same
+/// (docs/selfcheck-runs/run-e.md) and the fourth cost 3 s there. A round that fails (a refit
+/// that cannot be integrated) leaves the problem and the fit of the round before.
 pub fn settle(
     joint: &mut Joint,
     mut fit: (lm::LmResult, Vec<usize>),
     opts: &LmOptions,
 ) -> (lm::LmResult, Vec<usize>) {
-    let held = |f: &(lm::LmResult, Vec<usize>)| {
-        joint
-            .effect
-            .iter()
-            .filter(|v| !v.shape)
-            .all(|v| f.1.contains(&v.index))
-    };
-    if !joint.has_dp_link() || held(&fit) {
+    if !joint.has_dp_link() || all_held(joint, &fit.1) {
         return fit;
     }
     for _ in 0..SETTLE_ROUNDS {

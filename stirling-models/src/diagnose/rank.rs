@@ -82,9 +82,9 @@ fn estimates(joint: &Joint, res: &lm::LmResult, fixed: &[usize]) -> Vec<EffectEs
 
 /// Fit one screened candidate jointly and evaluate it on the held-out block. `significant`:
 /// its score is; only such a candidate can be the verdict and only those rank ahead of the
-/// others ([`sort`]), so its fit is taken to the fixed point of the two stages (`joint_fit::settle`),
-/// while the others (fitted for the report with `--fit-all`) keep the first fit but get the
-/// start in their own basin that the score cannot see (`starts`).
+/// others ([`sort`]), so its fit is taken to the fixed point of the two stages
+/// (`joint_fit::settle`), while the others (fitted for the report with `--fit-all`) keep the
+/// first fit but get the start in their own basin that the score cannot see (`starts`).
 pub fn assess(
     ctx: &Context,
     nominal: &[FittedStage],
