@@ -9,9 +9,13 @@
 //! What is measured (all in this process, wall clock, median over repeats; fast calls are timed
 //! in batches so the clock resolution does not matter):
 //! - `rhs`: one right-hand side call;
-//! - `jac`: one analytic Jacobian into triplets (the sparse form; the buffer is reused);
-//! - `rhs_jac`: the right-hand side and the Jacobian (triplets) in one call
-//!   (`Model::rhs_and_jacobian`, which shares their common values);
+//! - `jac`: one analytic Jacobian, its values alone in the fixed order of
+//!   `Model::jacobian_pattern` (`Model::jacobian_values`: the form a sparse solver refills, and
+//!   the form of CasADi's generated code); `jac_triplets`: the same into triplets (pattern and
+//!   values; the buffer is reused);
+//! - `rhs_jac`: the right-hand side and the Jacobian values in one call
+//!   (`Model::rhs_and_jacobian_values`, which shares their common values); `rhs_jac_triplets`:
+//!   the same into triplets (`Model::rhs_and_jacobian`);
 //! - `jac_fd`: one forward-difference Jacobian (n_states + 1 RHS calls) into triplets;
 //! - `sim`: one second of engine time from the rest state with the displacer moved by 5 mm
 //!   (as `stirling simulate` does), with the default stiff BDF of `stirling_models::sim`
@@ -157,8 +161,16 @@ fn main() {
         51,
         2.0,
     );
-    // --- analytic Jacobian (triplets)
+    // --- analytic Jacobian: values alone in the pattern's order (the sparse solvers' format,
+    // and CasADi's), then as triplets (pattern and values)
+    let mut vals = vec![0.0; m.jacobian_pattern(&p).len()];
     let (t_jac, n_jac) = time_per_call(
+        || m.jacobian_values(black_box(&p), black_box(&x), 0.0, black_box(&mut vals)),
+        2e-3,
+        51,
+        2.0,
+    );
+    let (t_jac_trip, _) = time_per_call(
         || {
             trip.clear();
             m.jacobian(
@@ -173,8 +185,23 @@ fn main() {
         51,
         2.0,
     );
-    // --- right-hand side and Jacobian (triplets) in one call (`Model::rhs_and_jacobian`)
+    // --- right-hand side and Jacobian in one call (`Model::rhs_and_jacobian_values`,
+    // `Model::rhs_and_jacobian` into triplets)
     let (t_rhs_jac, _) = time_per_call(
+        || {
+            m.rhs_and_jacobian_values(
+                black_box(&p),
+                black_box(&x),
+                0.0,
+                black_box(&mut out),
+                black_box(&mut vals),
+            )
+        },
+        2e-3,
+        51,
+        2.0,
+    );
+    let (t_rhs_jac_trip, _) = time_per_call(
         || {
             trip.clear();
             m.rhs_and_jacobian(
@@ -368,6 +395,7 @@ fn main() {
                 "rhs": t_rhs, "rhs_calls_timed": n_rhs,
                 "jac": t_jac, "jac_calls_timed": n_jac, "jac_nnz": jac_at_x.len(),
                 "rhs_jac": t_rhs_jac,
+                "jac_triplets": t_jac_trip, "rhs_jac_triplets": t_rhs_jac_trip,
                 "jac_dense": t_jac_dense,
                 "jac_fd": t_fd, "jac_fd_max_rel_err": fd_err,
             },
@@ -382,7 +410,12 @@ fn main() {
             t_jac * 1e6,
             jac_at_x.len()
         );
+        println!("  jac triplets {:>12.3} us", t_jac_trip * 1e6);
         println!("  rhs + jac    {:>12.3} us (one call)", t_rhs_jac * 1e6);
+        println!(
+            "  rhs + jac    {:>12.3} us (one call, triplets)",
+            t_rhs_jac_trip * 1e6
+        );
         println!("  jac dense    {:>12.3} us", t_jac_dense * 1e6);
         println!(
             "  jac FD       {:>12.3} us (x{:.1}, max rel err {:.1e})",

@@ -3,7 +3,7 @@
 //! order, and its Jacobian matches finite differences of its right-hand side; for the
 //! family members, the test chains and every section count that peels differently
 //! (n = 1, 2, 3 and longer), per-section links into a scalar CV (the sums' arrow) and a
-//! wall array.
+//! wall array. The values-only writers give the same values in the pattern's order.
 
 mod common;
 #[path = "dsl_sections/models.rs"]
@@ -34,6 +34,33 @@ fn combined(m: &dyn Model, p: &[f64], x: &[f64]) -> (Vec<f64>, Triplets) {
     (f, t)
 }
 
+/// The values-only writers (`jacobian_values`, `rhs_and_jacobian_values`) give the triplets'
+/// values bit for bit, in the order of `jacobian_pattern`, which is the triplets' positions.
+fn values_only(m: &dyn Model, p: &[f64], x: &[f64], f: &[f64], t: &Triplets, label: &str) {
+    let pattern = m.jacobian_pattern(p);
+    let at: Vec<(usize, usize)> = t.iter().map(|e| (e.0, e.1)).collect();
+    assert_eq!(
+        pattern, at,
+        "{label}: pattern differs from the triplets' positions"
+    );
+    let want: Vec<f64> = t.iter().map(|e| e.2).collect();
+    let mut v = vec![f64::NAN; pattern.len()];
+    m.jacobian_values(p, x, 0.0, &mut v);
+    assert_eq!(bits(&v), bits(&want), "{label}: jacobian_values differ");
+    let (mut g, mut w) = (vec![f64::NAN; f.len()], vec![f64::NAN; pattern.len()]);
+    m.rhs_and_jacobian_values(p, x, 0.0, &mut g, &mut w);
+    assert_eq!(
+        bits(&g),
+        bits(f),
+        "{label}: rhs_and_jacobian_values' rhs differs"
+    );
+    assert_eq!(
+        bits(&w),
+        bits(&want),
+        "{label}: rhs_and_jacobian_values' values differ"
+    );
+}
+
 fn bits(v: &[f64]) -> Vec<u64> {
     v.iter().map(|x| x.to_bits()).collect()
 }
@@ -58,6 +85,7 @@ fn check(m: &dyn Model, label: &str, seed: u64, fd: bool) {
                     .collect::<Vec<_>>()
             };
             assert_eq!(key(&t), key(&u), "{label} {spread:?} {k}: Jacobian differs");
+            values_only(m, &p, &x, &f, &t, &format!("{label} {spread:?} {k}"));
             if !fd {
                 continue;
             }

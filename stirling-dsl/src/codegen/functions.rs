@@ -14,6 +14,7 @@ use crate::expr::Arena;
 /// parameter slice, the parameters and block offsets that occur in `body`.
 fn method(
     name: &Ident,
+    generics: TokenStream,
     args: TokenStream,
     ret: TokenStream,
     lay: &Layout,
@@ -26,7 +27,7 @@ fn method(
     quote! {
         #[allow(non_snake_case, unused_variables, unused_parens, unused_assignments, clippy::all)]
         #[inline(never)]
-        fn #name(&self, #args) #ret {
+        fn #name #generics(&self, #args) #ret {
             let n: usize = self.n;
             #nf
             #params
@@ -59,6 +60,9 @@ pub fn closure_methods(
 ) -> TokenStream {
     let f = |what: &str| format_ident!("__{}_{}", what, tag);
     let sink = quote!(sink: &mut #krate::JacSink);
+    // the Jacobian writes to any writer: triplets or dense (`JacSink`), or values alone
+    let writer = quote!(<W: #krate::JacWrite>);
+    let wsink = quote!(sink: &mut W);
     let xp = quote!(p: &[f64], x: &[f64]);
     // the sums over the sections, for every function of the state
     let s = super::sums::prologue(arena, lay, private);
@@ -79,22 +83,39 @@ pub fn closure_methods(
     let items = [
         method(
             &f("rhs"),
+            quote!(),
             quote!(#xp, t: f64, out: &mut [f64]),
             quote!(),
             lay,
             rhs,
         ),
-        method(&f("jac"), quote!(#xp, t: f64, #sink), quote!(), lay, jac),
+        method(
+            &f("jac"),
+            writer.clone(),
+            quote!(#xp, t: f64, #wsink),
+            quote!(),
+            lay,
+            jac,
+        ),
         method(
             &f("rhs_jac"),
-            quote!(#xp, t: f64, out: &mut [f64], #sink),
+            writer,
+            quote!(#xp, t: f64, out: &mut [f64], #wsink),
             quote!(),
             lay,
             both,
         ),
-        method(&f("pjac"), quote!(#xp, t: f64, #sink), quote!(), lay, pjac),
+        method(
+            &f("pjac"),
+            quote!(),
+            quote!(#xp, t: f64, #sink),
+            quote!(),
+            lay,
+            pjac,
+        ),
         method(
             &f("forces"),
+            quote!(),
             quote!(#xp, out: &mut [f64]),
             quote!(),
             lay,
@@ -102,6 +123,7 @@ pub fn closure_methods(
         ),
         method(
             &f("force_grad"),
+            quote!(),
             quote!(__body: usize, #xp, out: &mut [f64]),
             quote!(),
             lay,
@@ -109,6 +131,7 @@ pub fn closure_methods(
         ),
         method(
             &f("init"),
+            quote!(),
             quote!(p: &[f64], out: &mut [f64]),
             quote!(),
             lay,
@@ -116,14 +139,23 @@ pub fn closure_methods(
         ),
         method(
             &f("vessels"),
+            quote!(),
             quote!(#xp, f: &mut dyn FnMut(usize, [f64; 7])),
             quote!(),
             lay,
             vessels,
         ),
-        method(&f("mech"), quote!(#xp), quote!(-> [f64; 2]), lay, mech),
+        method(
+            &f("mech"),
+            quote!(),
+            quote!(#xp),
+            quote!(-> [f64; 2]),
+            lay,
+            mech,
+        ),
         method(
             &f("masses"),
+            quote!(),
             quote!(p: &[f64], out: &mut [f64]),
             quote!(),
             lay,
@@ -134,7 +166,14 @@ pub fn closure_methods(
     let walls = (!lay.topo.walls.is_empty()).then(|| {
         let body = terms::walls(arena, lay, private);
         let body = quote!(#s #body);
-        method(&f("walls"), xp.clone(), quote!(-> [f64; 2]), lay, body)
+        method(
+            &f("walls"),
+            quote!(),
+            xp.clone(),
+            quote!(-> [f64; 2]),
+            lay,
+            body,
+        )
     });
     let items = quote! {
         #(#items)*

@@ -194,6 +194,11 @@ fn model_impl(topo: &Topology, spec: &ModelSpec, st: &Statics) -> TokenStream {
     let jac = call("jac", quote!(p, x, t, sink));
     let both = call("rhs_jac", quote!(p, x, t, out, sink));
     let pjac = call("pjac", quote!(p, x, t, sink));
+    let jac_values = call("jac", quote!(p, x, t, &mut #krate::JacValues::new(values)));
+    let both_values = call(
+        "rhs_jac",
+        quote!(p, x, t, out, &mut #krate::JacValues::new(values)),
+    );
     let forces = call("forces", quote!(p, x, out));
     let grad = call("force_grad", quote!(k, p, x, out));
     let init = call("init", quote!(p, out));
@@ -227,6 +232,8 @@ fn model_impl(topo: &Topology, spec: &ModelSpec, st: &Statics) -> TokenStream {
             fn rhs(&self, p: &[f64], x: &[f64], t: f64, out: &mut [f64]) { #rhs }
             fn jacobian(&self, p: &[f64], x: &[f64], t: f64, sink: &mut #krate::JacSink) { #jac }
             fn rhs_and_jacobian(&self, p: &[f64], x: &[f64], t: f64, out: &mut [f64], sink: &mut #krate::JacSink) { #both }
+            fn jacobian_values(&self, p: &[f64], x: &[f64], t: f64, values: &mut [f64]) { #jac_values }
+            fn rhs_and_jacobian_values(&self, p: &[f64], x: &[f64], t: f64, out: &mut [f64], values: &mut [f64]) { #both_values }
             fn param_jacobian(&self, p: &[f64], x: &[f64], t: f64, sink: &mut #krate::JacSink) { #pjac }
             fn pressure_forces(&self, p: &[f64], x: &[f64], out: &mut [f64]) { #forces }
             fn pressure_force_gradient(&self, k: usize, p: &[f64], x: &[f64], out: &mut [f64]) {

@@ -2,12 +2,14 @@
 
 mod dot;
 mod error;
+mod jac_sink;
 mod model;
 mod topology_info;
 
 pub use dot::to_dot;
 pub use error::ModelError;
-pub use model::{BodyInfo, JacSink, Model, ParamInfo, PowerTerms, StateInfo, StateKind};
+pub use jac_sink::{JacSink, JacValues, JacWrite};
+pub use model::{BodyInfo, Model, ParamInfo, PowerTerms, StateInfo, StateKind};
 pub use topology_info::{
     ConductionInfo, FaceInfo, LinkInfo, PortInfo, TopologyInfo, VesselInfo, WallInfo,
 };

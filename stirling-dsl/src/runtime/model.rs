@@ -1,5 +1,6 @@
 //! The interface every generated model implements; the analyses are generic over it.
 
+use super::jac_sink::JacSink;
 use crate::expr::Style;
 use crate::Closure;
 
@@ -58,42 +59,6 @@ pub struct PowerTerms {
     pub mechanical: f64,
 }
 
-/// Where the Jacobian entries go; `add` accumulates.
-pub enum JacSink<'a> {
-    /// Column-major dense storage with `nrows` rows (zero it first).
-    Dense { data: &'a mut [f64], nrows: usize },
-    /// Coordinate triplets `(row, col, value)`.
-    Triplets(&'a mut Vec<(usize, usize, f64)>),
-}
-
-impl JacSink<'_> {
-    /// Add `v` at `(r, c)`.
-    #[inline(always)]
-    pub fn add(&mut self, r: usize, c: usize, v: f64) {
-        match self {
-            JacSink::Dense { data, nrows } => data[r + *nrows * c] += v,
-            JacSink::Triplets(t) => t.push((r, c, v)),
-        }
-    }
-}
-
-impl JacSink<'_> {
-    /// Add the entries `(r, c, v)` in order: one capacity check for a block of triplets (a
-    /// `push` per entry stores the length and loads it again for the next one, a chain
-    /// through memory that costs more than the entry's arithmetic).
-    #[inline(always)]
-    pub fn add_all<const K: usize>(&mut self, entries: &[(usize, usize, f64); K]) {
-        match self {
-            JacSink::Dense { data, nrows } => {
-                for &(r, c, v) in entries {
-                    data[r + *nrows * c] += v;
-                }
-            }
-            JacSink::Triplets(t) => t.extend_from_slice(entries),
-        }
-    }
-}
-
 /// A generated model at a given `n` and closure.
 ///
 /// Callback shape: `(p, x, t, out)`, parameters as a slice in [`Model::params`] order.
@@ -126,6 +91,38 @@ pub trait Model: Send + Sync {
     fn rhs_and_jacobian(&self, p: &[f64], x: &[f64], t: f64, out: &mut [f64], sink: &mut JacSink) {
         self.rhs(p, x, t, out);
         self.jacobian(p, x, t, sink);
+    }
+    /// The values of [`Model::jacobian`]'s entries, written into `values` in the fixed order
+    /// of [`Model::jacobian_pattern`] (entries at one position are to be summed). The default
+    /// goes through triplets; a generated model writes the values alone (no indices).
+    fn jacobian_values(&self, p: &[f64], x: &[f64], t: f64, values: &mut [f64]) {
+        let trip = self.jacobian_triplets(p, x, t);
+        values[..trip.len()]
+            .iter_mut()
+            .zip(&trip)
+            .for_each(|(o, e)| *o = e.2);
+    }
+    /// [`Model::rhs`] and [`Model::jacobian_values`] in one call (a generated model shares
+    /// their common values, as [`Model::rhs_and_jacobian`]).
+    fn rhs_and_jacobian_values(
+        &self,
+        p: &[f64],
+        x: &[f64],
+        t: f64,
+        out: &mut [f64],
+        values: &mut [f64],
+    ) {
+        self.rhs(p, x, t, out);
+        self.jacobian_values(p, x, t, values);
+    }
+    /// Where [`Model::jacobian`]'s entries go, in the order it gives them (a position may
+    /// repeat; the order depends on the model and `n`, never on the state): the pattern of
+    /// [`Model::jacobian_values`].
+    fn jacobian_pattern(&self, p: &[f64]) -> Vec<(usize, usize)> {
+        let mut x = vec![0.0; self.n_states()];
+        self.equilibrium_guess(p, &mut x);
+        let trip = self.jacobian_triplets(p, &x, 0.0);
+        trip.into_iter().map(|(r, c, _)| (r, c)).collect()
     }
     /// The analytic parameter Jacobian `df/dp` (columns in parameter order).
     fn param_jacobian(&self, p: &[f64], x: &[f64], t: f64, sink: &mut JacSink);
