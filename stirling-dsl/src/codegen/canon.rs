@@ -54,8 +54,6 @@ pub struct Canon {
     names: Vec<Option<String>>,
     memo: HashMap<Id, Id>,
     at_memo: HashMap<(Id, Section), Id>,
-    /// Whether a node is fixed for the whole call (parameters, `n`, constants).
-    fixed_memo: HashMap<Id, bool>,
 }
 
 impl Canon {
@@ -82,61 +80,11 @@ impl Canon {
                     let q = self.arena.div(c, d);
                     self.arena.neg(q)
                 }
-                // `a / b` with `b` fixed for the call (parameters and `n` alone) and `a` not:
-                // `a * (1 / b)`, the reciprocal computed once in the prologue and shared, a
-                // multiplication per use instead of a division (which costs several times
-                // more and sits on the section's critical path); rounds differently in the
-                // last bit
-                // `1 / (u / v)` as `v / u`: one division, and the same value as the
-                // reciprocal below
-                (Node::Div(..), Some(c)) if c == 1.0 && self.quotient(kids[1]).is_some() => {
-                    let (u, v) = self.quotient(kids[1]).expect("checked");
-                    self.arena.div(v, u)
-                }
-                (Node::Div(..), _) if !self.fixed(kids[0]) && self.fixed(kids[1]) => {
-                    let b = kids[1];
-                    if self.arena.as_const(b).is_some() {
-                        self.arena.make(node.with_children(&kids))
-                    } else {
-                        let r = match self.quotient(b) {
-                            Some((u, v)) => self.arena.div(v, u),
-                            None => {
-                                let one = self.arena.num(1.0);
-                                self.arena.div(one, b)
-                            }
-                        };
-                        self.arena.mul(kids[0], r)
-                    }
-                }
                 _ => self.arena.make(node.with_children(&kids)),
             }
         };
         self.memo.insert(id, r);
         r
-    }
-
-    /// `(u, v)` when `id` is `u / v`.
-    fn quotient(&self, id: Id) -> Option<(Id, Id)> {
-        match *self.arena.node(id) {
-            Node::Div(u, v) => Some((u, v)),
-            _ => None,
-        }
-    }
-
-    /// Whether `id` is fixed for the whole call: it reads no state, sum, input or section
-    /// index (only parameters, `n` and constants).
-    fn fixed(&mut self, id: Id) -> bool {
-        if let Some(&f) = self.fixed_memo.get(&id) {
-            return f;
-        }
-        let node = self.arena.node(id).clone();
-        let f = match node {
-            Node::Sym(Sym::Param(_) | Sym::Count) | Node::Const(_) => true,
-            Node::Sym(_) => false,
-            _ => node.children().into_iter().all(|c| self.fixed(c)),
-        };
-        self.fixed_memo.insert(id, f);
-        f
     }
 
     fn set_name(&mut self, id: Id, name: &str) {
