@@ -162,8 +162,7 @@ class CasadiModel:
         run = subprocess.run([timer, self.lib, str(len(zv)), "f", "jacf", "fj"], input=state,
                              capture_output=True, text=True, check=True)
         t = json.loads(run.stdout)
-        out = {"rhs": t["f"], "jac": t["jacf"], "rhs_jac": t["fj"], "kernel_timer": "C driver"}
-        return out
+        return {"rhs": t["f"], "jac": t["jacf"], "rhs_jac": t["fj"], "kernel_timer": "C driver"}
 
     def _vm_kernel_times(self, zv):
         k1, k2 = self.K

@@ -62,7 +62,7 @@ impl JacWrite for JacSink<'_> {
 }
 
 /// The values of the entries in the generated order, written (not added) one after the
-/// other into `data`; `len` counts them.
+/// other into `data`; `len` counts them (the next position).
 pub struct JacValues<'a> {
     data: &'a mut [f64],
     len: usize,
@@ -73,14 +73,6 @@ impl<'a> JacValues<'a> {
     /// that of [`crate::Model::jacobian_pattern`]).
     pub fn new(data: &'a mut [f64]) -> Self {
         Self { data, len: 0 }
-    }
-    /// How many values were written.
-    pub fn len(&self) -> usize {
-        self.len
-    }
-    /// Whether none was written.
-    pub fn is_empty(&self) -> bool {
-        self.len == 0
     }
 }
 

@@ -191,13 +191,7 @@ pub trait Model: Send + Sync {
     }
     /// The structural sparsity pattern of the Jacobian: sorted, unique `(row, col)`.
     fn sparsity(&self, p: &[f64]) -> Vec<(usize, usize)> {
-        let mut x = vec![0.0; self.n_states()];
-        self.equilibrium_guess(p, &mut x);
-        let mut rc: Vec<(usize, usize)> = self
-            .jacobian_triplets(p, &x, 0.0)
-            .into_iter()
-            .map(|(r, c, _)| (r, c))
-            .collect();
+        let mut rc = self.jacobian_pattern(p);
         rc.sort_unstable();
         rc.dedup();
         rc
