@@ -9,15 +9,16 @@
 //! with the factorization of the block it equals, so `k + 1` equal blocks cost one `nz x nz`
 //! factorization (the staggered corrector of CVODES' sensitivities). Blocks are compared by
 //! value, so a block-diagonal matrix whose blocks differ is still solved exactly; a pattern
-//! that is not block-diagonal with equal block sizes falls back to faer's sparse LU.
+//! that is not block-diagonal with equal block sizes falls back to the refactoring sparse LU
+//! ([`super::refactor_lu`]).
 
-use diffsol::{
-    FaerContext, FaerSparseLU, FaerSparseMat, FaerVec, LaError, Matrix, MatrixCommon, Vector,
-};
+use diffsol::{FaerContext, FaerSparseMat, FaerVec, LaError, Matrix, MatrixCommon, Vector};
 use diffsol_la::error::LinearSolverError;
 use diffsol_la::{LinearOp, LinearSolver};
 use faer::sparse::SymbolicSparseColMatRef;
 use nalgebra::{DMatrix, DMatrixViewMut, LU};
+
+use super::refactor_lu::RefactorLu;
 
 /// The block solver (see the module doc).
 #[derive(Default)]
@@ -28,7 +29,7 @@ pub struct BlockLu {
     /// The distinct factorizations, and which one each block uses.
     lus: Vec<LU<f64, nalgebra::Dyn, nalgebra::Dyn>>,
     which: Vec<usize>,
-    fallback: Option<FaerSparseLU<f64>>,
+    fallback: Option<RefactorLu>,
 }
 
 /// The size `b` of the diagonal blocks when the pattern is block-diagonal with blocks of
@@ -153,9 +154,7 @@ impl LinearSolver<FaerSparseMat<f64>> for BlockLu {
                 self.fallback = None;
             }
             None => {
-                let mut f = FaerSparseLU::default();
-                f.set_sparsity(op);
-                self.fallback = Some(f);
+                self.fallback = Some(RefactorLu::with_pattern(a));
                 self.a = None;
             }
         }

@@ -50,7 +50,7 @@ impl Default for SimOptions {
 
 /// Above this many states (and when the system knows its Jacobian pattern),
 /// [`LinearSolverKind::Auto`] picks the sparse LU.
-pub const SPARSE_THRESHOLD: usize = 60;
+pub const SPARSE_THRESHOLD: usize = 20;
 
 /// The linear algebra of the implicit solver.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]

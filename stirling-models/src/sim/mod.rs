@@ -39,6 +39,8 @@ pub mod lane_lu;
 pub mod monodromy;
 /// The nonphysical-state check run after every accepted step.
 pub mod physical;
+/// A sparse LU that keeps its pivots between factorizations (KLU's refactorization).
+pub mod refactor_lu;
 /// Forward sensitivities by the staggered corrector (diffsol's sensitivity BDF).
 pub mod sens;
 /// Limit cycles by single shooting.
