@@ -98,17 +98,21 @@ impl LinearSolver<FaerSparseMat<f64>> for BlockLu {
         &mut self,
         op: &C,
     ) {
-        if let Some(f) = self.fallback.as_mut() {
-            return f.set_linearisation(op);
-        }
         let a = self.a.as_mut().expect("the pattern is set first");
         op.matrix_inplace(a);
+        if let Some(f) = self.fallback.as_mut() {
+            // a singular matrix is reported by the solve (a failed step)
+            let _ = f.factor(a.inner()[0].as_ref());
+            return;
+        }
         self.factor();
     }
 
     fn solve_in_place(&self, x: &mut FaerVec<f64>) -> Result<(), LaError> {
         if let Some(f) = self.fallback.as_ref() {
-            return f.solve_in_place(x);
+            return f
+                .solve(x.inner_mut().col_as_slice_mut(0))
+                .map_err(|_| LinearSolverError::LuSolveFailed.into());
         }
         if self.which.is_empty() {
             return Err(LinearSolverError::LuNotInitialized.into());
@@ -132,10 +136,7 @@ impl LinearSolver<FaerSparseMat<f64>> for BlockLu {
         }
     }
 
-    fn solve_transpose_in_place(&self, x: &mut FaerVec<f64>) -> Result<(), LaError> {
-        if let Some(f) = self.fallback.as_ref() {
-            return f.solve_transpose_in_place(x);
-        }
+    fn solve_transpose_in_place(&self, _x: &mut FaerVec<f64>) -> Result<(), LaError> {
         Err(LinearSolverError::Other("the block LU has no transposed solve".into()).into())
     }
 
@@ -150,14 +151,11 @@ impl LinearSolver<FaerSparseMat<f64>> for BlockLu {
         match block_size(a.inner()[0].symbolic()) {
             Some(b) => {
                 self.block = b;
-                self.a = Some(a);
                 self.fallback = None;
             }
-            None => {
-                self.fallback = Some(RefactorLu::with_pattern(a));
-                self.a = None;
-            }
+            None => self.fallback = Some(RefactorLu::new(a.inner()[0].symbolic())),
         }
+        self.a = Some(a);
         self.lus.clear();
         self.which.clear();
     }

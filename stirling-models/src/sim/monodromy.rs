@@ -11,8 +11,9 @@
 //! ```
 //!
 //! One LU of the `3n x 3n` stage matrix per (sub)step serves all `n` columns of
-//! `Phi` (propagated in state-scaled form `D^-1 Phi D`): nalgebra dense LU for small `n`, faer sparse LU (symbolic analysis once,
-//! on the union of the block patterns) above [`super::SPARSE_THRESHOLD`] states
+//! `Phi` (propagated in state-scaled form `D^-1 Phi D`): nalgebra dense LU for small `n`,
+//! the refactoring sparse LU ([`super::refactor_lu`]: column order once, on the union of the
+//! block patterns; pivots kept from step to step) above [`super::SPARSE_THRESHOLD`] states
 //! (or as [`SimOptions::linear_solver`] says). L-stability makes the stiff
 //! (pressure-equalization) modes decay to ~0 as they should; the stage matrix is a
 //! rational function of `h J`, so a left null vector of `J` (the mass inventory,
@@ -22,16 +23,13 @@
 //! Cost per step: `O(n^3)` dense, `O(nnz(LU) n)` sparse, against the old
 //! `n (n + 1)` BDF states with an `n^2 x n^2` dense iteration matrix.
 
-use faer::dyn_stack::{MemBuffer, MemStack};
-use faer::reborrow::Reborrow;
-use faer::sparse::linalg::lu::{factorize_symbolic_lu, LuRef, NumericLu, SymbolicLu};
 use faer::sparse::{Pair, SparseColMat, SymbolicSparseColMat};
-use faer::{Conj, Mat, Par};
 use nalgebra::DMatrix;
 use stirling_dsl::Model;
 
 use super::adapter::scatter;
 use super::integrate::{integrate, Hooks, SimOptions, SolverStats};
+use super::refactor_lu::RefactorLu;
 use super::system::{state_scale, ModelSystem, OdeSystem};
 use super::SimError;
 
@@ -55,19 +53,19 @@ pub(super) fn radau3() -> ([f64; 3], [[f64; 3]; 3]) {
     (c, a)
 }
 
-/// Sparse stage-matrix storage: pattern, symbolic LU, scratch, reused every step
-/// (right-hand sides of `cols` columns).
+/// Sparse stage-matrix storage: the matrix on its pattern and its refactoring LU, reused
+/// every step.
 pub(super) struct SparseStage {
     mat: SparseColMat<usize, f64>,
-    pub(super) symbolic: SymbolicLu<usize>,
-    pub(super) numeric: NumericLu<usize, f64>,
-    factor_scratch: MemBuffer,
-    pub(super) solve_scratch: MemBuffer,
-    pub(super) rhs: Mat<f64>,
+    pub(super) lu: RefactorLu,
+    /// A right-hand side of the stage system (`3 n`).
+    pub(super) rhs: Vec<f64>,
+    /// The solve's work vector (`3 n`).
+    pub(super) work: Vec<f64>,
 }
 
 impl SparseStage {
-    pub(super) fn new(n: usize, cols: usize, pattern: &[(usize, usize)]) -> Result<Self, SimError> {
+    pub(super) fn new(n: usize, pattern: &[(usize, usize)]) -> Result<Self, SimError> {
         let mut idx = Vec::with_capacity(9 * pattern.len() + 3 * n);
         for bi in 0..3 {
             for bj in 0..3 {
@@ -79,26 +77,18 @@ impl SparseStage {
             }
             idx.extend((0..n).map(|k| Pair::new(bi * n + k, bi * n + k)));
         }
-        let bad = |e: String| SimError::SolverFailure {
-            t: 0.0,
-            why: format!("monodromy stage matrix: {e}"),
-        };
-        let (sym, _) = SymbolicSparseColMat::try_new_from_indices(3 * n, 3 * n, &idx)
-            .map_err(|e| bad(format!("{e:?}")))?;
-        let symbolic = factorize_symbolic_lu(sym.rb(), Default::default())
-            .map_err(|e| bad(format!("{e:?}")))?;
-        let factor_scratch = MemBuffer::new(
-            symbolic.factorize_numeric_lu_scratch::<f64>(Par::Seq, Default::default()),
-        );
-        let solve_scratch = MemBuffer::new(symbolic.solve_in_place_scratch::<f64>(cols, Par::Seq));
+        let (sym, _) = SymbolicSparseColMat::try_new_from_indices(3 * n, 3 * n, &idx).map_err(
+            |e| SimError::SolverFailure {
+                t: 0.0,
+                why: format!("monodromy stage matrix: {e:?}"),
+            },
+        )?;
         let nnz = sym.row_idx().len();
         Ok(Self {
+            lu: RefactorLu::new(sym.as_ref()),
             mat: SparseColMat::new(sym, vec![0.0; nnz]),
-            symbolic,
-            numeric: NumericLu::new(),
-            factor_scratch,
-            solve_scratch,
-            rhs: Mat::zeros(3 * n, cols),
+            rhs: vec![0.0; 3 * n],
+            work: vec![0.0; 3 * n],
         })
     }
 }
@@ -210,14 +200,18 @@ pub(super) struct StageStep<'t> {
 /// Why one Radau stage solve failed (mapped to [`SimError::SolverFailure`] at the step's time).
 #[derive(Debug, thiserror::Error)]
 pub(super) enum StageError {
-    #[error("sparse LU of the stage matrix failed: {0}")]
-    Factorization(String),
     #[error("singular stage matrix")]
     Singular,
 }
 
+impl From<super::refactor_lu::Singular> for StageError {
+    fn from(_: super::refactor_lu::Singular) -> Self {
+        StageError::Singular
+    }
+}
+
 impl StageStep<'_> {
-    /// Assemble the stage matrix into `sp` and factorize it into `sp.numeric`.
+    /// Assemble the stage matrix into `sp` and factorize it into `sp.lu`.
     pub(super) fn factor_sparse(&self, sp: &mut SparseStage) -> Result<(), StageError> {
         let (n, h, a) = (self.n, self.h, self.a);
         let (sym, vals) = sp.mat.parts_mut();
@@ -237,23 +231,17 @@ impl StageStep<'_> {
             shifted.extend((0..n).map(|k| (i * n + k, i * n + k, 1.0)));
             scatter(sym.col_ptr(), sym.row_idx(), vals, &shifted);
         }
-        sp.symbolic
-            .factorize_numeric_lu(
-                &mut sp.numeric,
-                sp.mat.rb(),
-                Par::Seq,
-                MemStack::new(&mut sp.factor_scratch),
-                Default::default(),
-            )
-            .map_err(|e| StageError::Factorization(format!("{e:?}")))?;
+        sp.lu.factor(sp.mat.as_ref())?;
         Ok(())
     }
 
     /// Solve with the sparse LU of `sp`; `phi` becomes the last stage.
     fn solve_sparse(&self, sp: &mut SparseStage, phi: &mut [f64]) -> Result<(), StageError> {
         self.factor_sparse(sp)?;
-        let lu = LuRef::new_unchecked(&sp.symbolic, &sp.numeric);
-        solve_stages(self.n, lu, &mut sp.rhs, &mut sp.solve_scratch, phi);
+        let lu = &sp.lu;
+        solve_stages(self.n, &mut sp.rhs, phi, |r| {
+            lu.solve(r).expect("factored just above")
+        });
         Ok(())
     }
 
@@ -288,28 +276,20 @@ impl StageStep<'_> {
     }
 }
 
-/// Solve the stage system factored in `lu` for the columns of `phi` (`n` rows each, as many
-/// columns as `rhs` has); `phi` becomes the last stage.
+/// Solve the stage system (by `solve`, on a `3 n` right-hand side) for each `n`-row column
+/// of `phi`; `phi` becomes the last stage.
 pub(super) fn solve_stages(
     n: usize,
-    lu: LuRef<'_, usize, f64>,
-    rhs: &mut Mat<f64>,
-    scratch: &mut MemBuffer,
+    rhs: &mut [f64],
     phi: &mut [f64],
+    mut solve: impl FnMut(&mut [f64]),
 ) {
-    let cols = rhs.ncols();
-    for col in 0..cols {
+    for col in phi.chunks_exact_mut(n) {
         for i in 0..3 {
-            for r in 0..n {
-                rhs[(i * n + r, col)] = phi[r + col * n];
-            }
+            rhs[i * n..(i + 1) * n].copy_from_slice(col);
         }
-    }
-    lu.solve_in_place_with_conj(Conj::No, rhs.as_mut(), Par::Seq, MemStack::new(scratch));
-    for col in 0..cols {
-        for r in 0..n {
-            phi[r + col * n] = rhs[(2 * n + r, col)];
-        }
+        solve(rhs);
+        col.copy_from_slice(&rhs[2 * n..]);
     }
 }
 
@@ -353,7 +333,7 @@ pub fn flow_with_monodromy_radau(
 ) -> Result<(Vec<f64>, Vec<f64>, SolverStats), SimError> {
     let n = model.n_states();
     let sparse = if opts.linear_solver.use_sparse(n, true) {
-        Some(SparseStage::new(n, n, &model.sparsity(p))?)
+        Some(SparseStage::new(n, &model.sparsity(p))?)
     } else {
         None
     };

@@ -14,65 +14,95 @@
 //! with fresh partial pivoting. A matrix singular even then is an error at the solve, which
 //! the integrator treats as a failed step.
 //!
+//! The factors of one matrix can be kept ([`LuSnapshot`]: the values only, the pattern is
+//! shared while the pivots hold), which is how the tangent route stores one factorization
+//! per step of a period at half the memory of faer's factors.
+//!
 //! Why our own: neither faer nor diffsol has a refactorization with a fixed pivot sequence,
 //! and KLU itself is C (SuiteSparse) that the project does not otherwise need.
 
 use std::cell::RefCell;
+use std::sync::Arc;
 
-use diffsol::{FaerContext, FaerSparseMat, FaerVec, LaError, Matrix, MatrixCommon, Vector};
-use diffsol_la::error::LinearSolverError;
-use diffsol_la::{LinearOp, LinearSolver};
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::perm::PermRef;
 use faer::sparse::linalg::lu::factorize_symbolic_lu;
 use faer::sparse::linalg::lu::simplicial::{
     factorize_simplicial_numeric_lu, factorize_simplicial_numeric_lu_scratch, SimplicialLu,
 };
-use faer::sparse::SparseColMatRef;
+use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
 
 /// A kept pivot smaller than this times the largest entry below it starts a new pivoting.
 pub const PIVOT_TOLERANCE: f64 = 1e-3;
 
-/// The factors in the permuted order: `P A Q = L U`, `L` unit lower triangular (its
+/// The matrix is singular (or the factorization was never done).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, thiserror::Error)]
+#[error("singular matrix in the sparse LU")]
+pub struct Singular;
+
+/// The pivot order and the patterns of `P A Q = L U`: `L` unit lower triangular (its
 /// diagonal stored first in each column), `U` upper triangular (its diagonal stored last,
 /// the other entries of a column in an order that is topological for the solve with `L`).
-#[derive(Default)]
-struct Factors {
+#[derive(Debug, Default)]
+struct LuPattern {
     l_ptr: Vec<usize>,
     l_idx: Vec<usize>,
-    l_val: Vec<f64>,
     u_ptr: Vec<usize>,
     u_idx: Vec<usize>,
-    u_val: Vec<f64>,
-    /// `1 / U[j, j]` (the solve multiplies).
-    u_inv_diag: Vec<f64>,
     /// Permuted row `i` is original row `row_perm[i]`; `row_inv` is the inverse.
     row_perm: Vec<usize>,
     row_inv: Vec<usize>,
+    /// Column `j` of `A Q` is column `col_perm[j]` of `A`.
+    col_perm: Vec<usize>,
 }
 
-/// The refactoring sparse LU (see the module doc).
-#[derive(Default)]
+/// The values of one factorization on its [`LuPattern`].
+#[derive(Clone, Debug, Default)]
+struct LuValues {
+    l: Vec<f64>,
+    u: Vec<f64>,
+    /// `1 / U[j, j]` (the solve multiplies).
+    u_inv_diag: Vec<f64>,
+}
+
+/// One factorization kept for later solves.
+#[derive(Clone, Debug)]
+pub struct LuSnapshot {
+    pattern: Arc<LuPattern>,
+    values: LuValues,
+}
+
+impl LuSnapshot {
+    /// `x <- A^-1 x`; `work` of the matrix's size.
+    pub fn solve(&self, x: &mut [f64], work: &mut [f64]) {
+        solve_with(&self.pattern, &self.values, x, work);
+    }
+
+    /// Bytes of the values (the pattern is shared).
+    pub fn bytes(&self) -> usize {
+        8 * (self.values.l.len() + self.values.u.len() + self.values.u_inv_diag.len())
+    }
+}
+
+/// The refactoring sparse LU of matrices of one pattern (see the module doc).
 pub struct RefactorLu {
-    a: Option<FaerSparseMat<f64>>,
-    /// Column `j` of `A Q` is column `col_perm[j]` of `A`; `col_inv` is the inverse.
+    pattern: Arc<LuPattern>,
+    values: LuValues,
     col_perm: Vec<usize>,
     col_inv: Vec<usize>,
-    f: Factors,
-    /// Whether `f` holds a usable factorization of the current matrix.
+    /// Whether the factors hold a usable factorization of the last matrix.
     ok: bool,
     work: Vec<f64>,
     solve_work: RefCell<Vec<f64>>,
-    stack: Option<MemBuffer>,
+    stack: MemBuffer,
     /// Factorizations with fresh pivoting, and those that reused the pivots.
     pub full: usize,
     pub refactored: usize,
 }
 
 impl RefactorLu {
-    /// Analyse the pattern of `a` (column order) and keep the matrix storage.
-    pub fn with_pattern(a: FaerSparseMat<f64>) -> Self {
-        let sym = a.inner()[0].symbolic();
+    /// Analyse the pattern (COLAMD column order).
+    pub fn new(sym: SymbolicSparseColMatRef<'_, usize>) -> Self {
         let n = sym.ncols();
         let (col_perm, col_inv) = match factorize_symbolic_lu(sym, Default::default()) {
             Ok(s) => {
@@ -82,153 +112,168 @@ impl RefactorLu {
             Err(_) => ((0..n).collect(), (0..n).collect()),
         };
         Self {
-            stack: Some(MemBuffer::new(factorize_simplicial_numeric_lu_scratch::<
-                usize,
-                f64,
-            >(n, n))),
-            a: Some(a),
+            pattern: Arc::default(),
+            values: LuValues::default(),
             col_perm,
             col_inv,
+            ok: false,
             work: vec![0.0; n],
             solve_work: RefCell::new(vec![0.0; n]),
-            ..Default::default()
+            stack: MemBuffer::new(factorize_simplicial_numeric_lu_scratch::<usize, f64>(n, n)),
+            full: 0,
+            refactored: 0,
         }
     }
 
-    /// Factor the stored matrix: reuse the pivots when there are any and they hold.
-    pub fn factor(&mut self) {
-        let Some(a) = self.a.as_ref() else {
-            self.ok = false;
-            return;
-        };
-        let a = a.inner()[0].as_ref();
-        if self.ok && refactor(&mut self.f, &mut self.work, a, &self.col_perm) {
+    /// Factor `a` (the pattern given to [`RefactorLu::new`]): reuse the pivots when there
+    /// are any and they hold.
+    pub fn factor(&mut self, a: SparseColMatRef<'_, usize, f64>) -> Result<(), Singular> {
+        if self.ok && refactor(&self.pattern, &mut self.values, &mut self.work, a) {
             self.refactored += 1;
-            return;
+            return Ok(());
         }
         self.full += 1;
-        let stack = self.stack.as_mut().expect("scratch allocated with the pattern");
-        self.ok = full_factor(&mut self.f, a, &self.col_perm, &self.col_inv, stack);
+        let q = PermRef::new_checked(&self.col_perm, &self.col_inv, a.ncols());
+        self.ok = match full_factor(a, q, &mut self.stack) {
+            Some((pattern, values)) => {
+                self.pattern = Arc::new(pattern);
+                self.values = values;
+                true
+            }
+            None => false,
+        };
+        if self.ok {
+            Ok(())
+        } else {
+            Err(Singular)
+        }
     }
 
     /// `x <- A^-1 x`.
-    pub fn solve(&self, x: &mut [f64]) -> Result<(), LaError> {
+    pub fn solve(&self, x: &mut [f64]) -> Result<(), Singular> {
         if !self.ok {
-            return Err(LinearSolverError::LuSolveFailed.into());
+            return Err(Singular);
         }
-        let f = &self.f;
-        let mut y = self.solve_work.borrow_mut();
-        let y = &mut y[..];
-        for (yi, &r) in y.iter_mut().zip(&f.row_perm) {
-            *yi = x[r];
-        }
-        let (lp, li, lv) = (&f.l_ptr[..], &f.l_idx[..], &f.l_val[..]);
-        for j in 0..y.len() {
-            let yj = y[j];
-            let (a, b) = (lp[j] + 1, lp[j + 1]);
-            for (&i, &v) in li[a..b].iter().zip(&lv[a..b]) {
-                y[i] -= v * yj;
-            }
-        }
-        let (up, ui, uv, dinv) = (&f.u_ptr[..], &f.u_idx[..], &f.u_val[..], &f.u_inv_diag[..]);
-        for j in (0..y.len()).rev() {
-            let yj = y[j] * dinv[j];
-            y[j] = yj;
-            let (a, b) = (up[j], up[j + 1] - 1);
-            for (&i, &v) in ui[a..b].iter().zip(&uv[a..b]) {
-                y[i] -= v * yj;
-            }
-        }
-        for (&yj, &c) in y.iter().zip(&self.col_perm) {
-            x[c] = yj;
-        }
+        solve_with(&self.pattern, &self.values, x, &mut self.solve_work.borrow_mut());
         Ok(())
+    }
+
+    /// The current factorization, kept.
+    pub fn snapshot(&self) -> Result<LuSnapshot, Singular> {
+        if !self.ok {
+            return Err(Singular);
+        }
+        Ok(LuSnapshot {
+            pattern: Arc::clone(&self.pattern),
+            values: self.values.clone(),
+        })
     }
 }
 
-/// Partial pivoting from scratch (faer), then the factors copied into `f`. False when the
-/// matrix is singular.
+/// Permute, two column sweeps, permute back.
+fn solve_with(p: &LuPattern, v: &LuValues, x: &mut [f64], y: &mut [f64]) {
+    for (yi, &r) in y.iter_mut().zip(&p.row_perm) {
+        *yi = x[r];
+    }
+    let (lp, li, lv) = (&p.l_ptr[..], &p.l_idx[..], &v.l[..]);
+    for j in 0..y.len() {
+        let yj = y[j];
+        let (a, b) = (lp[j] + 1, lp[j + 1]);
+        for (&i, &l) in li[a..b].iter().zip(&lv[a..b]) {
+            y[i] -= l * yj;
+        }
+    }
+    let (up, ui, uv, dinv) = (&p.u_ptr[..], &p.u_idx[..], &v.u[..], &v.u_inv_diag[..]);
+    for j in (0..y.len()).rev() {
+        let yj = y[j] * dinv[j];
+        y[j] = yj;
+        let (a, b) = (up[j], up[j + 1] - 1);
+        for (&i, &u) in ui[a..b].iter().zip(&uv[a..b]) {
+            y[i] -= u * yj;
+        }
+    }
+    for (&yj, &c) in y.iter().zip(&p.col_perm) {
+        x[c] = yj;
+    }
+}
+
+/// Partial pivoting from scratch (faer), the factors copied out. `None` when the matrix is
+/// singular.
 fn full_factor(
-    f: &mut Factors,
     a: SparseColMatRef<'_, usize, f64>,
-    col_perm: &[usize],
-    col_inv: &[usize],
+    q: PermRef<'_, usize>,
     stack: &mut MemBuffer,
-) -> bool {
+) -> Option<(LuPattern, LuValues)> {
     let n = a.ncols();
-    f.row_perm.resize(n, 0);
-    f.row_inv.resize(n, 0);
+    let mut p = LuPattern {
+        row_perm: vec![0; n],
+        row_inv: vec![0; n],
+        col_perm: q.arrays().0.to_vec(),
+        ..Default::default()
+    };
     let mut lu = SimplicialLu::<usize, f64>::new();
-    let q = PermRef::new_checked(col_perm, col_inv, n);
-    let done = factorize_simplicial_numeric_lu(
-        &mut f.row_perm,
-        &mut f.row_inv,
+    factorize_simplicial_numeric_lu(
+        &mut p.row_perm,
+        &mut p.row_inv,
         &mut lu,
         a,
         q,
         MemStack::new(stack),
-    );
-    if done.is_err() {
-        return false;
-    }
+    )
+    .ok()?;
     let (l, u) = (lu.l_factor_unsorted(), lu.u_factor_unsorted());
-    copy_csc(l, &mut f.l_ptr, &mut f.l_idx, &mut f.l_val);
-    copy_csc(u, &mut f.u_ptr, &mut f.u_idx, &mut f.u_val);
-    f.u_inv_diag.clear();
-    f.u_inv_diag.extend((0..n).map(|j| 1.0 / f.u_val[f.u_ptr[j + 1] - 1]));
-    (0..n).all(|j| {
-        let d = f.u_val[f.u_ptr[j + 1] - 1];
-        d.is_finite() && d != 0.0 && f.u_idx[f.u_ptr[j + 1] - 1] == j
-    })
+    p.l_ptr = l.symbolic().col_ptr().to_vec();
+    p.l_idx = l.symbolic().row_idx().to_vec();
+    p.u_ptr = u.symbolic().col_ptr().to_vec();
+    p.u_idx = u.symbolic().row_idx().to_vec();
+    let diag = |j: usize| p.u_ptr[j + 1] - 1;
+    let regular = (0..n).all(|j| {
+        let d = u.val()[diag(j)];
+        d.is_finite() && d != 0.0 && p.u_idx[diag(j)] == j
+    });
+    let values = LuValues {
+        l: l.val().to_vec(),
+        u: u.val().to_vec(),
+        u_inv_diag: (0..n).map(|j| 1.0 / u.val()[diag(j)]).collect(),
+    };
+    regular.then_some((p, values))
 }
 
-fn copy_csc(
-    m: SparseColMatRef<'_, usize, f64>,
-    ptr: &mut Vec<usize>,
-    idx: &mut Vec<usize>,
-    val: &mut Vec<f64>,
-) {
-    ptr.clear();
-    ptr.extend_from_slice(m.symbolic().col_ptr());
-    idx.clear();
-    idx.extend_from_slice(m.symbolic().row_idx());
-    val.clear();
-    val.extend_from_slice(m.val());
-}
-
-/// Gilbert-Peierls with the kept pivots and patterns. False (the factors then unusable)
+/// Gilbert-Peierls with the kept pivots and patterns. False (the values then unusable)
 /// when a pivot fails the tolerance.
 fn refactor(
-    f: &mut Factors,
+    p: &LuPattern,
+    v: &mut LuValues,
     x: &mut [f64],
     a: SparseColMatRef<'_, usize, f64>,
-    col_perm: &[usize],
 ) -> bool {
     let (ap, ai, av) = (a.symbolic().col_ptr(), a.symbolic().row_idx(), a.val());
-    for (j, &c) in col_perm.iter().enumerate() {
+    for (j, &c) in p.col_perm.iter().enumerate() {
         for e in ap[c]..ap[c + 1] {
-            x[f.row_inv[ai[e]]] += av[e];
+            x[p.row_inv[ai[e]]] += av[e];
         }
-        let last = f.u_ptr[j + 1] - 1;
-        for e in f.u_ptr[j]..last {
-            let r = f.u_idx[e];
+        let last = p.u_ptr[j + 1] - 1;
+        for e in p.u_ptr[j]..last {
+            let r = p.u_idx[e];
             let xr = x[r];
             x[r] = 0.0;
-            f.u_val[e] = xr;
-            for k in f.l_ptr[r] + 1..f.l_ptr[r + 1] {
-                x[f.l_idx[k]] -= f.l_val[k] * xr;
+            v.u[e] = xr;
+            for k in p.l_ptr[r] + 1..p.l_ptr[r + 1] {
+                x[p.l_idx[k]] -= v.l[k] * xr;
             }
         }
         let pivot = x[j];
         x[j] = 0.0;
-        let below = &f.l_idx[f.l_ptr[j] + 1..f.l_ptr[j + 1]];
-        let largest = below.iter().fold(0.0f64, |m, &i| m.max(x[i].abs()));
-        let good = pivot.is_finite() && pivot.abs() > PIVOT_TOLERANCE * largest && pivot != 0.0;
-        f.u_val[last] = pivot;
-        f.u_inv_diag[j] = 1.0 / pivot;
-        for k in f.l_ptr[j] + 1..f.l_ptr[j + 1] {
-            let i = f.l_idx[k];
-            f.l_val[k] = x[i] / pivot;
+        let below = p.l_ptr[j] + 1..p.l_ptr[j + 1];
+        let largest = p.l_idx[below.clone()]
+            .iter()
+            .fold(0.0f64, |m, &i| m.max(x[i].abs()));
+        let good = pivot.is_finite() && pivot != 0.0 && pivot.abs() > PIVOT_TOLERANCE * largest;
+        v.u[last] = pivot;
+        v.u_inv_diag[j] = 1.0 / pivot;
+        for k in below {
+            let i = p.l_idx[k];
+            v.l[k] = x[i] / pivot;
             x[i] = 0.0;
         }
         if !good {
@@ -239,46 +284,28 @@ fn refactor(
     true
 }
 
-impl LinearSolver<FaerSparseMat<f64>> for RefactorLu {
-    fn set_linearisation<
-        C: LinearOp<T = f64, V = FaerVec<f64>, M = FaerSparseMat<f64>, C = FaerContext>,
-    >(
-        &mut self,
-        op: &C,
-    ) {
-        let a = self.a.as_mut().expect("the pattern is set first");
-        op.matrix_inplace(a);
-        self.factor();
-    }
-
-    fn solve_in_place(&self, x: &mut FaerVec<f64>) -> Result<(), LaError> {
-        self.solve(x.inner_mut().col_as_slice_mut(0))
-    }
-
-    fn solve_transpose_in_place(&self, _x: &mut FaerVec<f64>) -> Result<(), LaError> {
-        Err(LinearSolverError::Other("the refactoring LU has no transposed solve".into()).into())
-    }
-
-    fn set_sparsity<
-        C: LinearOp<T = f64, V = FaerVec<f64>, M = FaerSparseMat<f64>, C = FaerContext>,
-    >(
-        &mut self,
-        op: &C,
-    ) {
-        let a =
-            FaerSparseMat::new_from_sparsity(op.nrows(), op.ncols(), op.sparsity(), *op.context());
-        *self = Self::with_pattern(a);
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
+    use faer::sparse::{SparseColMat, Triplet};
     use nalgebra::{DMatrix, DVector};
+
+    fn sparse(d: &DMatrix<f64>) -> SparseColMat<usize, f64> {
+        let n = d.nrows();
+        let mut trip = Vec::new();
+        for c in 0..n {
+            for r in 0..n {
+                if d[(r, c)] != 0.0 || r == c {
+                    trip.push(Triplet::new(r, c, d[(r, c)]));
+                }
+            }
+        }
+        SparseColMat::try_new_from_triplets(n, n, &trip).expect("matrix")
+    }
 
     /// A banded matrix with a dense border (the shape of a regenerator chain with bodies),
     /// values varied by `s`.
-    fn matrix(n: usize, s: f64) -> (FaerSparseMat<f64>, DMatrix<f64>) {
+    fn matrix(n: usize, s: f64) -> DMatrix<f64> {
         let mut d = DMatrix::zeros(n, n);
         for i in 0..n {
             d[(i, i)] = 4.0 + s * (i as f64 * 0.37).sin();
@@ -289,82 +316,68 @@ mod tests {
             d[(i, 0)] += 0.1 * (1.0 + i as f64 * 0.01);
             d[(0, i)] += 0.2 * s;
         }
-        let mut trip = Vec::new();
-        let mut vals = Vec::new();
-        for c in 0..n {
-            for r in 0..n {
-                if d[(r, c)] != 0.0 || r == c {
-                    trip.push((r, c));
-                    vals.push(d[(r, c)]);
-                }
-            }
-        }
-        let m = FaerSparseMat::try_from_triplets(n, n, trip, vals, FaerContext::default())
-            .expect("matrix");
-        (m, d)
+        d
     }
 
-    fn solve_matches(lu: &RefactorLu, d: &DMatrix<f64>) {
-        let n = d.nrows();
-        let b: Vec<f64> = (0..n).map(|i| 1.0 + (i as f64 * 0.7).cos()).collect();
-        let mut x = b.clone();
-        lu.solve(&mut x).expect("solve");
-        let want = d.clone().lu().solve(&DVector::from_vec(b)).expect("dense");
-        for i in 0..n {
+    fn rhs(n: usize) -> Vec<f64> {
+        (0..n).map(|i| 1.0 + (i as f64 * 0.7).cos()).collect()
+    }
+
+    fn check(x: &[f64], d: &DMatrix<f64>) {
+        let want = d.clone().lu().solve(&DVector::from_vec(rhs(d.nrows()))).expect("dense");
+        for i in 0..x.len() {
             assert!((x[i] - want[i]).abs() < 1e-12 * (1.0 + want[i].abs()), "x[{i}]");
         }
     }
 
     #[test]
     fn refactorization_solves_as_the_dense_lu() {
-        let (m, d) = matrix(40, 0.0);
-        let mut lu = RefactorLu::with_pattern(m.clone());
-        lu.factor();
-        solve_matches(&lu, &d);
-        for s in [0.3, 0.7, 1.1] {
-            let (m2, d2) = matrix(40, s);
-            lu.a = Some(m2);
-            lu.factor();
-            solve_matches(&lu, &d2);
+        let d0 = matrix(40, 0.0);
+        let a0 = sparse(&d0);
+        let mut lu = RefactorLu::new(a0.symbolic());
+        let mut kept = Vec::new();
+        for s in [0.0, 0.3, 0.7, 1.1] {
+            let d = matrix(40, s);
+            lu.factor(sparse(&d).as_ref()).expect("regular");
+            let mut x = rhs(40);
+            lu.solve(&mut x).expect("solve");
+            check(&x, &d);
+            kept.push((lu.snapshot().expect("factored"), d));
         }
         assert_eq!((lu.full, lu.refactored), (1, 3));
+        // the kept factors still solve their own matrices
+        let mut work = vec![0.0; 40];
+        for (snap, d) in &kept {
+            let mut x = rhs(40);
+            snap.solve(&mut x, &mut work);
+            check(&x, d);
+        }
     }
 
     #[test]
     fn a_pivot_gone_small_starts_a_new_pivoting() {
         // [[a, 1], [1, 1]]: pivots kept from a = 2 fail when a -> 1e-9
-        let build = |a: f64| {
-            FaerSparseMat::try_from_triplets(
-                2,
-                2,
-                vec![(0, 0), (1, 0), (0, 1), (1, 1)],
-                vec![a, 1.0, 1.0, 1.0],
-                FaerContext::default(),
-            )
-            .expect("matrix")
-        };
-        let mut lu = RefactorLu::with_pattern(build(2.0));
-        lu.factor();
-        lu.a = Some(build(1e-9));
-        lu.factor();
+        let build = |a: f64| DMatrix::from_row_slice(2, 2, &[a, 1.0, 1.0, 1.0]);
+        let mut lu = RefactorLu::new(sparse(&build(2.0)).symbolic());
+        lu.factor(sparse(&build(2.0)).as_ref()).expect("regular");
+        let kept = lu.snapshot().expect("factored");
+        lu.factor(sparse(&build(1e-9)).as_ref()).expect("regular");
         assert_eq!(lu.full, 2, "the tiny pivot was not caught");
-        let d = DMatrix::from_row_slice(2, 2, &[1e-9, 1.0, 1.0, 1.0]);
-        solve_matches(&lu, &d);
+        let mut x = rhs(2);
+        lu.solve(&mut x).expect("solve");
+        check(&x, &build(1e-9));
+        // a snapshot taken before the new pivoting keeps its own pattern
+        let mut x = rhs(2);
+        kept.solve(&mut x, &mut [0.0; 2]);
+        check(&x, &build(2.0));
     }
 
     #[test]
-    fn a_singular_matrix_is_an_error_at_the_solve() {
-        let m = FaerSparseMat::try_from_triplets(
-            2,
-            2,
-            vec![(0, 0), (1, 0), (0, 1), (1, 1)],
-            vec![1.0, 2.0, 2.0, 4.0],
-            FaerContext::default(),
-        )
-        .expect("matrix");
-        let mut lu = RefactorLu::with_pattern(m);
-        lu.factor();
-        let mut x = vec![1.0, 1.0];
-        assert!(lu.solve(&mut x).is_err());
+    fn a_singular_matrix_is_an_error() {
+        let a = sparse(&DMatrix::from_row_slice(2, 2, &[1.0, 2.0, 2.0, 4.0]));
+        let mut lu = RefactorLu::new(a.symbolic());
+        assert_eq!(lu.factor(a.as_ref()), Err(Singular));
+        assert_eq!(lu.solve(&mut [1.0, 1.0]), Err(Singular));
+        assert!(lu.snapshot().is_err());
     }
 }

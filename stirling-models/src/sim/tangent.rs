@@ -13,29 +13,26 @@
 //!
 //! in state-scaled form (`J_s = D^-1 J D`), so a product is `D^-1 Phi D v` with the
 //! same discrete `Phi` as [`super::monodromy::flow_with_monodromy_radau`] (to round-off:
-//! same steps, same stage states, same stage matrices). The stage matrix is factored by a
-//! faer sparse LU (symbolic analysis once); the numeric factors of the first steps are kept
-//! up to [`TangentFlow`]'s memory budget, so repeated products (GMRES, Arnoldi) cost one
-//! triangular solve per step there and a refactorization only past the budget.
+//! same steps, same stage states, same stage matrices). The stage matrix is factored by the
+//! refactoring sparse LU ([`super::refactor_lu`]: column order once, pivots kept from step
+//! to step); the factors' values of the first steps are kept up to [`TangentFlow`]'s memory
+//! budget, so repeated products (GMRES, Arnoldi) cost one triangular solve per step there
+//! and a refactorization (no pivot search) only past the budget.
 //!
 //! Why this route and not the staggered sensitivities of [`super::sens`]: those
 //! re-run the corrector of the BDF for every direction (a full nonlinear run per
 //! product), while here a product is linear work on stored data, and it reproduces the
 //! dense route's `Phi` exactly, which the route-equality test relies on.
 
-use faer::sparse::linalg::lu::{LuRef, NumericLu};
 use stirling_dsl::Model;
 
 use super::integrate::{SimOptions, SolverStats};
 use super::monodromy::{
     radau3, run_recorded, scaled_triplets, solve_stages, SparseStage, StageStep,
 };
+use super::refactor_lu::LuSnapshot;
 use super::system::{state_scale, ModelSystem};
 use super::SimError;
-
-/// Bytes of one stored numeric LU factor per stage-matrix nonzero (values and indices of
-/// `L` and `U` with the fill measured on `nsection`: about 3x the stage matrix's nonzeros).
-const LU_BYTES_PER_NNZ: usize = 48;
 
 /// The recorded orbit and the operator `v -> D^-1 Phi D v`.
 pub struct TangentFlow<'m> {
@@ -46,9 +43,11 @@ pub struct TangentFlow<'m> {
     /// The states at the three stage times, `3 n` per step.
     stage_x: Vec<f64>,
     sparse: SparseStage,
-    /// Numeric LU factors of the first steps' stage matrices.
-    cache: Vec<NumericLu<usize, f64>>,
-    cache_limit: usize,
+    /// The factors of the first steps' stage matrices.
+    cache: Vec<LuSnapshot>,
+    /// Bytes the cache may hold, and holds.
+    cache_budget: usize,
+    cache_used: usize,
     trip: [Vec<(usize, usize, f64)>; 3],
     scale: Vec<f64>,
     /// Products applied so far.
@@ -88,21 +87,22 @@ impl TangentFlow<'_> {
             if k >= self.cache.len() {
                 self.factor(k)?;
             }
-            let numeric = self.cache.get(k).unwrap_or(&self.sparse.numeric);
-            let lu = LuRef::new_unchecked(&self.sparse.symbolic, numeric);
-            solve_stages(
-                self.n,
-                lu,
-                &mut self.sparse.rhs,
-                &mut self.sparse.solve_scratch,
-                v,
-            );
+            let sp = &mut self.sparse;
+            match self.cache.get(k) {
+                Some(kept) => solve_stages(self.n, &mut sp.rhs, v, |r| kept.solve(r, &mut sp.work)),
+                None => {
+                    let lu = &sp.lu;
+                    solve_stages(self.n, &mut sp.rhs, v, |r| {
+                        lu.solve(r).expect("factored just above")
+                    })
+                }
+            }
         }
         Ok(())
     }
 
-    /// Factor step `k`'s stage matrix into `sparse.numeric` (moved into the cache while
-    /// the budget lasts and `k` is the next uncached step).
+    /// Factor step `k`'s stage matrix into `sparse.lu` (kept in the cache while the budget
+    /// lasts and `k` is the next uncached step).
     fn factor(&mut self, k: usize) -> Result<(), SimError> {
         let (c, a) = radau3();
         let (t0, h) = self.steps[k];
@@ -125,8 +125,17 @@ impl TangentFlow<'_> {
                 why: format!("tangent step: {e}"),
             })?;
         self.factorizations += 1;
-        if k == self.cache.len() && k < self.cache_limit {
-            self.cache.push(std::mem::take(&mut self.sparse.numeric));
+        if k == self.cache.len() && self.cache_used < self.cache_budget {
+            let kept = self.sparse.lu.snapshot().map_err(|e| SimError::SolverFailure {
+                t: t0,
+                why: format!("tangent step: {e}"),
+            })?;
+            if self.cache_used + kept.bytes() <= self.cache_budget {
+                self.cache_used += kept.bytes();
+                self.cache.push(kept);
+            } else {
+                self.cache_budget = 0;
+            }
         }
         Ok(())
     }
@@ -183,15 +192,15 @@ pub fn flow_with_tangent<'m>(
 ) -> Result<(Vec<f64>, TangentFlow<'m>, SolverStats), SimError> {
     let n = model.n_states();
     let pattern = model.sparsity(p);
-    let stage_nnz = 9 * pattern.len() + 3 * n;
     let mut tf = TangentFlow {
         sys: ModelSystem { model, p },
         n,
         steps: Vec::new(),
         stage_x: Vec::new(),
-        sparse: SparseStage::new(n, 1, &pattern)?,
+        sparse: SparseStage::new(n, &pattern)?,
         cache: Vec::new(),
-        cache_limit: cache_bytes / (LU_BYTES_PER_NNZ * stage_nnz).max(1),
+        cache_budget: cache_bytes,
+        cache_used: 0,
         trip: Default::default(),
         scale: state_scale(model, p),
         products: 0,
