@@ -55,7 +55,7 @@ pub struct SimulateArgs {
     #[arg(long)]
     pub limit_cycle: bool,
     /// Shooting route of --limit-cycle: auto (dense monodromy up to 400 states, Newton-Krylov
-    /// with the leading Floquet multipliers up to 900, none above), dense, krylov, or none
+    /// with the leading Floquet multipliers up to 2100 (nsection n = 1000), none above), dense, krylov, or none
     #[arg(long, value_enum, default_value_t = ShootingArg::Auto, requires = "limit_cycle")]
     pub shooting: ShootingArg,
 }
