@@ -62,6 +62,9 @@ pub(super) struct SparseStage {
     pub(super) rhs: Vec<f64>,
     /// The solve's work vector (`3 n`).
     pub(super) work: Vec<f64>,
+    /// Right-hand sides and work of the many-column solve (the dense monodromy's columns).
+    many: Vec<f64>,
+    many_work: Vec<f64>,
 }
 
 impl SparseStage {
@@ -77,18 +80,21 @@ impl SparseStage {
             }
             idx.extend((0..n).map(|k| Pair::new(bi * n + k, bi * n + k)));
         }
-        let (sym, _) = SymbolicSparseColMat::try_new_from_indices(3 * n, 3 * n, &idx).map_err(
-            |e| SimError::SolverFailure {
-                t: 0.0,
-                why: format!("monodromy stage matrix: {e:?}"),
-            },
-        )?;
+        let (sym, _) =
+            SymbolicSparseColMat::try_new_from_indices(3 * n, 3 * n, &idx).map_err(|e| {
+                SimError::SolverFailure {
+                    t: 0.0,
+                    why: format!("monodromy stage matrix: {e:?}"),
+                }
+            })?;
         let nnz = sym.row_idx().len();
         Ok(Self {
             lu: RefactorLu::new(sym.as_ref()),
             mat: SparseColMat::new(sym, vec![0.0; nnz]),
             rhs: vec![0.0; 3 * n],
             work: vec![0.0; 3 * n],
+            many: Vec::new(),
+            many_work: Vec::new(),
         })
     }
 }
@@ -235,13 +241,23 @@ impl StageStep<'_> {
         Ok(())
     }
 
-    /// Solve with the sparse LU of `sp`; `phi` becomes the last stage.
+    /// Solve with the sparse LU of `sp` for every column of `phi` at once; `phi` becomes the
+    /// last stage.
     fn solve_sparse(&self, sp: &mut SparseStage, phi: &mut [f64]) -> Result<(), StageError> {
         self.factor_sparse(sp)?;
-        let lu = &sp.lu;
-        solve_stages(self.n, &mut sp.rhs, phi, |r| {
-            lu.solve(r).expect("factored just above")
-        });
+        let n = self.n;
+        let mut rhs = std::mem::take(&mut sp.many);
+        rhs.resize(3 * n * n, 0.0);
+        for (col, block) in phi.chunks_exact(n).zip(rhs.chunks_exact_mut(3 * n)) {
+            for i in 0..3 {
+                block[i * n..(i + 1) * n].copy_from_slice(col);
+            }
+        }
+        sp.lu.solve_columns(&mut rhs, n, &mut sp.many_work)?;
+        for (col, block) in phi.chunks_exact_mut(n).zip(rhs.chunks_exact(3 * n)) {
+            col.copy_from_slice(&block[2 * n..]);
+        }
+        sp.many = rhs;
         Ok(())
     }
 

@@ -154,7 +154,27 @@ impl RefactorLu {
         if !self.ok {
             return Err(Singular);
         }
-        solve_with(&self.pattern, &self.values, x, &mut self.solve_work.borrow_mut());
+        solve_with(
+            &self.pattern,
+            &self.values,
+            x,
+            &mut self.solve_work.borrow_mut(),
+        );
+        Ok(())
+    }
+
+    /// `X <- A^-1 X` for the `k` columns of `x` (column-major); `work` is resized to `n k`.
+    /// One sweep over the factors serves every column (the dense monodromy's `n` columns).
+    pub fn solve_columns(
+        &self,
+        x: &mut [f64],
+        k: usize,
+        work: &mut Vec<f64>,
+    ) -> Result<(), Singular> {
+        if !self.ok {
+            return Err(Singular);
+        }
+        solve_many(&self.pattern, &self.values, x, k, work);
         Ok(())
     }
 
@@ -194,6 +214,48 @@ fn solve_with(p: &LuPattern, v: &LuValues, x: &mut [f64], y: &mut [f64]) {
     }
     for (&yj, &c) in y.iter().zip(&p.col_perm) {
         x[c] = yj;
+    }
+}
+
+/// [`solve_with`] for `k` columns at once: the work holds the permuted right-hand sides row
+/// by row, so every update of a factor entry runs over the `k` columns contiguously.
+fn solve_many(p: &LuPattern, v: &LuValues, x: &mut [f64], k: usize, y: &mut Vec<f64>) {
+    let n = p.row_perm.len();
+    y.clear();
+    y.resize(n * k, 0.0);
+    for (i, &r) in p.row_perm.iter().enumerate() {
+        for c in 0..k {
+            y[i * k + c] = x[c * n + r];
+        }
+    }
+    let axpy = |y: &mut [f64], dst: usize, src: usize, f: f64| {
+        let (d, s) = if dst > src {
+            let (lo, hi) = y.split_at_mut(dst * k);
+            (&mut hi[..k], &lo[src * k..src * k + k])
+        } else {
+            let (lo, hi) = y.split_at_mut(src * k);
+            (&mut lo[dst * k..dst * k + k], &hi[..k])
+        };
+        for (a, b) in d.iter_mut().zip(s) {
+            *a -= f * b;
+        }
+    };
+    for j in 0..n {
+        for e in p.l_ptr[j] + 1..p.l_ptr[j + 1] {
+            axpy(y, p.l_idx[e], j, v.l[e]);
+        }
+    }
+    for j in (0..n).rev() {
+        let d = v.u_inv_diag[j];
+        y[j * k..j * k + k].iter_mut().for_each(|a| *a *= d);
+        for e in p.u_ptr[j]..p.u_ptr[j + 1] - 1 {
+            axpy(y, p.u_idx[e], j, v.u[e]);
+        }
+    }
+    for (j, &c) in p.col_perm.iter().enumerate() {
+        for col in 0..k {
+            x[col * n + c] = y[j * k + col];
+        }
     }
 }
 
@@ -324,9 +386,16 @@ mod tests {
     }
 
     fn check(x: &[f64], d: &DMatrix<f64>) {
-        let want = d.clone().lu().solve(&DVector::from_vec(rhs(d.nrows()))).expect("dense");
+        let want = d
+            .clone()
+            .lu()
+            .solve(&DVector::from_vec(rhs(d.nrows())))
+            .expect("dense");
         for i in 0..x.len() {
-            assert!((x[i] - want[i]).abs() < 1e-12 * (1.0 + want[i].abs()), "x[{i}]");
+            assert!(
+                (x[i] - want[i]).abs() < 1e-12 * (1.0 + want[i].abs()),
+                "x[{i}]"
+            );
         }
     }
 
@@ -345,6 +414,20 @@ mod tests {
             kept.push((lu.snapshot().expect("factored"), d));
         }
         assert_eq!((lu.full, lu.refactored), (1, 3));
+        // several columns at once: each as the one-column solve
+        let (d, k) = (matrix(40, 1.1), 3);
+        let mut xs: Vec<f64> = (0..k)
+            .flat_map(|c| rhs(40).into_iter().map(move |v| v * (c + 1) as f64))
+            .collect();
+        lu.solve_columns(&mut xs, k, &mut Vec::new())
+            .expect("solve");
+        for c in 0..k {
+            let one: Vec<f64> = xs[c * 40..(c + 1) * 40]
+                .iter()
+                .map(|v| v / (c + 1) as f64)
+                .collect();
+            check(&one, &d);
+        }
         // the kept factors still solve their own matrices
         let mut work = vec![0.0; 40];
         for (snap, d) in &kept {

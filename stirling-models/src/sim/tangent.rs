@@ -126,10 +126,14 @@ impl TangentFlow<'_> {
             })?;
         self.factorizations += 1;
         if k == self.cache.len() && self.cache_used < self.cache_budget {
-            let kept = self.sparse.lu.snapshot().map_err(|e| SimError::SolverFailure {
-                t: t0,
-                why: format!("tangent step: {e}"),
-            })?;
+            let kept = self
+                .sparse
+                .lu
+                .snapshot()
+                .map_err(|e| SimError::SolverFailure {
+                    t: t0,
+                    why: format!("tangent step: {e}"),
+                })?;
             if self.cache_used + kept.bytes() <= self.cache_budget {
                 self.cache_used += kept.bytes();
                 self.cache.push(kept);
