@@ -331,3 +331,28 @@ fn the_command_line_is_checked() {
         .unwrap_err()
         .contains("unknown argument"));
 }
+
+/// Until sensors are declared with the model, the fit reads `p` as the last CV's pressure:
+/// here that is the bounce space, so identification refuses the model by name instead of
+/// feeding it the cold-side pressure. The family passes the same check.
+#[test]
+fn identification_refuses_a_cv_outside_the_working_gas() {
+    use stirling::models::data::Measured;
+    use stirling::models::fit::{self, supported::check_working_gas, FitError};
+    let m = model(2);
+    let p = m.default_params();
+    let err = fit::identify(&m, &p, &Measured::default(), &fit::FitOptions::default())
+        .expect_err("the bounce space is outside the chain");
+    assert!(
+        matches!(&err, FitError::OutsideChain { vessel, .. } if vessel == "bounce"),
+        "{err}"
+    );
+    assert!(err.to_string().contains("bounce"), "{err}");
+    for entry in stirling::models::model::registry::FAMILY {
+        for closure in [Closure::Full, Closure::Frozen] {
+            let family = stirling::models::model::registry::build(entry.name, None, closure)
+                .expect("family member");
+            assert!(check_working_gas(family.as_ref()).is_ok(), "{}", entry.name);
+        }
+    }
+}

@@ -58,6 +58,12 @@ pub enum FitError {
         value: f64,
         floor: f64,
     },
+    #[error(
+        "`{model}`: control volume `{vessel}` has no mass-flow link to the working gas (a closed \
+         bounce space?); the fit reads `p` as the last CV's pressure and would give it to \
+         `{vessel}` - fitting such a model needs sensors declared with it, not yet supported"
+    )]
+    OutsideChain { model: String, vessel: String },
     #[error("{stage} expects two bodies (displacer x, piston y); `{model}` has {found}")]
     Bodies {
         stage: &'static str,

@@ -48,6 +48,8 @@ pub mod stage_fit;
 pub mod staggered;
 /// The static response of the bodies to a pressure offset.
 pub mod static_shift;
+/// Which declared engines the stages can fit.
+pub mod supported;
 /// Pressures the mechanics need but the record lacks.
 pub mod unmeasured;
 /// The variables of a driven-stage fit.
