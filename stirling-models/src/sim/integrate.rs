@@ -60,7 +60,7 @@ pub enum LinearSolverKind {
     Auto,
     /// Dense nalgebra LU.
     Dense,
-    /// faer sparse LU (falls back to a full pattern if the system has none).
+    /// The refactoring sparse LU (`refactor_lu`; a full pattern if the system has none).
     Sparse,
 }
 
