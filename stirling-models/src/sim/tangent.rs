@@ -138,6 +138,7 @@ impl TangentFlow<'_> {
                 self.cache_used += kept.bytes();
                 self.cache.push(kept);
             } else {
+                // full: keep no later step (the cache is the first steps, in order)
                 self.cache_budget = 0;
             }
         }
