@@ -60,6 +60,8 @@ stirling_model! {
             faces { displacer: Ar, piston: A - Ar },
             port wall { h: hb, area: Awb, wall: Tb },
         }
+        // a transducer in the bounce space, besides the family's `p`, `p_hot`, `x`, `y`
+        sensor p_bounce: P_bounce "Pa";
     }
 }
 

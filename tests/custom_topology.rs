@@ -332,9 +332,10 @@ fn the_command_line_is_checked() {
         .contains("unknown argument"));
 }
 
-/// Until sensors are declared with the model, the fit reads `p` as the last CV's pressure:
-/// here that is the bounce space, so identification refuses the model by name instead of
-/// feeding it the cold-side pressure. The family passes the same check.
+/// The two stages read `p` as the last CV's pressure (the engine declares its `p_bounce`
+/// sensor, but the stages cannot drive from it yet): here the last CV is the bounce space,
+/// so identification refuses the model by name instead of feeding it the cold-side pressure.
+/// The family passes the same check.
 #[test]
 fn identification_refuses_a_cv_outside_the_working_gas() {
     use stirling::models::data::Measured;

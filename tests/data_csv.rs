@@ -36,9 +36,34 @@ fn reads_a_good_file_with_comments_and_extra_columns() {
     );
     let m = parse_csv("rec.csv", &text).unwrap();
     assert_eq!(m.len(), 10);
-    assert_eq!(m.channels(), vec!["p", "x", "y"]);
+    // another column is kept by name (a sensor a model may declare)
+    assert_eq!(m.channels(), vec!["p", "x", "y", "temperature"]);
+    assert_eq!(m.channel("temperature").unwrap(), &[300.0; 10]);
     assert!(m.p_hot.is_none());
     assert!((m.dt() - 5e-4).abs() < 1e-15);
+}
+
+/// A column besides the seed's four that does not hold a number in every row is set aside
+/// with its first bad cell (the record still reads; a fit that needs it says where);
+/// a seed channel's bad cell is an error at once.
+#[test]
+fn another_column_with_a_bad_cell_is_set_aside_with_where() {
+    let rows: String = good_rows(6)
+        .lines()
+        .enumerate()
+        .map(|(k, l)| format!("{l},{}\n", if k == 3 { "n/a" } else { "1.5e5" }))
+        .collect();
+    let m = parse_csv("rec.csv", &format!("t,p,x,y,p_bounce\n{rows}")).unwrap();
+    assert_eq!(m.channels(), vec!["p", "x", "y"]);
+    let e = m.unread("p_bounce").expect("set aside");
+    assert_eq!((e.row, e.column.as_str()), (5, "p_bounce"));
+    assert!(e.message.contains("n/a"), "{e}");
+    // only other columns, all unreadable: the first bad cell is the error
+    let only: String = (0..4)
+        .map(|k| format!("{},oops\n", k as f64 * 1e-3))
+        .collect();
+    let s = err(&format!("t,p_bounce\n{only}"));
+    assert!(s.contains("row 2") && s.contains("p_bounce"), "{s}");
 }
 
 #[test]
@@ -57,8 +82,8 @@ fn missing_time_column() {
 
 #[test]
 fn missing_channels() {
-    let s = err("# c\nt,temperature\n0,300\n");
-    assert_eq!(s, "rec.csv: row 2, column `p`: no measured channel: expected at least one of the columns p, p_hot, x, y; the header has: t, temperature");
+    let s = err("# c\nt\n0\n");
+    assert_eq!(s, "rec.csv: row 2, column `p`: no measured channel: expected at least one of the columns p, p_hot, x, y (or a sensor a model declares); the header has: t");
 }
 
 #[test]
@@ -171,13 +196,19 @@ fn write_read_roundtrip_and_offsets_are_estimated() {
         p_hot: None,
         x: Some(x),
         y: Some(y),
+        ..Default::default()
     };
     let dir = std::env::temp_dir().join(format!("stirling_data_rt_{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let f = dir.join("rt.csv");
+    let mut m = m;
+    m.others.push(("p_bounce".into(), vec![1.2e5; n]));
     write_csv(&f, &m, &["a comment".into()]).unwrap();
     let mut r = read_csv(&f).unwrap();
     assert_eq!(r.len(), n);
+    assert_eq!(r.channels(), vec!["p", "x", "y", "p_bounce"]);
+    assert_eq!(r.channel("p_bounce"), m.channel("p_bounce"));
+    assert_eq!(r.slice(0.0, 1e-3).channel("p_bounce").unwrap().len(), 3);
     assert!((r.x.as_ref().unwrap()[10] - m.x.as_ref().unwrap()[10]).abs() < 1e-12);
     assert!((cycle_mean(m.x.as_ref().unwrap()) - 0.0012).abs() < 2e-5);
     let off = remove_position_offsets(&mut r);

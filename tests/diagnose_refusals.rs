@@ -41,6 +41,7 @@ fn record(amp: impl Fn(f64) -> f64) -> Measured {
         p_hot: None,
         x: Some(x),
         y: Some(y),
+        ..Default::default()
     }
 }
 

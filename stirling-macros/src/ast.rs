@@ -27,6 +27,8 @@
 //!     link head -> matrix[0] { conductance: 2.0 * Gm * n }  // between walls ...
 //!     link matrix[n - 1] -> Tk { conductance: 2.0 * Gm * n } // ... or to a fixed temperature
 //!     link matrix[j] -> shell for j in 0..n { conductance: Gms / n } // every section to one wall
+//!     sensor p: P_cold "Pa";       // a measured channel: a CSV column named `p` observes state `P_cold`
+//!     sensor T3: Tw_matrix[3] "K"; // an element of an array (checked against `n` at run time)
 //! }
 //! ```
 
@@ -178,6 +180,45 @@ pub enum Item {
     /// A wall with a temperature state (its fields; faces and ports are refused).
     Wall(VesselAst),
     Link(LinkAst),
+    /// A measured channel: a CSV column observing one state.
+    Sensor(SensorAst),
+}
+
+/// `sensor name: STATE "unit";` or `sensor name: STATE[k] "unit";` (unit optional: the
+/// state's own).
+pub struct SensorAst {
+    pub name: Ident,
+    /// The observed state's name as [`Model::states`] lists it (`x`, `P_cold`, `Tw_head`),
+    /// without the index.
+    pub state: Ident,
+    /// The element of an array state.
+    pub index: Option<syn::LitInt>,
+    pub unit: Option<LitStr>,
+}
+
+fn sensor(input: ParseStream) -> syn::Result<SensorAst> {
+    let name = input.parse()?;
+    input.parse::<Token![:]>()?;
+    let state = input.parse()?;
+    let index = if input.peek(syn::token::Bracket) {
+        let content;
+        bracketed!(content in input);
+        Some(content.parse()?)
+    } else {
+        None
+    };
+    let unit = if input.peek(LitStr) {
+        Some(input.parse()?)
+    } else {
+        None
+    };
+    input.parse::<Token![;]>()?;
+    Ok(SensorAst {
+        name,
+        state,
+        index,
+        unit,
+    })
 }
 
 pub struct ModelAst {
@@ -247,10 +288,11 @@ pub(crate) fn item(input: ParseStream) -> syn::Result<Item> {
         "cv" => Item::Cv(vessel(input)?),
         "wall" => Item::Wall(vessel(input)?),
         "link" => link(input, kw.span())?,
+        "sensor" => Item::Sensor(sensor(input)?),
         other => {
             return Err(syn::Error::new(
                 kw.span(),
-                format!("unknown item `{other}`: expected one of name, params, let, gas, body, coupling, space, cv, wall, link"),
+                format!("unknown item `{other}`: expected one of name, params, let, gas, body, coupling, space, cv, wall, link, sensor"),
             ))
         }
     };

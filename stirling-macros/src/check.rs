@@ -16,6 +16,7 @@ mod declare;
 mod fields;
 mod flow;
 mod mechanics;
+mod sensors;
 mod vessels;
 
 /// Collects errors so that all are reported at once.
@@ -152,7 +153,12 @@ impl Lower {
                 Item::Cv(v) => self.cv(v),
                 Item::Wall(v) => self.wall(v),
                 Item::Link(l) => self.link(l),
-                Item::Name(_) | Item::Params(_) => {}
+                Item::Name(_) | Item::Params(_) | Item::Sensor(_) => {}
+            }
+        }
+        for it in &ast.items {
+            if let Item::Sensor(s) = it {
+                self.sensor(s);
             }
         }
         self.check_space_links(ast);

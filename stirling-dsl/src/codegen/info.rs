@@ -25,6 +25,15 @@ pub fn bodies(topo: &Topology, krate: &TokenStream) -> TokenStream {
     quote! { &[#(#items),*] }
 }
 
+/// `&[SensorInfo { .. }, ..]`.
+pub fn sensors(topo: &Topology, krate: &TokenStream) -> TokenStream {
+    let items = topo.sensors.iter().map(|s| {
+        let (name, state, unit) = (&s.name, &s.state, &s.unit);
+        quote! { #krate::SensorInfo { name: #name, state: #state, unit: #unit } }
+    });
+    quote! { &[#(#items),*] }
+}
+
 /// Vessel-element offset of CV `i`: `(scalars before, arrays before)`.
 fn cv_element_offset(topo: &Topology, i: usize) -> (usize, usize) {
     let before = &topo.cvs[..i];

@@ -58,6 +58,7 @@ pub fn generate(mut topo: Topology, spec: &ModelSpec) -> TokenStream {
     let statics = Statics {
         params: info::params(&topo, krate),
         bodies: info::bodies(&topo, krate),
+        sensors: info::sensors(&topo, krate),
         topology: info::topology(&topo, &lay, krate),
         vessel_names: info::vessel_names(&topo),
         states,
@@ -70,6 +71,7 @@ pub fn generate(mut topo: Topology, spec: &ModelSpec) -> TokenStream {
 struct Statics {
     params: TokenStream,
     bodies: TokenStream,
+    sensors: TokenStream,
     topology: TokenStream,
     vessel_names: TokenStream,
     states: Vec<TokenStream>,
@@ -82,7 +84,7 @@ fn items(topo: &Topology, spec: &ModelSpec, st: &Statics, parts: &[TokenStream])
     let model_impl = model_impl(topo, spec, st);
     let (name, doc, has_array) = (&topo.name, &topo.doc, topo.has_array());
     let (full_part, frozen_part) = (&parts[0], &parts[1]);
-    let (p, b, tp) = (&st.params, &st.bodies, &st.topology);
+    let (p, b, sn, tp) = (&st.params, &st.bodies, &st.sensors, &st.topology);
     quote! {
         #[doc = #doc]
         #[doc = ""]
@@ -98,6 +100,8 @@ fn items(topo: &Topology, spec: &ModelSpec, st: &Statics, parts: &[TokenStream])
             pub const PARAMS: &'static [#krate::ParamInfo] = #p;
             /// The bodies, in state order.
             pub const BODIES: &'static [#krate::BodyInfo] = #b;
+            /// The declared sensors (measured channels).
+            pub const SENSORS: &'static [#krate::SensorInfo] = #sn;
             /// The declared topology.
             pub const TOPOLOGY: #krate::TopologyInfo = #tp;
             /// Whether the topology has an array of CVs, so that `n` matters.
@@ -278,6 +282,7 @@ fn model_impl(topo: &Topology, spec: &ModelSpec, st: &Statics) -> TokenStream {
                 }
             }
             fn topology(&self) -> &'static #krate::TopologyInfo { &Self::TOPOLOGY }
+            fn sensors(&self) -> &'static [#krate::SensorInfo] { Self::SENSORS }
         }
     }
 }

@@ -9,7 +9,7 @@ mod topology_info;
 pub use dot::to_dot;
 pub use error::ModelError;
 pub use jac_sink::{JacSink, JacValues, JacWrite};
-pub use model::{BodyInfo, Model, ParamInfo, PowerTerms, StateInfo, StateKind};
+pub use model::{BodyInfo, Model, ParamInfo, PowerTerms, SensorInfo, StateInfo, StateKind};
 pub use topology_info::{
     ConductionInfo, FaceInfo, LinkInfo, PortInfo, TopologyInfo, VesselInfo, WallInfo,
 };

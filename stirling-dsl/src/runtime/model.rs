@@ -37,6 +37,15 @@ pub struct StateInfo {
     pub meaning: String,
 }
 
+/// A measured channel declared with the model (`sensor p: P_cold "Pa";`): the CSV column
+/// `name` observes the state `state` (as [`Model::states`] names it), in `unit`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct SensorInfo {
+    pub name: &'static str,
+    pub state: &'static str,
+    pub unit: &'static str,
+}
+
 /// A body of the topology.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct BodyInfo {
@@ -149,6 +158,11 @@ pub trait Model: Send + Sync {
     fn equations(&self, style: Style) -> String;
     /// The topology, for the bond-graph view.
     fn topology(&self) -> &'static crate::runtime::TopologyInfo;
+    /// The measured channels declared with the model (`sensor` items), in declaration order;
+    /// none by default.
+    fn sensors(&self) -> &'static [SensorInfo] {
+        &[]
+    }
 
     /// Default parameter values.
     fn default_params(&self) -> Vec<f64> {
@@ -163,6 +177,13 @@ pub trait Model: Send + Sync {
         let mut m = vec![0.0; self.bodies().len()];
         self.body_masses(p, &mut m);
         m[k]
+    }
+    /// The state a declared sensor observes, at this model's `n` and closure: `None` when
+    /// no sensor has that name, `Some(None)` when its state does not exist here (an array
+    /// element beyond `n`, a mass state of the frozen closure).
+    fn sensor_state(&self, name: &str) -> Option<Option<usize>> {
+        let s = self.sensors().iter().find(|s| s.name == name)?;
+        Some(self.states().iter().position(|st| st.name == s.state))
     }
     /// Names of the states.
     fn state_names(&self) -> Vec<String> {

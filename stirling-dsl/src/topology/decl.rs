@@ -198,6 +198,16 @@ impl LinkDecl {
 }
 
 /// A whole declared model.
+/// A measured channel: a CSV column observing one state.
+#[derive(Clone, Debug)]
+pub struct SensorDecl {
+    /// The channel (the CSV column's name).
+    pub name: String,
+    /// The observed state's name as `Model::states` lists it (`x`, `P_cold`, `Tw_matrix[3]`).
+    pub state: String,
+    pub unit: String,
+}
+
 #[derive(Clone, Debug, Default)]
 pub struct Topology {
     pub name: String,
@@ -212,6 +222,7 @@ pub struct Topology {
     pub links: Vec<LinkDecl>,
     pub walls: Vec<WallDecl>,
     pub conductions: Vec<ConductionDecl>,
+    pub sensors: Vec<SensorDecl>,
 }
 
 impl Topology {

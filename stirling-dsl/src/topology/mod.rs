@@ -15,6 +15,6 @@ mod walls;
 pub use assemble::assemble;
 pub use decl::{
     BodyDecl, ConductionDecl, CouplingDecl, CvDecl, End, FaceDecl, GasDecl, HeatEnd, LinkDecl,
-    ParamDecl, PortDecl, SpaceDecl, Topology, Vessel, WallDecl,
+    ParamDecl, PortDecl, SensorDecl, SpaceDecl, Topology, Vessel, WallDecl,
 };
 pub use system::{BlockInfo, BlockKind, Row, System, Variant, VesselTerms, WallTerms, VARIANTS};

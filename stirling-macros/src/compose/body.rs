@@ -44,6 +44,7 @@ pub(super) fn entry(input: ParseStream) -> syn::Result<Entry> {
             (Key::Vessel(v.name.to_string()), v.name.span())
         }
         Item::Link(l) => (link_key(&l.from, &l.to), l.from.name.span()),
+        Item::Sensor(s) => (Key::Sensor(s.name.to_string()), s.name.span()),
     };
     Ok(Entry::Item(Chunk { key, span, tokens }))
 }

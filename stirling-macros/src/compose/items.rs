@@ -18,6 +18,7 @@ pub(super) enum Key {
     /// The two ends as written (`regen [n - 1]`).
     Link(String, String),
     Param(String),
+    Sensor(String),
 }
 
 impl Key {
@@ -31,6 +32,7 @@ impl Key {
             Key::Vessel(n) => format!("space, cv or wall `{n}`"),
             Key::Link(a, b) => format!("link `{a} -> {b}`"),
             Key::Param(n) => format!("parameter `{n}`"),
+            Key::Sensor(n) => format!("sensor `{n}`"),
         }
     }
 
@@ -39,7 +41,9 @@ impl Key {
         match self {
             Key::Name => "name".into(),
             Key::Gas => "gas".into(),
-            Key::Let(n) | Key::Body(n) | Key::Vessel(n) | Key::Param(n) => format!("`{n}`"),
+            Key::Let(n) | Key::Body(n) | Key::Vessel(n) | Key::Param(n) | Key::Sensor(n) => {
+                format!("`{n}`")
+            }
             Key::Coupling(a, b) => format!("`{a}, {b}`"),
             Key::Link(a, b) => format!("`{a} -> {b}`"),
         }
@@ -51,6 +55,7 @@ impl Key {
         match self {
             Key::Let(n) => format!("write `replace let {n} = ..;` to replace it"),
             Key::Param(n) => format!("write `replace params {{ {n}: .. }}` to change its default"),
+            Key::Sensor(n) => format!("write `replace sensor {n}: STATE \"unit\";` to replace it"),
             _ => format!(
                 "write `replace {k} {{ .. }}` to replace it or `modify {k} {{ .. }}` to change its fields"
             ),
@@ -68,6 +73,7 @@ impl Key {
             Key::Vessel(n) => format!("cv {n}"),
             Key::Link(a, b) => format!("link {a} -> {b}"),
             Key::Param(n) => format!("param {n}"),
+            Key::Sensor(n) => format!("sensor {n}"),
         }
     }
 }

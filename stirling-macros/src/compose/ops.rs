@@ -35,10 +35,13 @@ pub(super) fn op(input: ParseStream) -> syn::Result<Op> {
     if is_ident(input, "modify") {
         input.parse::<Ident>()?;
         let (key, span) = target(input, "modify")?;
-        if matches!(key, Key::Param(_) | Key::Let(_) | Key::Name) {
+        if matches!(
+            key,
+            Key::Param(_) | Key::Let(_) | Key::Name | Key::Sensor(_)
+        ) {
             return Err(syn::Error::new(
                 span,
-                "`modify` changes the fields of a body, coupling, space, cv, wall, link or gas; write `replace params { .. }` or `replace let .. ;`",
+                "`modify` changes the fields of a body, coupling, space, cv, wall, link or gas; write `replace params { .. }`, `replace let .. ;` or `replace sensor .. ;`",
             ));
         }
         let TokenTree::Group(g) = input.parse::<TokenTree>()? else {
@@ -81,6 +84,10 @@ pub(super) fn target(input: ParseStream, verb: &str) -> syn::Result<(Key, Span)>
             let n = named(input)?;
             (Key::Vessel(n.to_string()), n.span())
         }
+        "sensor" => {
+            let n = named(input)?;
+            (Key::Sensor(n.to_string()), n.span())
+        }
         "link" => {
             let from: EndAst = input.parse()?;
             input.parse::<Token![->]>()?;
@@ -90,7 +97,7 @@ pub(super) fn target(input: ParseStream, verb: &str) -> syn::Result<(Key, Span)>
         other => {
             return Err(syn::Error::new(
                 kw.span(),
-                format!("`{verb} {other}`: expected one of param, let, gas, body, coupling, space, cv, wall, link"),
+                format!("`{verb} {other}`: expected one of param, let, gas, body, coupling, space, cv, wall, link, sensor"),
             ))
         }
     })

@@ -90,13 +90,14 @@ impl Errors<'_> {
         Ok((hrow, names))
     }
 
-    /// The position of column `t` and of each measured channel present.
-    fn columns(
+    /// The position of column `t` and of each measured channel present (the seed's four,
+    /// then the others by name, each once).
+    fn columns<'n>(
         &self,
         hrow: usize,
-        names: &[String],
+        names: &'n [String],
         body: &str,
-    ) -> Result<(usize, Vec<(usize, &'static str)>), DataError> {
+    ) -> Result<(usize, Vec<(usize, &'n str)>), DataError> {
         let file = self.file;
         let Some(it) = names.iter().position(|n| n == "t") else {
             return Err(self.err(
@@ -109,12 +110,19 @@ impl Errors<'_> {
                 ),
             ));
         };
-        let cols: Vec<(usize, &str)> = CHANNELS
+        let mut cols: Vec<(usize, &str)> = CHANNELS
             .iter()
             .filter_map(|c| names.iter().position(|n| n == c).map(|i| (i, *c)))
             .collect();
-        if cols.is_empty() {
-            return Err(self.err(hrow, "p", format!("no measured channel: expected at least one of the columns p, p_hot, x, y; the header has: {}{}", list(names), format_hint(file, body))));
+        let seed = cols.len();
+        for (i, n) in names.iter().enumerate() {
+            let known = n == "t" || CHANNELS.contains(&n.as_str()) || n.is_empty();
+            if !known && !names[..i].contains(n) {
+                cols.push((i, n.as_str()));
+            }
+        }
+        if seed == 0 && cols.is_empty() {
+            return Err(self.err(hrow, "p", format!("no measured channel: expected at least one of the columns p, p_hot, x, y (or a sensor a model declares); the header has: {}{}", list(names), format_hint(file, body))));
         }
         Ok((it, cols))
     }
@@ -169,12 +177,14 @@ impl Errors<'_> {
         number(s).map_err(|m| self.err(row, name, m))
     }
 
-    /// The record from the columns read: each channel checked for its units.
+    /// The record from the columns read: each of the seed's channels checked for its units;
+    /// another column kept when every row held a number (`bad[k]`: its first bad cell).
     fn record(
         &self,
         t: Vec<f64>,
         cols: &[(usize, &str)],
         mut data: Vec<Vec<f64>>,
+        bad: Vec<Option<DataError>>,
         rows: &[usize],
     ) -> Result<Measured, DataError> {
         let mut m = Measured {
@@ -182,8 +192,15 @@ impl Errors<'_> {
             t,
             ..Default::default()
         };
-        for (k, (_, name)) in cols.iter().enumerate() {
+        for (k, ((_, name), bad)) in cols.iter().zip(bad).enumerate() {
             let v = std::mem::take(&mut data[k]);
+            if !CHANNELS.contains(name) {
+                match bad {
+                    Some(e) => m.unread.push(e),
+                    None => m.others.push((name.to_string(), v)),
+                }
+                continue;
+            }
             check_units(name, &v).map_err(|(at, msg)| match at {
                 Some(i) => self.err(rows[i], name, msg),
                 None => self.err(
@@ -216,6 +233,7 @@ fn parse(file: &str, text: &str) -> Result<(Measured, Vec<usize>), DataError> {
     let (it, cols) = e.columns(hrow, &names, body)?;
     let mut t = Vec::new();
     let mut data: Vec<Vec<f64>> = vec![Vec::new(); cols.len()];
+    let mut bad: Vec<Option<DataError>> = vec![None; cols.len()];
     let mut rows = Vec::new();
     for (row, line) in lines {
         let fields: Vec<&str> = line.split(',').map(str::trim).collect();
@@ -223,7 +241,14 @@ fn parse(file: &str, text: &str) -> Result<(Measured, Vec<usize>), DataError> {
         e.check_time(row, tv, t.last().copied())?;
         t.push(tv);
         for (k, &col) in cols.iter().enumerate() {
-            data[k].push(e.field(row, &fields, names.len(), col)?);
+            match e.field(row, &fields, names.len(), col) {
+                Ok(v) => data[k].push(v),
+                // another column: set aside at its first bad cell, the record still reads
+                Err(err) if !CHANNELS.contains(&col.1) => {
+                    bad[k].get_or_insert(err);
+                }
+                Err(err) => return Err(err),
+            }
         }
         rows.push(row);
     }
@@ -237,7 +262,10 @@ fn parse(file: &str, text: &str) -> Result<(Measured, Vec<usize>), DataError> {
             "only one data row: a record needs at least two samples".into(),
         ));
     }
-    let m = e.record(t, &cols, data, &rows)?;
+    let m = e.record(t, &cols, data, bad, &rows)?;
+    if m.channels().is_empty() {
+        return Err(m.unread[0].clone());
+    }
     Ok((m, rows))
 }
 
@@ -326,7 +354,8 @@ fn check_units(name: &str, v: &[f64]) -> Result<(), (Option<usize>, String)> {
     }
 }
 
-/// Write a record (channels present in `m`, in the order t, p, p_hot, x, y), with `#` comments.
+/// Write a record (channels present in `m`, in the order t, p, p_hot, x, y, then the others),
+/// with `#` comments.
 pub fn write_csv(path: &Path, m: &Measured, comments: &[String]) -> std::io::Result<()> {
     let mut f = std::io::BufWriter::new(std::fs::File::create(path)?);
     for c in comments {

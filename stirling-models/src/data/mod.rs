@@ -1,5 +1,8 @@
 //! Measured data: a CSV with a header, `t` [s] and any of `p` (cold-side absolute pressure,
-//! Pa), `p_hot` (Pa), `x`, `y` (m); `#` comment lines; other columns ignored.
+//! Pa), `p_hot` (Pa), `x`, `y` (m); `#` comment lines. Other columns are kept by name when
+//! every row holds a number there ([`Measured::others`]: a channel a model declares with
+//! `sensor name: STATE;`), and set aside with the first bad cell otherwise
+//! ([`Measured::unread`]), so that a fit asking for one can say where it failed.
 //!
 //! Every malformed input is a [`DataError`] naming the file, the row (1-based line number in
 //! the file) and the column. Sensor offsets are estimated ([`offsets`]), never assumed zero.
@@ -54,18 +57,31 @@ pub struct Measured {
     pub p_hot: Option<Vec<f64>>,
     pub x: Option<Vec<f64>>,
     pub y: Option<Vec<f64>>,
+    /// Columns besides `t` and the seed's four, in header order.
+    pub others: Vec<(String, Vec<f64>)>,
+    /// Columns besides the seed's four that could not be read: the first bad cell of each.
+    pub unread: Vec<DataError>,
 }
 
 impl Measured {
-    /// A channel by name (`p`, `p_hot`, `x`, `y`).
+    /// A channel by name (`p`, `p_hot`, `x`, `y`, or one of [`Measured::others`]).
     pub fn channel(&self, name: &str) -> Option<&[f64]> {
         match name {
             "p" => self.p.as_deref(),
             "p_hot" => self.p_hot.as_deref(),
             "x" => self.x.as_deref(),
             "y" => self.y.as_deref(),
-            _ => None,
+            _ => self
+                .others
+                .iter()
+                .find(|(n, _)| n == name)
+                .map(|(_, v)| v.as_slice()),
         }
+    }
+
+    /// Why a column the record has could not be read (`None`: it is read, or absent).
+    pub fn unread(&self, name: &str) -> Option<&DataError> {
+        self.unread.iter().find(|e| e.column == name)
     }
 
     /// Mutable channel by name.
@@ -75,15 +91,20 @@ impl Measured {
             "p_hot" => self.p_hot.as_mut(),
             "x" => self.x.as_mut(),
             "y" => self.y.as_mut(),
-            _ => None,
+            _ => self
+                .others
+                .iter_mut()
+                .find(|(n, _)| n == name)
+                .map(|(_, v)| v),
         }
     }
 
-    /// Names of the channels present.
-    pub fn channels(&self) -> Vec<&'static str> {
+    /// Names of the channels present: the seed's in the order p, p_hot, x, y, then the others.
+    pub fn channels(&self) -> Vec<&str> {
         CHANNELS
             .into_iter()
             .filter(|c| self.channel(c).is_some())
+            .chain(self.others.iter().map(|(n, _)| n.as_str()))
             .collect()
     }
 
@@ -115,6 +136,12 @@ impl Measured {
             p_hot: cut(&self.p_hot),
             x: cut(&self.x),
             y: cut(&self.y),
+            others: self
+                .others
+                .iter()
+                .map(|(n, v)| (n.clone(), v[i0..i1].to_vec()))
+                .collect(),
+            unread: self.unread.clone(),
         }
     }
 

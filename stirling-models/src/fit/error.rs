@@ -64,6 +64,17 @@ pub enum FitError {
          `{vessel}` - fitting such a model needs sensors declared with it, not yet supported"
     )]
     OutsideChain { model: String, vessel: String },
+    #[error(
+        "`{model}` declares sensor `{channel}` on {state}; the two stages read `{channel}` from \
+         {expected} (x, y: the two bodies' positions; p: the last CV's pressure; p_hot: the \
+         first's) - fitting a channel placed elsewhere is not supported yet"
+    )]
+    SensorPlace {
+        model: String,
+        channel: &'static str,
+        state: String,
+        expected: String,
+    },
     #[error("{stage} expects two bodies (displacer x, piston y); `{model}` has {found}")]
     Bodies {
         stage: &'static str,

@@ -293,6 +293,7 @@ pub fn identify_stages<'a>(
 ) -> Result<(Identification, Vec<FittedStage<'a>>), FitError> {
     let clock = Instant::now();
     super::supported::check_working_gas(model)?;
+    super::supported::check_sensors(model)?;
     let layout = StateLayout::of(model);
     let rec = Record::new(model, &layout, p0, data, opts)?;
     let free = opts.free.clone().unwrap_or_else(|| default_free(model, p0));

@@ -309,6 +309,7 @@ pub fn run(cfg: &RigConfig) -> Result<RigOutput, RigError> {
         p_hot: r.ph.filter(|_| want("p_hot")),
         x: Some(r.x).filter(|_| want("x")),
         y: Some(r.y).filter(|_| want("y")),
+        ..Default::default()
     };
     let truth = truth(cfg, model.as_ref(), &p, fx);
     Ok(RigOutput { data, truth })

@@ -145,6 +145,7 @@ mod tests {
             p_hot: None,
             x: Some(x),
             y: None,
+            ..Default::default()
         };
         let s = signature(&d);
         assert!((s.x_amp / 0.003 - 1.0).abs() < 1e-3, "{}", s.x_amp);

@@ -12,5 +12,7 @@ stirling_macros::stirling_model! {
             port cold { h: hk, area: Awc0 + pi * D * (x - y), wall: Tk },
             port regen { h: hr, area: Awr, wall: (Th + Tk) / 2.0 },
         }
+        // the seed's pressure transducer, here on the one CV
+        sensor p: P_gas "Pa";
     }
 }

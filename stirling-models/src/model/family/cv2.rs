@@ -17,5 +17,8 @@ stirling_macros::stirling_model! {
             port regen { h: hr, area: Awr / 2.0, wall: (Th + 3.0 * Tk) / 4.0 },
         }
         link hot -> cold { resistance: Rf }
+        // the seed's cold-side transducer, and a hot-side one when a rig has it
+        sensor p: P_cold "Pa";
+        sensor p_hot: P_hot "Pa";
     }
 }

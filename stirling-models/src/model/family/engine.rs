@@ -74,5 +74,8 @@ stirling_macros::stirling_model! {
         body piston(y, w) { mass: mp, spring: kp, damper: bp, quad_damper: bqp }
         coupling displacer, piston { damper: b }
         space bounce { pressure: Pb, faces { displacer: Ar, piston: A - Ar } }
+        // the seed's position sensors (a member adds its pressure sensors)
+        sensor x: x "m";
+        sensor y: y "m";
     }
 }

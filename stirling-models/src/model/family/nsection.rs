@@ -21,6 +21,9 @@ stirling_macros::stirling_model! {
         link hot -> regen[0] { resistance: Rf / (2.0 * n) }
         link regen[j] -> regen[j + 1] for j in 0..n - 1 { resistance: Rf / n }
         link regen[n - 1] -> cold { resistance: Rf / (2.0 * n) }
+        // the seed's cold-side transducer, and a hot-side one when a rig has it
+        sensor p: P_cold "Pa";
+        sensor p_hot: P_hot "Pa";
     }
 }
 
