@@ -357,3 +357,75 @@ fn identification_refuses_a_cv_outside_the_working_gas() {
         }
     }
 }
+
+/// The rig measures the engine with its own sensors: the seed's `p` (cold CV, where the
+/// engine's inherited sensor puts it, not its last CV) and `x`, `y`, and the bounce-space
+/// transducer `p_bounce` it declares; the record carries it by name through a CSV.
+#[test]
+fn the_rig_measures_the_declared_bounce_sensor() {
+    use stirling::models::data::{read_csv, write_csv};
+    use stirling::models::rig::{measure, RigConfig, RigError};
+    let m = model(2);
+    let p = m.default_params();
+    let cfg = RigConfig {
+        t_end: 0.3,
+        rate: 2000.0,
+        noise_p: 20.0,
+        channels: ["p", "x", "y", "p_bounce"].map(String::from).to_vec(),
+        ..Default::default()
+    };
+    let rec = measure(&m, &p, &cfg).expect("measured");
+    assert_eq!(rec.channels(), ["p", "x", "y", "p_bounce"]);
+    // the same run, sampled clean: each channel within 6 sigma of its state
+    let samples: Vec<f64> = rec.t.clone();
+    let mut x0 = vec![0.0; m.n_states()];
+    m.equilibrium_guess(&p, &mut x0);
+    x0[0] += cfg.x0;
+    let opts = stirling::models::sim::SimOptions {
+        rtol: 1e-8,
+        atol: 1e-8,
+        ..Default::default()
+    };
+    let traj = stirling::models::sim::simulate(&m, &p, &x0, cfg.t_end, &samples, &opts).unwrap();
+    let names = m.state_names();
+    for (channel, state, sd) in [
+        ("p", "P_cold", cfg.noise_p),
+        ("p_bounce", "P_bounce", cfg.noise_p),
+        ("x", "x", cfg.noise_x),
+    ] {
+        let k = names.iter().position(|s| s == state).unwrap();
+        let v = rec.channel(channel).unwrap();
+        let worst = v
+            .iter()
+            .zip(&traj.x)
+            .map(|(a, row)| (a - row[k]).abs())
+            .fold(0.0, f64::max);
+        assert!(worst < 6.0 * sd, "{channel}: {worst} against sd {sd}");
+    }
+    // the bounce and cold pressures differ: the channel is not the cold one relabelled
+    let (pb, pc) = (rec.channel("p_bounce").unwrap(), rec.channel("p").unwrap());
+    let swing = |v: &[f64]| {
+        v.iter().fold(f64::MIN, |a, &b| a.max(b)) - v.iter().fold(f64::MAX, |a, &b| a.min(b))
+    };
+    assert!(
+        (swing(pc) - swing(pb)).abs() > 0.1 * swing(pc),
+        "{} {}",
+        swing(pc),
+        swing(pb)
+    );
+    let dir = std::env::temp_dir().join(format!("stirling_bounce_{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let f = dir.join("bounce.csv");
+    write_csv(&f, &rec, &[]).unwrap();
+    let back = read_csv(&f).unwrap();
+    assert_eq!(back.channels(), ["p", "x", "y", "p_bounce"]);
+    assert!((back.channel("p_bounce").unwrap()[7] - pb[7]).abs() < 1e-6 * pb[7]);
+    // a channel the engine does not declare is refused with the ones it does
+    let bad = RigConfig {
+        channels: vec!["p_crank".into()],
+        ..cfg.clone()
+    };
+    let err = measure(&m, &p, &bad).unwrap_err();
+    assert!(matches!(err, RigError::UnknownChannel { .. }), "{err}");
+    assert!(err.to_string().contains("p_bounce"), "{err}");
+}

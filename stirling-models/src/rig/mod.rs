@@ -155,16 +155,6 @@ fn validate(cfg: &RigConfig) -> Result<(), RigError> {
             return bad(option, v, "a non-negative noise level");
         }
     }
-    if let Some(c) = cfg
-        .channels
-        .iter()
-        .find(|c| !crate::data::CHANNELS.contains(&c.as_str()))
-    {
-        return Err(RigError::UnknownChannel {
-            channel: c.clone(),
-            known: crate::data::CHANNELS.join(", "),
-        });
-    }
     if cfg.channels.is_empty() {
         return Err(RigError::NoChannels);
     }
@@ -217,7 +207,7 @@ fn outside_engine(cfg: &RigConfig, truth: &str) -> Result<Box<dyn Model>, RigErr
     Ok(crate::outside::build(truth, n, Closure::Full)?)
 }
 
-/// The clean run: from equilibrium with the displacer kicked by `x0`, sampled at `rate`
+/// The clean run: from equilibrium with the first state (the displacer) kicked by `x0`, sampled at `rate`
 /// after `settle` (rows: the `count + 1` samples).
 fn clean_run(
     model: &dyn Model,
@@ -284,35 +274,147 @@ fn truth(cfg: &RigConfig, model: &dyn Model, p: &[f64], fx: EffectSettings) -> T
 /// Run the rig.
 pub fn run(cfg: &RigConfig) -> Result<RigOutput, RigError> {
     validate(cfg)?;
+    check_seed_channels(&cfg.channels)?;
     let (model, fx, p) = engine(cfg)?;
-    let count = (cfg.t_end * cfg.rate).round() as usize;
-    let dt = 1.0 / cfg.rate;
-    let rows = clean_run(model.as_ref(), &p, cfg, count)?;
-    let ps = StateLayout::of(model.as_ref()).pressures;
-    let (Some(&ic), Some(&ih)) = (ps.last(), ps.first()) else {
-        return Err(RigError::NoGas {
-            model: cfg.model.clone(),
-        });
-    };
-    let r = read_sensors(&rows, (ic, ih, ps.len()), &fx, cfg)?;
-    let t: Vec<f64> = (0..=count).map(|k| k as f64 * dt).collect();
-    let want = |c: &str| cfg.channels.iter().any(|k| k == c);
-    if want("p_hot") && r.ph.is_none() {
-        return Err(RigError::NoHotSide {
-            model: cfg.model.clone(),
-        });
-    }
-    let data = Measured {
-        source: format!("rig:{}", model.name()),
-        t,
-        p: Some(r.pc).filter(|_| want("p")),
-        p_hot: r.ph.filter(|_| want("p_hot")),
-        x: Some(r.x).filter(|_| want("x")),
-        y: Some(r.y).filter(|_| want("y")),
-        ..Default::default()
-    };
+    let data = record(model.as_ref(), &p, &fx, cfg)?;
     let truth = truth(cfg, model.as_ref(), &p, fx);
     Ok(RigOutput { data, truth })
+}
+
+/// Measure any model with its declared sensors (`sensor name: STATE "unit";`): the channels
+/// `cfg.channels` name (the seed's `p`, `p_hot`, `x`, `y` where the model has them, read as
+/// the family's rig reads them, then any other declared sensor), from a run of `model` at
+/// `p` (no effects: the truth is the model itself). A pressure sensor (unit `Pa`) gets
+/// `offset_p` and `noise_p`, a position (`m`) no offset and `noise_x`.
+pub fn measure(model: &dyn Model, p: &[f64], cfg: &RigConfig) -> Result<Measured, RigError> {
+    validate(cfg)?;
+    record(model, p, &EffectSettings::default(), cfg)
+}
+
+/// `--channels` of the family's rig: the seed's four.
+fn check_seed_channels(channels: &[String]) -> Result<(), RigError> {
+    match channels
+        .iter()
+        .find(|c| !crate::data::CHANNELS.contains(&c.as_str()))
+    {
+        Some(c) => Err(RigError::UnknownChannel {
+            channel: c.clone(),
+            known: crate::data::CHANNELS.join(", "),
+        }),
+        None => Ok(()),
+    }
+}
+
+/// The record the sensors of `cfg.channels` give of a clean run of `model`.
+fn record(
+    model: &dyn Model,
+    p: &[f64],
+    fx: &EffectSettings,
+    cfg: &RigConfig,
+) -> Result<Measured, RigError> {
+    let lay = StateLayout::of(model);
+    let ps = &lay.pressures;
+    // the seed's channels where the model declares them, else where the family has them
+    let at = |name: &str, fallback: Option<&usize>| match model.sensor_state(name) {
+        Some(s) => s,
+        None => fallback.copied(),
+    };
+    let (Some(ic), Some(ih)) = (at("p", ps.last()), at("p_hot", ps.first())) else {
+        return Err(RigError::NoGas {
+            model: model.name().into(),
+        });
+    };
+    let want = |c: &str| cfg.channels.iter().any(|k| k == c);
+    if want("p_hot") && ps.len() < 2 {
+        return Err(RigError::NoHotSide {
+            model: model.name().into(),
+        });
+    }
+    let pos = &lay.positions;
+    let mut chans = match (at("x", pos.first()), at("y", pos.get(1))) {
+        (Some(a), Some(b)) => sensors::seed_channels((ic, ih, ps.len()), [a, b], fx, cfg),
+        _ => Vec::new(),
+    };
+    for c in &cfg.channels {
+        if !chans.iter().any(|k| &k.name == c) {
+            chans.push(declared_channel(model, c, cfg)?);
+        }
+    }
+    let count = (cfg.t_end * cfg.rate).round() as usize;
+    let dt = 1.0 / cfg.rate;
+    let rows = clean_run(model, p, cfg, count)?;
+    let read = read_sensors(&rows, &chans, cfg)?;
+    let mut data = Measured {
+        source: format!("rig:{}", model.name()),
+        t: (0..=count).map(|k| k as f64 * dt).collect(),
+        ..Default::default()
+    };
+    for (c, v) in chans.iter().zip(read) {
+        if !want(&c.name) {
+            continue;
+        }
+        match c.name.as_str() {
+            "p" => data.p = Some(v),
+            "p_hot" => data.p_hot = Some(v),
+            "x" => data.x = Some(v),
+            "y" => data.y = Some(v),
+            _ => data.others.push((c.name.clone(), v)),
+        }
+    }
+    Ok(data)
+}
+
+/// A channel of `model`'s declared sensor `name`.
+fn declared_channel(
+    model: &dyn Model,
+    name: &str,
+    cfg: &RigConfig,
+) -> Result<sensors::Channel, RigError> {
+    let known = || {
+        model
+            .sensors()
+            .iter()
+            .map(|s| s.name)
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
+    let Some(sensor) = model.sensors().iter().find(|s| s.name == name) else {
+        return Err(RigError::UnknownChannel {
+            channel: name.into(),
+            known: format!("{} (the sensors `{}` declares)", known(), model.name()),
+        });
+    };
+    let Some(Some(state)) = model.sensor_state(name) else {
+        return Err(RigError::UnknownChannel {
+            channel: name.into(),
+            known: format!(
+                "{}; `{}` observes {}, absent at n = {}",
+                known(),
+                name,
+                sensor.state,
+                model.n()
+            ),
+        });
+    };
+    let (offset, sd, pressure) = match sensor.unit {
+        "Pa" => (cfg.offset_p, cfg.noise_p, true),
+        "m" => (0.0, cfg.noise_x, false),
+        unit => {
+            return Err(RigError::SensorUnit {
+                channel: name.into(),
+                unit: unit.into(),
+            })
+        }
+    };
+    Ok(sensors::Channel {
+        name: name.into(),
+        state,
+        tau: 0.0,
+        gain: 0.0,
+        offset,
+        sd,
+        pressure,
+    })
 }
 
 /// A channel's meaning and unit, for the CSV header comment.

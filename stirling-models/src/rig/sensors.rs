@@ -31,50 +31,89 @@ fn check_pressure(p: &[f64], cfg: &RigConfig) -> Result<(), RigError> {
     Ok(())
 }
 
-/// The sensor readings of a clean run: cold and hot pressure, `x`, `y`.
-pub(super) struct Readings {
-    pub pc: Vec<f64>,
-    pub ph: Option<Vec<f64>>,
-    pub x: Vec<f64>,
-    pub y: Vec<f64>,
+/// One channel the rig writes: the state it reads and what its sensor does to it.
+pub(super) struct Channel {
+    pub name: String,
+    pub state: usize,
+    /// First-order lag (s) and relative gain error.
+    pub tau: f64,
+    pub gain: f64,
+    /// Additive offset and noise standard deviation, in the channel's unit.
+    pub offset: f64,
+    pub sd: f64,
+    /// Whether the channel is an absolute pressure (checked to stay positive).
+    pub pressure: bool,
 }
 
-/// What the sensors read from the clean `rows`: lag, gain, offset and seeded noise (cold
-/// pressure state `ic`, hot `ih` when there are several CVs).
-pub(super) fn read_sensors(
-    rows: &[Vec<f64>],
+/// The seed's channels of a family member: cold pressure `p` (state `ic`), hot pressure
+/// `p_hot` (`ih`, several CVs only), `x`, `y` (the two bodies' positions `pos`), in the
+/// order the rig has always drawn their noise (`p_hot` drawn even when not written, so a
+/// seed gives the same record whatever channels are asked for).
+pub(super) fn seed_channels(
     (ic, ih, ncv): (usize, usize, usize),
+    pos: [usize; 2],
     fx: &EffectSettings,
     cfg: &RigConfig,
-) -> Result<Readings, RigError> {
+) -> Vec<Channel> {
+    let tau = fx.sensor_value("tau_p");
+    let pressure = |name: &str, state| Channel {
+        name: name.into(),
+        state,
+        tau,
+        gain: 0.0,
+        offset: cfg.offset_p,
+        sd: cfg.noise_p,
+        pressure: true,
+    };
+    let position = |name: &str, state, gain, offset| Channel {
+        name: name.into(),
+        state,
+        tau: 0.0,
+        gain,
+        offset,
+        sd: cfg.noise_x,
+        pressure: false,
+    };
+    let mut out = vec![pressure("p", ic)];
+    if ncv > 1 {
+        out.push(pressure("p_hot", ih));
+    }
+    out.push(position(
+        "x",
+        pos[0],
+        fx.sensor_value("gain_x"),
+        cfg.offset_x,
+    ));
+    out.push(position(
+        "y",
+        pos[1],
+        fx.sensor_value("gain_y"),
+        cfg.offset_y,
+    ));
+    out
+}
+
+/// What the sensors read from the clean `rows`: per channel, lag, gain, offset and seeded
+/// noise (one generator, drawn channel after channel).
+pub(super) fn read_sensors(
+    rows: &[Vec<f64>],
+    chans: &[Channel],
+    cfg: &RigConfig,
+) -> Result<Vec<Vec<f64>>, RigError> {
     let dt = 1.0 / cfg.rate;
     let col = |i: usize| rows.iter().map(|r| r[i]).collect::<Vec<f64>>();
-    let tau = fx.sensor_value("tau_p");
-    let (gx, gy) = (fx.sensor_value("gain_x"), fx.sensor_value("gain_y"));
     let mut g = Gauss(StdRng::seed_from_u64(cfg.seed));
-    let mut noisy = |v: Vec<f64>, gain: f64, off: f64, sd: f64| {
-        v.into_iter()
-            .map(|s| (1.0 + gain) * s + off + sd * g.next())
-            .collect::<Vec<f64>>()
-    };
-    let pc = noisy(
-        first_order_lag(&col(ic), dt, tau),
-        0.0,
-        cfg.offset_p,
-        cfg.noise_p,
-    );
-    let ph = if ncv > 1 {
-        Some(noisy(
-            first_order_lag(&col(ih), dt, tau),
-            0.0,
-            cfg.offset_p,
-            cfg.noise_p,
-        ))
-    } else {
-        None
-    };
-    check_pressure(&col(ic), cfg)?;
-    let x = noisy(col(0), gx, cfg.offset_x, cfg.noise_x);
-    let y = noisy(col(2), gy, cfg.offset_y, cfg.noise_x);
-    Ok(Readings { pc, ph, x, y })
+    let mut out = Vec::with_capacity(chans.len());
+    for c in chans {
+        let clean = col(c.state);
+        if c.pressure {
+            check_pressure(&clean, cfg)?;
+        }
+        let v = first_order_lag(&clean, dt, c.tau)
+            .into_iter()
+            .map(|s| (1.0 + c.gain) * s + c.offset + c.sd * g.next())
+            .collect();
+        out.push(v);
+    }
+    Ok(out)
 }
