@@ -84,6 +84,10 @@ fn listing(model: &dyn Model, p: &[f64], style: Style) -> String {
         &param_rows(model, p),
         &["name", "value", "unit", "meaning"],
     ));
+    if !model.sensors().is_empty() {
+        s.push_str("\nsensors (CSV columns a record may hold)\n");
+        s.push_str(&table(&sensor_rows(model), &["column", "state", "unit"]));
+    }
     s.push('\n');
     s.push_str(&model.equations(style));
     s
@@ -101,6 +105,20 @@ fn state_rows(model: &dyn Model) -> Vec<Vec<String>> {
                 st.unit.into(),
                 st.meaning.clone(),
             ]
+        })
+        .collect()
+}
+
+fn sensor_rows(model: &dyn Model) -> Vec<Vec<String>> {
+    model
+        .sensors()
+        .iter()
+        .map(|s| {
+            let state = match model.sensor_state(s.name) {
+                Some(Some(_)) => s.state.to_string(),
+                _ => format!("{} (absent at this n and closure)", s.state),
+            };
+            vec![s.name.into(), state, s.unit.into()]
         })
         .collect()
 }
@@ -174,6 +192,11 @@ fn json(model: &dyn Model, p: &[f64], style: Style) -> serde_json::Value {
         .zip(p)
         .map(|(i, v)| serde_json::json!({ "name": i.name, "value": v, "default": i.default, "unit": i.unit, "doc": i.doc }))
         .collect();
+    let sensors: Vec<_> = model
+        .sensors()
+        .iter()
+        .map(|s| serde_json::json!({ "column": s.name, "state": s.state, "unit": s.unit, "present": matches!(model.sensor_state(s.name), Some(Some(_))) }))
+        .collect();
     serde_json::json!({
         "model": model.name(),
         "n": model.n(),
@@ -183,6 +206,7 @@ fn json(model: &dyn Model, p: &[f64], style: Style) -> serde_json::Value {
         "doc": model.topology().doc.trim(),
         "states": states,
         "params": params,
+        "sensors": sensors,
         "equations_style": if matches!(style, Style::Latex) { "latex" } else { "text" },
         "equations": model.equations(style),
     })

@@ -48,6 +48,8 @@ fn listing_shows_states_parameters_and_equations() {
         "regenerator flow resistance",
         "where",
         "P_cold' =",
+        "sensors (CSV columns a record may hold)",
+        "p_hot   P_hot   Pa",
     ] {
         assert!(s.contains(needle), "missing `{needle}` in\n{s}");
     }
@@ -126,6 +128,14 @@ fn json_listing() {
     assert_eq!(v["n_states"], 8);
     assert_eq!(v["states"].as_array().unwrap().len(), 8);
     assert_eq!(v["states"][4]["unit"], "Pa");
+    let sensors = v["sensors"].as_array().unwrap();
+    let names: Vec<&str> = sensors
+        .iter()
+        .map(|s| s["column"].as_str().unwrap())
+        .collect();
+    assert_eq!(names, ["x", "y", "p", "p_hot"]);
+    assert_eq!(sensors[2]["state"], "P_cold");
+    assert_eq!(sensors[2]["present"], true);
     let rf = v["params"]
         .as_array()
         .unwrap()
