@@ -17,6 +17,9 @@ pub struct StateLayout {
     pub masses: Vec<usize>,
     /// Wall temperatures (walls with a heat capacity), in wall order.
     pub walls: Vec<usize>,
+    /// Pressures of CVs outside the working gas ([`StateLayout::working_gas`] only; empty
+    /// from [`StateLayout::of`]), in vessel order.
+    pub outside: Vec<usize>,
 }
 
 impl StateLayout {
@@ -47,6 +50,35 @@ impl StateLayout {
         l
     }
 
+    /// As [`StateLayout::of`], with the pressures split: `pressures` keeps the working gas -
+    /// the CVs joined by mass-flow links to the CV the model's `p` sensor observes (else to
+    /// the last CV), hot side first - and `outside` gets the others (a closed bounce space).
+    /// For a model whose CVs are all linked (the family), equal to [`StateLayout::of`].
+    pub fn working_gas(model: &dyn Model) -> Self {
+        let mut l = Self::of(model);
+        let Some(&last) = l.pressures.last() else {
+            return l;
+        };
+        let anchor = match model.sensor_state("p") {
+            Some(Some(s)) if l.pressures.contains(&s) => s,
+            _ => last,
+        };
+        let vessels = model.vessel_names();
+        let base = |s: &str| s.split('[').next().unwrap_or(s).trim().to_string();
+        let cv_of = |state: usize| match model.states()[state].kind {
+            StateKind::Pressure(k) => base(&vessels[k]),
+            _ => String::new(),
+        };
+        let chain = linked_to(model, &cv_of(anchor));
+        let (keep, out): (Vec<usize>, Vec<usize>) = l
+            .pressures
+            .iter()
+            .partition(|&&s| chain.contains(&cv_of(s)));
+        l.pressures = keep;
+        l.outside = out;
+        l
+    }
+
     /// Position of state `i` in the gas list.
     pub fn gas_pos(&self, i: usize) -> Option<usize> {
         self.gas.iter().position(|&g| g == i)
@@ -67,4 +99,29 @@ impl StateLayout {
     pub fn cold(&self) -> Option<usize> {
         self.pressures.last().copied()
     }
+}
+
+/// The CVs (base names) joined to `start` by mass-flow links, `start` included.
+fn linked_to(model: &dyn Model, start: &str) -> Vec<String> {
+    let base = |s: &str| s.split('[').next().unwrap_or(s).trim().to_string();
+    let links: Vec<(String, String)> = model
+        .topology()
+        .links
+        .iter()
+        .map(|l| (base(l.from), base(l.to)))
+        .collect();
+    let mut seen = vec![start.to_string()];
+    let mut k = 0;
+    while k < seen.len() {
+        let at = seen[k].clone();
+        for (a, b) in &links {
+            for (x, y) in [(a, b), (b, a)] {
+                if *x == at && !seen.contains(y) {
+                    seen.push(y.clone());
+                }
+            }
+        }
+        k += 1;
+    }
+    seen
 }

@@ -60,10 +60,18 @@ pub enum FitError {
     },
     #[error(
         "`{model}`: control volume `{vessel}` has no mass-flow link to the working gas (a closed \
-         bounce space?); the fit reads `p` as the last CV's pressure and would give it to \
-         `{vessel}` - fitting such a model needs sensors declared with it, not yet supported"
+         bounce space?) and no sensor on its pressure; its pressure is its own, so the fit needs \
+         it measured: declare `sensor p_{vessel}: P_{vessel} \"Pa\";` with the model and record \
+         that column"
     )]
     OutsideChain { model: String, vessel: String },
+    #[error("{file}: control volume `{vessel}` is outside the working gas, so the fit needs its sensor `{sensor}`, but {why}")]
+    OutsideUnmeasured {
+        file: String,
+        vessel: String,
+        sensor: String,
+        why: String,
+    },
     #[error(
         "`{model}` declares sensor `{channel}` on {state}; the two stages read `{channel}` from \
          {expected} (x, y: the two bodies' positions; p: the last CV's pressure; p_hot: the \

@@ -20,8 +20,9 @@ use crate::signal::noise_sigma;
 /// Stage 2 with the bookkeeping that turns its pressure offsets back into position offsets.
 pub struct GasStage<'a> {
     pub stage: Stage<'a>,
-    /// Static position shift per unit offset of `p` (`[0]`) and `p_hot` (`[1]`), `[x, y]`.
-    pub shift: [Vec<f64>; 2],
+    /// Static position shift per unit offset of `p` (`[0]`), `p_hot` (`[1]`) and each
+    /// measured CV outside the working gas (`[2..]`), `[x, y]`.
+    pub shift: Vec<Vec<f64>>,
     /// The shift that the pressure offsets used in stage 1 caused, `[x, y]`.
     pub used: [f64; 2],
     /// Samples skipped at the window start while the gas forgets its initial state.
@@ -29,11 +30,20 @@ pub struct GasStage<'a> {
 }
 
 impl GasStage<'_> {
-    /// Position offsets seen by the free model after stage 2 found offsets `p_off`, `ph_off`.
-    pub fn position_offsets(&self, x_off: [f64; 2], p_off: f64, ph_off: f64) -> [f64; 2] {
+    /// Position offsets seen by the free model after stage 2 found the pressure offsets
+    /// `offs` (channels as [`GasStage::shift`]).
+    pub fn position_offsets(&self, x_off: [f64; 2], offs: &[f64]) -> [f64; 2] {
         let s = &self.shift;
-        [0, 1].map(|k| x_off[k] + s[0][k] * p_off + s[1][k] * ph_off - self.used[k])
+        // summed from `x_off` channel by channel: the family's values bit for bit as before
+        [0, 1].map(|k| s.iter().zip(offs).fold(x_off[k], |a, (c, o)| a + c[k] * o) - self.used[k])
     }
+}
+
+/// The pressure offsets a record starts from, channels as [`GasStage::shift`].
+pub fn first_offsets(rec: &Record) -> Vec<f64> {
+    let mut v = vec![rec.p_off0, rec.ph_off0];
+    v.extend(rec.outside.iter().map(|o| o.off0));
+    v
 }
 
 /// Build stage 2 at parameters `p` (free gas parameters `free`), with the position offsets
@@ -55,12 +65,16 @@ pub fn stage<'a>(
         });
     };
     let have_hot = rec.have_hot;
-    let (p_off0, ph_off0) = (rec.p_off0, rec.ph_off0);
+    let off0 = first_offsets(rec);
     let mut eq = vec![0.0; model.n_states()];
     model.equilibrium_guess(p, &mut eq);
     let shift = static_shift(model, p, have_hot)?;
     let (sx, sy) = rec.pos.clone().expect("checked");
-    let used = [0, 1].map(|k| shift[0][k] * p_off0 + shift[1][k] * ph_off0);
+    let used = [0, 1].map(|k| {
+        let mut terms = shift.iter().zip(&off0).map(|(c, o)| c[k] * o);
+        let first = terms.next().unwrap_or(0.0);
+        terms.fold(first, |a, t| a + t)
+    });
     let given = given_bodies(layout, x_off, used);
     let mut vars = Var::params(model, p, free, opts.prior);
     let outputs = pressure_outputs(layout, rec, &eq, &shift, &mut vars);
@@ -69,6 +83,22 @@ pub fn stage<'a>(
     // the gas positions stay those of `layout.gas`): a wall is driven by the gas it touches
     let free: Vec<usize> = layout.gas.iter().chain(&layout.walls).copied().collect();
     let z0: Vec<f64> = free.iter().map(|&i| x_start[i]).collect();
+    // a closed CV keeps its gas: its mean pressure is set by its temperature, which relaxes
+    // over seconds (no burn-in forgets it), so its initial pressure is fitted, as stage 1
+    // fits the bodies' initial states - else its offset would absorb the transient
+    let names = model.state_names();
+    for o in &rec.outside {
+        let pos = free
+            .iter()
+            .position(|&i| i == o.state)
+            .expect("a gas state");
+        vars.push(Var::initial(
+            &format!("{}(0)", names[o.state]),
+            z0[pos],
+            100.0,
+            pos,
+        ));
+    }
     let (tr, dt) = (rec.tr, rec.dt);
     let burn = ((opts.burn_in / dt).round() as usize).min(tr.1 - tr.0 - 5);
     let stage = Stage {
@@ -115,7 +145,7 @@ fn pressure_outputs(
     layout: &StateLayout,
     rec: &Record,
     eq: &[f64],
-    shift: &[Vec<f64>; 2],
+    shift: &[Vec<f64>],
     vars: &mut Vec<Var>,
 ) -> Vec<Output> {
     let data = rec.data;
@@ -131,6 +161,12 @@ fn pressure_outputs(
         let ph = data.p_hot.as_ref().expect("have_hot");
         vars.push(Var::offset("p_hot_offset", rec.ph_off0, 100.0, 1, du(1)));
         outputs.push(Output::new("p_hot", hot_pos, ph, 1e-6 * pmean));
+    }
+    for (k, o) in rec.outside.iter().enumerate() {
+        let name = format!("{}_offset", o.name);
+        vars.push(Var::offset(&name, o.off0, 100.0, outputs.len(), du(2 + k)));
+        let at = layout.gas_pos(o.state).expect("gas state");
+        outputs.push(Output::new(&o.name, at, &o.raw, 1e-6 * pmean));
     }
     outputs
 }
@@ -156,8 +192,6 @@ fn initial_state(
     x[vel[1]] = sy.der[ta];
     let ps = &layout.pressures;
     let ncv = ps.len();
-    let mut t_rest = vec![0.0; ncv];
-    model.temperatures(p, eq, &mut t_rest);
     let hot = rec
         .sig_ph
         .as_ref()
@@ -168,17 +202,9 @@ fn initial_state(
         let wc = cold_weight(i, ncv, rec.have_hot);
         x[s] = wc * (sp.val[ta] - rec.p_off0) + (1.0 - wc) * hot;
     }
-    let masses = &layout.masses;
-    if !masses.is_empty() {
-        let nv = model.vessel_names().len();
-        let (mut pr, mut vol) = (vec![0.0; nv], vec![0.0; nv]);
-        model.pv(p, &x, &mut pr, &mut vol);
-        let total: f64 = masses.iter().map(|&i| eq[i]).sum();
-        let share: Vec<f64> = (0..ncv).map(|i| x[ps[i]] * vol[i] / t_rest[i]).collect();
-        let ssum: f64 = share.iter().sum();
-        for (k, &mi) in masses.iter().enumerate() {
-            x[mi] = total * share[k] / ssum;
-        }
+    for o in &rec.outside {
+        x[o.state] = o.sig.val[ta] - o.off0;
     }
+    super::measured_state::mass_states(model, p, layout, eq, &mut x);
     x
 }

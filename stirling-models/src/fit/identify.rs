@@ -50,16 +50,17 @@ impl<'a> Run<'a, '_> {
         p: &[f64],
         free: &[usize],
         x_off: [f64; 2],
-        p_off: (f64, f64),
+        offs: &[f64],
         dp: Option<&[Signal]>,
     ) -> Result<(Stage<'a>, Solved), FitError> {
         let inp = MechInputs {
             p,
             free,
             x_off,
-            p_off: p_off.0,
-            ph_off: p_off.1,
+            p_off: offs[0],
+            ph_off: offs[1],
             dp,
+            out_off: &offs[2..],
         };
         let stage = mechanics::stage(self.model, &self.layout, &self.rec, &inp, self.opts)?;
         let solved = fit_stage(&stage, self.rec.tr, self.rec.ho, 0, self.opts)?;
@@ -115,8 +116,8 @@ fn apply(stage: &Stage, values: &[f64], p: &mut [f64]) -> Vec<(usize, f64)> {
 struct Progress<'a> {
     p: Vec<f64>,
     x_off: [f64; 2],
-    p_off: f64,
-    ph_off: f64,
+    /// Pressure offsets: `p`, `p_hot`, then the CVs outside the working gas.
+    offs: Vec<f64>,
     stage1: Option<StageFit>,
     stage2: Option<StageFit>,
     fitted: Vec<FittedStage<'a>>,
@@ -128,8 +129,7 @@ impl Progress<'_> {
         Progress {
             p: p0.to_vec(),
             x_off: rec.x_off0,
-            p_off: rec.p_off0,
-            ph_off: rec.ph_off0,
+            offs: gas::first_offsets(rec),
             stage1: None,
             stage2: None,
             fitted: Vec::new(),
@@ -137,12 +137,18 @@ impl Progress<'_> {
     }
 
     /// The sensor offsets reached so far.
-    fn offsets(&self, have_hot: bool) -> free_run::SensorOffsets {
+    fn offsets(&self, rec: &Record) -> free_run::SensorOffsets {
         free_run::SensorOffsets {
             x: self.x_off[0],
             y: self.x_off[1],
-            p: self.p_off,
-            p_hot: have_hot.then_some(self.ph_off),
+            p: self.offs[0],
+            p_hot: rec.have_hot.then_some(self.offs[1]),
+            others: rec
+                .outside
+                .iter()
+                .zip(&self.offs[2..])
+                .map(|(o, v)| (o.name.clone(), *v))
+                .collect(),
         }
     }
 }
@@ -155,7 +161,7 @@ impl<'a> Run<'a, '_> {
         mech: &[usize],
         rerun: bool,
     ) -> Result<(), FitError> {
-        let (stage, solved) = self.mechanics(&st.p, mech, st.x_off, (st.p_off, st.ph_off), None)?;
+        let (stage, solved) = self.mechanics(&st.p, mech, st.x_off, &st.offs, None)?;
         for (out, v) in apply(&stage, &solved.values, &mut st.p) {
             st.x_off[out] = v;
         }
@@ -178,14 +184,13 @@ impl<'a> Run<'a, '_> {
             Vec::new()
         };
         let (gs, solved) = self.gas(&st.p, &free2, st.x_off)?;
+        // outputs: p, p_hot when measured, then the CVs outside the working gas
+        let hot = usize::from(self.rec.have_hot);
         for (out, v) in apply(&gs.stage, &solved.values, &mut st.p) {
-            if out == 0 {
-                st.p_off = v;
-            } else {
-                st.ph_off = v;
-            }
+            let ch = if out == 0 { 0 } else { out + 1 - hot };
+            st.offs[ch] = v;
         }
-        st.x_off = gs.position_offsets(st.x_off, st.p_off, st.ph_off);
+        st.x_off = gs.position_offsets(st.x_off, &st.offs);
         if self.opts.stage2 {
             st.stage2 = Some(solved.fit.clone());
         }
@@ -205,8 +210,7 @@ impl<'a> Run<'a, '_> {
         for &j in mech {
             st.p[j] = self.p0[j];
         }
-        let (stage, mut solved) =
-            self.mechanics(&st.p, mech, st.x_off, (st.p_off, st.ph_off), Some(&dp))?;
+        let (stage, mut solved) = self.mechanics(&st.p, mech, st.x_off, &st.offs, Some(&dp))?;
         let carried = unmeasured::carried_covariance(
             &stage,
             &solved.lm.x,
@@ -292,9 +296,8 @@ pub fn identify_stages<'a>(
     opts: &FitOptions,
 ) -> Result<(Identification, Vec<FittedStage<'a>>), FitError> {
     let clock = Instant::now();
-    super::supported::check_working_gas(model)?;
     super::supported::check_sensors(model)?;
-    let layout = StateLayout::of(model);
+    let layout = StateLayout::working_gas(model);
     let rec = Record::new(model, &layout, p0, data, opts)?;
     let free = opts.free.clone().unwrap_or_else(|| default_free(model, p0));
     let (mech, gas_free) = classify(model, p0, &free)?;
@@ -325,7 +328,7 @@ pub fn identify_stages<'a>(
     if let Some((gs, s2)) = gas_fit.filter(|_| opts.stage2) {
         st.fitted.push(run.fitted(gs.stage, &s2));
     }
-    let mut offsets = st.offsets(rec.have_hot);
+    let mut offsets = st.offsets(rec);
     let mut notes = Vec::new();
     let mut idx_free: Vec<usize> = mech.clone();
     idx_free.extend(gas_free.iter().filter(|j| !mech.contains(j)));

@@ -4,7 +4,7 @@
 //! rules).
 
 use serde::Serialize;
-use stirling_dsl::Model;
+use stirling_dsl::{Model, StateKind};
 
 use super::static_shift::cold_weight;
 use super::FitError;
@@ -20,6 +20,9 @@ pub struct SensorOffsets {
     pub p: f64,
     /// `None` when the record has no `p_hot` or the model a single control volume.
     pub p_hot: Option<f64>,
+    /// The measured CVs outside the working gas: `(sensor, offset)`.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub others: Vec<(String, f64)>,
 }
 
 impl SensorOffsets {
@@ -30,7 +33,11 @@ impl SensorOffsets {
             "y" => self.y,
             "p" => self.p,
             "p_hot" => self.p_hot.unwrap_or(0.0),
-            _ => 0.0,
+            other => self
+                .others
+                .iter()
+                .find(|(n, _)| n == other)
+                .map_or(0.0, |(_, v)| *v),
         }
     }
 }
@@ -44,9 +51,10 @@ pub struct Channel {
 }
 
 /// The observed channels: `x`, `y` (body positions), `p` (cold pressure), `p_hot` (hot
-/// pressure, when measured and the model has more than one control volume).
+/// pressure, when measured and the working gas has more than one control volume), then the
+/// sensors on the CVs outside the working gas.
 pub fn channels(model: &dyn Model, data: &Measured) -> Result<Vec<Channel>, FitError> {
-    let layout = StateLayout::of(model);
+    let layout = StateLayout::working_gas(model);
     let (pos, ps) = (&layout.positions, &layout.pressures);
     let (Some(x), Some(y), Some(p)) = (&data.x, &data.y, &data.p) else {
         return Err(FitError::MissingColumns {
@@ -83,6 +91,13 @@ pub fn channels(model: &dyn Model, data: &Measured) -> Result<Vec<Channel>, FitE
             name: "p_hot".into(),
             state: ps[0],
             data: ph.clone(),
+        });
+    }
+    for o in super::supported::outside_channels(model, &layout, data)? {
+        out.push(Channel {
+            name: o.name,
+            state: o.state,
+            data: o.data,
         });
     }
     Ok(out)
@@ -122,40 +137,61 @@ pub fn measured_state(
         })?;
         x[vel] = d;
     }
-    let layout = StateLayout::of(model);
+    let layout = StateLayout::working_gas(model);
     let ps = &layout.pressures;
-    let have_hot = ch.len() > 3;
+    let hot = ch.iter().find(|c| c.name == "p_hot");
+    let have_hot = hot.is_some();
     let pc = smooth(&ch[2].data, (h / 2).max(3)).0 - off.p;
-    let ph = if have_hot {
-        smooth(&ch[3].data, (h / 2).max(3)).0 - off.get("p_hot")
-    } else {
-        0.0
+    let ph = match hot {
+        Some(c) => smooth(&c.data, (h / 2).max(3)).0 - off.get("p_hot"),
+        None => 0.0,
     };
     for (i, &s) in ps.iter().enumerate() {
         let wc = cold_weight(i, ps.len(), have_hot);
         x[s] = wc * pc + (1.0 - wc) * ph;
+    }
+    for c in ch.iter().filter(|c| layout.outside.contains(&c.state)) {
+        x[c.state] = smooth(&c.data, (h / 2).max(3)).0 - off.get(&c.name);
     }
     mass_states(model, p, &layout, &eq, &mut x);
     Ok(x)
 }
 
 /// The mass states of `x` (if any): the equilibrium total shared in proportion to `p V / T`
-/// of each CV at the pressures already set in `x`.
-fn mass_states(model: &dyn Model, p: &[f64], layout: &StateLayout, eq: &[f64], x: &mut [f64]) {
-    let (ps, masses) = (&layout.pressures, &layout.masses);
-    if !masses.is_empty() {
-        let nv = model.vessel_names().len();
-        let (mut pr, mut vol) = (vec![0.0; nv], vec![0.0; nv]);
-        model.pv(p, x, &mut pr, &mut vol);
-        let mut t_rest = vec![0.0; ps.len()];
-        model.temperatures(p, eq, &mut t_rest);
-        let total: f64 = masses.iter().map(|&i| eq[i]).sum();
-        let share: Vec<f64> = (0..ps.len())
-            .map(|i| x[ps[i]] * vol[i] / t_rest[i])
-            .collect();
-        let ssum: f64 = share.iter().sum();
-        for (j, &mi) in masses.iter().enumerate() {
-            x[mi] = total * share[j] / ssum;
-        }
+/// of each linked CV at the pressures already set in `x` (a CV matched to its mass state by
+/// its vessel element, so a CV without one - outside the working gas - takes no share).
+pub(super) fn mass_states(
+    model: &dyn Model,
+    p: &[f64],
+    layout: &StateLayout,
+    eq: &[f64],
+    x: &mut [f64],
+) {
+    let masses = &layout.masses;
+    if masses.is_empty() {
+        return;
+    }
+    let states = model.states();
+    let nv = model.vessel_names().len();
+    let (mut pr, mut vol) = (vec![0.0; nv], vec![0.0; nv]);
+    model.pv(p, x, &mut pr, &mut vol);
+    let mut t_rest = vec![0.0; nv];
+    model.temperatures(p, eq, &mut t_rest);
+    let element = |i: usize| match states[i].kind {
+        StateKind::Mass(k) | StateKind::Pressure(k) => k,
+        _ => usize::MAX,
+    };
+    let pressure_of = |k: usize| layout.pressures.iter().find(|&&s| element(s) == k);
+    let total: f64 = masses.iter().map(|&i| eq[i]).sum();
+    let share: Vec<f64> = masses
+        .iter()
+        .map(|&mi| {
+            let k = element(mi);
+            pressure_of(k).map_or(0.0, |&s| x[s] * vol[k] / t_rest[k])
+        })
+        .collect();
+    let ssum: f64 = share.iter().sum();
+    for (j, &mi) in masses.iter().enumerate() {
+        x[mi] = total * share[j] / ssum;
     }
 }

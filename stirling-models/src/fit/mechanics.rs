@@ -3,7 +3,8 @@
 //! Every CV pressure the bodies feel is prescribed: the cold side from the measured `p`, the
 //! hot side from `p_hot` when it is measured (sections in between interpolated linearly), and
 //! otherwise from the measured `p` plus the pressure differences `P_i - P_cold` that the gas
-//! stage computes from the measured positions ([`super::unmeasured`]). Fitted: the free
+//! stage computes from the measured positions ([`super::unmeasured`]); a CV outside the
+//! working gas (a closed bounce space) from its own sensor. Fitted: the free
 //! mechanical parameters, the initial body states and the position offsets (which also
 //! absorb the static shift of a pressure offset).
 
@@ -31,6 +32,23 @@ pub struct MechInputs<'s> {
     /// Model pressure differences `P_i - P_cold`, one per CV (in [`StateLayout::pressures`]
     /// order), when the hot side is not measured; `None`: prescribe from the measurements.
     pub dp: Option<&'s [Signal]>,
+    /// Offsets of the measured CVs outside the working gas ([`Record::outside`] order).
+    pub out_off: &'s [f64],
+}
+
+/// The pressures of the CVs outside the working gas, prescribed from their own sensors
+/// (signals `first..`).
+fn given_outside(rec: &Record, out_off: &[f64], first: usize) -> Vec<Given> {
+    rec.outside
+        .iter()
+        .zip(out_off)
+        .enumerate()
+        .map(|(k, (o, off))| Given {
+            state: o.state,
+            terms: vec![(first + k, 1.0, false)],
+            constant: -off,
+        })
+        .collect()
 }
 
 /// The CV pressures prescribed from `p` plus the gas stage's differences `dp` (pushed onto
@@ -122,6 +140,10 @@ fn input_noise(rec: &Record) -> Vec<(usize, f64, usize)> {
     if let Some(v) = data.p_hot.as_ref().filter(|_| rec.have_hot) {
         input_noise.push((1, noise_sigma(v), hp));
     }
+    let first = input_noise.len();
+    for (k, o) in rec.outside.iter().enumerate() {
+        input_noise.push((first + k, noise_sigma(&o.raw), hp));
+    }
     input_noise
 }
 
@@ -153,11 +175,15 @@ pub fn stage<'a>(
     if have_hot {
         signals.push(rec.sig_ph.clone().expect("have_hot"));
     }
+    let first_outside = signals.len();
+    signals.extend(rec.outside.iter().map(|o| o.sig.clone()));
+    let measured = signals.len();
     let ps = &layout.pressures;
-    let given: Vec<Given> = match inp.dp {
+    let mut given: Vec<Given> = match inp.dp {
         Some(dp) => given_with_dp(ps, dp, inp.p_off, &mut signals),
         None => given_measured(ps, inp, have_hot),
     };
+    given.extend(given_outside(rec, inp.out_off, first_outside));
     let z0 = body_start(rec, inp.x_off);
     let vars = variables(model, inp, &z0, opts);
     let outputs = vec![Output::new("x", 0, xm, 1e-9), Output::new("y", 2, ym, 1e-9)];
@@ -165,7 +191,6 @@ pub fn stage<'a>(
     let f0 = training_frequency(xm, ym, tr, dt);
     let mut base = vec![0.0; model.n_states()];
     model.equilibrium_guess(inp.p, &mut base);
-    let measured = if have_hot { 2 } else { 1 };
     Ok(Stage {
         drift: drift_count(tr.1 - tr.0 + 1, dt, opts.drift_cut * f0),
         input_noise: input_noise(rec),

@@ -35,6 +35,19 @@ pub struct Record<'a> {
     pub x_off0: [f64; 2],
     pub p_off0: f64,
     pub ph_off0: f64,
+    /// The measured CVs outside the working gas (a closed bounce space), in layout order.
+    pub outside: Vec<Outside>,
+}
+
+/// A measured CV outside the working gas: its channel, smoothed like `p`, and the first
+/// guess of its offset (whole-cycle mean minus the CV's pressure at rest).
+pub struct Outside {
+    pub name: String,
+    /// The CV's pressure state.
+    pub state: usize,
+    pub raw: Vec<f64>,
+    pub sig: Signal,
+    pub off0: f64,
 }
 
 impl<'a> Record<'a> {
@@ -73,6 +86,16 @@ impl<'a> Record<'a> {
         let pmean = ps.first().map(|&i| eq[i]).unwrap_or(0.0);
         let mean_of = |v: Option<&Vec<f64>>, base: f64| v.map(|v| cycle_mean(v) - base);
         let smooth = |v: &Vec<f64>| signal(t0, dt, v, (h / 2).max(3));
+        let outside = super::supported::outside_channels(model, layout, data)?
+            .into_iter()
+            .map(|c| Outside {
+                sig: smooth(&c.data),
+                off0: cycle_mean(&c.data) - eq[c.state],
+                name: c.name,
+                state: c.state,
+                raw: c.data,
+            })
+            .collect();
         Ok(Self {
             data,
             t0,
@@ -96,6 +119,7 @@ impl<'a> Record<'a> {
             ],
             p_off0: mean_of(data.p.as_ref(), pmean).unwrap_or(0.0),
             ph_off0: mean_of(data.p_hot.as_ref(), pmean).unwrap_or(0.0),
+            outside,
         })
     }
 }

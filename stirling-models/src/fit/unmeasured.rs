@@ -48,7 +48,7 @@ pub fn difference_sensitivity(
     var: usize,
     first: usize,
 ) -> Result<Vec<Signal>, FitError> {
-    let layout = StateLayout::of(gas.model);
+    let layout = StateLayout::working_gas(gas.model);
     let last = gas.outputs[0].data.len() - 1;
     let run = pressure_run(gas, u, &layout, first, last, true)?;
     let cold = run.yhat.len() - 1;
@@ -69,7 +69,7 @@ pub fn differences_at(
     first: usize,
     last: usize,
 ) -> Result<(Vec<Signal>, Vec<Vec<Signal>>), FitError> {
-    let layout = StateLayout::of(gas.model);
+    let layout = StateLayout::working_gas(gas.model);
     let run = pressure_run(gas, u, &layout, first, last, !vars.is_empty())?;
     let cold = run.yhat.len() - 1;
     let mut dp = signals(gas, cold, first, last, |i, k| {
@@ -149,7 +149,7 @@ fn signals(
 
 /// Covariance of stage 1's scaled variables carried in from stage 2's: stage 1 (`mech`, at
 /// its optimum `u1` with Jacobian `j1`) reads the pressure differences of stage 2 (`gas` at
-/// `u2`, statistics `stats2`) through its signals `1..`.
+/// `u2`, statistics `stats2`) through its derived signals (after the measured ones).
 pub fn carried_covariance(
     mech: &Stage,
     u1: &[f64],
@@ -170,7 +170,8 @@ pub fn carried_covariance(
         let dp = pressure_differences(gas, u2, layout, rec)?;
         let mut st = mech.clone();
         let cold = dp.len() - 1;
-        st.signals.truncate(1);
+        let measured = mech.derived.first().copied().unwrap_or(mech.signals.len());
+        st.signals.truncate(measured);
         st.signals.extend(dp.into_iter().take(cold));
         let mut r = st.weighted_residuals(u1, first, last, keep)?;
         r.resize(j1.nrows(), 0.0);

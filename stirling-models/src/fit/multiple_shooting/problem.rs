@@ -194,7 +194,10 @@ impl Problem<'_> {
                 "y" => offsets.y = v,
                 "p" => offsets.p = v,
                 "p_hot" => offsets.p_hot = Some(v),
-                _ => {}
+                other => match offsets.others.iter_mut().find(|(n, _)| n == other) {
+                    Some(slot) => slot.1 = v,
+                    None => offsets.others.push((other.to_string(), v)),
+                },
             }
         }
         offsets
