@@ -29,9 +29,9 @@ use stirling::stirling_model;
 
 stirling_model! {
     /// Default engine with a closed, heat-exchanging bounce space and a linear alternator:
-    /// the family's `nsection` engine (`stirling::models::nsection_engine`) extended.
-    pub model AlternatorEngine extends stirling::models::nsection_engine {
-        name "alternator_engine";
+    /// the family's `nsection` engine (`stirling::models::nsection_engine`) extended. A base
+    /// (`alternator_engine!`), so that the engine and its augmented member below share it.
+    base alternator_engine extends stirling::models::nsection_engine {
         params {
             /// bounce-space volume at rest (closed crankcase)
             Vb0: 2.0e-3 "m^3",
@@ -62,6 +62,33 @@ stirling_model! {
         }
         // a transducer in the bounce space, besides the family's `p`, `p_hot`, `x`, `y`
         sensor p_bounce: P_bounce "Pa";
+    }
+}
+
+stirling_model! {
+    /// The alternator engine (`alternator_engine`).
+    pub model AlternatorEngine extends alternator_engine {
+        name "alternator_engine";
+    }
+}
+
+stirling_model! {
+    /// The alternator engine with Coulomb friction on both bodies, `-Fc tanh(v / v_eps)`, at
+    /// its null (`Fcd = Fcp = 0`): the augmented member the diagnosis tests the effect with.
+    /// The parameter names are the effect library's (`coulomb`: `Fcd`, `Fcp`, `v_eps`), so
+    /// the diagnosis offers that candidate for this model.
+    pub model AlternatorFx extends alternator_engine {
+        name "alternator_engine_fx";
+        params {
+            /// displacer Coulomb friction force (0: none)
+            Fcd: 0.0 "N",
+            /// power-piston Coulomb friction force (0: none)
+            Fcp: 0.0 "N",
+            /// velocity scale of the smoothed Coulomb friction
+            v_eps: 1.0e-3 "m/s",
+        }
+        modify body displacer { force: -Fcd * tanh(v / v_eps) }
+        modify body piston { force: -c_alt * w - Fcp * tanh(w / v_eps) }
     }
 }
 

@@ -11,8 +11,19 @@ pub(super) fn candidates(
     names: &Option<Vec<String>>,
 ) -> Result<Vec<&'static EffectInfo>, DiagnoseError> {
     let base = model.name().trim_end_matches("_fx").to_string();
+    // a model outside the library (a user's augmented engine) carries an effect when it
+    // declares every parameter of it; the sensor effects act on the records of any model
+    let declared = |e: &EffectInfo| {
+        e.target == effects::EffectTarget::Sensor
+            || e.params.iter().all(|q| model.param_index(q.name).is_some())
+    };
+    let library = effects::in_library(&base);
     let Some(names) = names else {
-        return Ok(effects::effects_for(&base));
+        return Ok(if library {
+            effects::effects_for(&base)
+        } else {
+            effects::EFFECTS.iter().filter(|e| declared(e)).collect()
+        });
     };
     let mut v = Vec::new();
     for n in names {
@@ -24,7 +35,12 @@ pub(super) fn candidates(
                 .collect::<Vec<_>>()
                 .join(", "),
         })?;
-        if !e.applies_to.contains(&base.as_str()) {
+        let applies = if library {
+            e.applies_to.contains(&base.as_str())
+        } else {
+            declared(e)
+        };
+        if !applies {
             return Err(DiagnoseError::NotApplicable {
                 effect: n.clone(),
                 model: base.clone(),

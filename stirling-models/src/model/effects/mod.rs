@@ -209,6 +209,12 @@ pub fn effects_for(base: &str) -> Vec<&'static EffectInfo> {
         .collect()
 }
 
+/// Whether `base` is one of the library's base models (or an alias): its effects are the
+/// library's list; any other model carries the effects whose parameters it declares.
+pub fn in_library(base: &str) -> bool {
+    canonical(base).is_some()
+}
+
 /// Canonical base name and the `n` an alias fixes.
 fn canonical(name: &str) -> Option<(&'static str, Option<usize>)> {
     match name {
