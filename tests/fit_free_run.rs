@@ -236,6 +236,7 @@ fn nsection_free_run_at_truth() {
         y: -2e-3,
         p: 300.0,
         p_hot: Some(300.0),
+        ..Default::default()
     };
     let fr = free_run::free_run(
         model.as_ref(),
