@@ -574,3 +574,66 @@ fn the_diagnosis_names_withheld_piston_friction_and_passes_a_clean_record() {
         d.verdict.reason
     );
 }
+
+/// The command line serves the engine once a binary registers it (as a user's crate would:
+/// `user_models::register`, then `stirling_cli::main()`): `stirling models` lists it,
+/// `stirling fit` fits it from a CSV of its own sensors and `stirling diagnose` (with its
+/// augmented member) reports the withheld piston friction in report.md.
+#[test]
+fn the_command_line_fits_and_diagnoses_the_registered_engine() {
+    use stirling::models::data::write_csv;
+    use stirling::models::user_models::{register, UserModel};
+    register(UserModel {
+        name: "alternator_engine",
+        summary: "closed bounce space, linear alternator (examples/custom_topology.rs)",
+        has_array: true,
+        build: |n, c| Ok(Box::new(AlternatorEngine::new(n, c)?)),
+        augmented: Some(|n, c| Ok(Box::new(ex::AlternatorFx::new(n, c)?))),
+    })
+    .expect("registered");
+    let dir = std::env::temp_dir().join(format!("stirling_cli_user_{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let csv = dir.join("alternator.csv");
+    write_csv(&csv, &fx_record(0.5).2, &[]).unwrap();
+    let run = |args: &[&str]| {
+        stirling_cli::run_args(std::iter::once("stirling").chain(args.iter().copied()))
+    };
+    run(&["models"]).expect("models");
+    let plot = dir.join("fit.svg");
+    let (c, p) = (csv.to_str().unwrap(), plot.to_str().unwrap());
+    run(&[
+        "fit",
+        "alternator_engine",
+        "--n",
+        "2",
+        "--data",
+        c,
+        "--plot",
+        p,
+        "--force",
+    ])
+    .expect("fit");
+    assert!(
+        std::fs::metadata(&plot).unwrap().len() > 1000,
+        "fit figure written"
+    );
+    let report = dir.join("report");
+    let r = report.to_str().unwrap();
+    let args = ["diagnose", "alternator_engine", "--n", "2", "--data", c];
+    let opts = [
+        "--effects",
+        "coulomb,sensor_lag",
+        "--fit-all",
+        "--report",
+        r,
+        "--force",
+    ];
+    run(&[&args[..], &opts[..]].concat()).expect("diagnose");
+    let md = std::fs::read_to_string(report.join("report.md")).unwrap();
+    assert!(md.contains("verdict: effect `coulomb`"), "{md}");
+    // a name nobody registered lists the registered ones
+    let err = run(&["fit", "alternator", "--data", c])
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("registered model: alternator_engine"), "{err}");
+}

@@ -19,3 +19,5 @@ pub mod outside;
 pub mod params;
 /// The family by name, as the command line uses it.
 pub mod registry;
+/// Models a user's crate registers, served by name like the family.
+pub mod user_models;

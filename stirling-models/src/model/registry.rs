@@ -28,9 +28,12 @@ pub const FAMILY: &[ModelEntry] = &[
 #[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
 pub enum RegistryError {
     #[error(
-        "unknown model `{0}`: expected one of schmidt, cv1, cv2, nsection (aliases order4..order8)"
+        "unknown model `{0}`: expected one of schmidt, cv1, cv2, nsection (aliases order4..order8){more}",
+        more = registered_list()
     )]
     UnknownModel(String),
+    #[error("model `{model}`: {why}")]
+    User { model: String, why: String },
     #[error("model `{model}` has no regenerator sections: --n {n} does not apply (omit --n)")]
     NotAnArray { model: String, n: usize },
     #[error("--n must be at least 1, found {0}")]
@@ -93,7 +96,43 @@ pub fn build(
             let n = n.or(fixed_n).unwrap_or(1);
             Box::new(NSection::new(n, closure).map_err(|_| RegistryError::ZeroSections(n))?)
         }
-        _ => return Err(RegistryError::UnknownModel(name.to_string())),
+        _ => return user_model(name, n, closure),
     };
     Ok(boxed)
+}
+
+/// A registered user model ([`crate::model::user_models`]).
+fn user_model(
+    name: &str,
+    n: Option<usize>,
+    closure: Closure,
+) -> Result<Box<dyn Model>, RegistryError> {
+    let Some(u) = crate::model::user_models::find(name) else {
+        return Err(RegistryError::UnknownModel(name.to_string()));
+    };
+    if let (false, Some(k)) = (u.has_array, n) {
+        if k != 1 {
+            return Err(RegistryError::NotAnArray {
+                model: name.to_string(),
+                n: k,
+            });
+        }
+    }
+    (u.build)(n.unwrap_or(1), closure).map_err(|e| RegistryError::User {
+        model: name.to_string(),
+        why: e.to_string(),
+    })
+}
+
+/// `, or a registered model: a, b` (empty when none is registered).
+fn registered_list() -> String {
+    let names: Vec<&str> = crate::model::user_models::registered()
+        .iter()
+        .map(|u| u.name)
+        .collect();
+    if names.is_empty() {
+        String::new()
+    } else {
+        format!(", or a registered model: {}", names.join(", "))
+    }
 }

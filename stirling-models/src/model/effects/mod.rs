@@ -174,7 +174,7 @@ pub enum EffectError {
         model: String,
         applies: String,
     },
-    #[error("model `{0}` has no augmented member: effects are declared for cv1, nsection and nsection_ext (aliases order5, order7, order8)")]
+    #[error("model `{0}` has no augmented member: effects are declared for cv1, nsection and nsection_ext (aliases order5, order7, order8), and for a registered model that names one")]
     NoAugmented(String),
     #[error("effect parameter `{name}` = {value} is not physical: it must be {range}")]
     OutOfRange {
@@ -234,6 +234,12 @@ pub fn augmented(
     n: Option<usize>,
     closure: Closure,
 ) -> Result<Box<dyn Model>, EffectError> {
+    if let Some(u) = crate::model::user_models::find(base) {
+        let build = u
+            .augmented
+            .ok_or_else(|| EffectError::NoAugmented(base.to_string()))?;
+        return build(n.unwrap_or(1), closure).map_err(|e| EffectError::Model(e.to_string()));
+    }
     let (b, fixed) = canonical(base).ok_or_else(|| EffectError::NoAugmented(base.to_string()))?;
     // reuse the registry's checks of n and aliases
     let family = if b == "nsection_ext" {

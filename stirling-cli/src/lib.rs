@@ -1,0 +1,93 @@
+//! `stirling`: the command line of the framework (the library `stirling_cli`; a user's crate
+//! that registers its own engines runs the same command line from its own binary).
+
+mod cmd_diagnose;
+mod cmd_fit;
+mod cmd_info;
+mod cmd_linearize;
+mod cmd_locus;
+mod cmd_models;
+mod cmd_rig;
+mod cmd_simulate;
+mod cmd_sweep;
+mod common;
+
+use clap::{Parser, Subcommand};
+
+/// Energetic, symbolic modeling of free-piston Stirling engines.
+#[derive(Parser, Debug)]
+#[command(name = "stirling", version, about, long_about = None)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand, Debug)]
+enum Command {
+    /// List the model family and its aliases
+    Models {
+        /// Machine-readable output
+        #[arg(long)]
+        json: bool,
+    },
+    /// Sim-to-real gap diagnosis: where the gap lies, which omitted effect, how far it closes
+    Diagnose(cmd_diagnose::DiagnoseArgs),
+    /// Virtual test rig: truth model plus effects, noise and offsets -> measured CSV + truth sidecar
+    Rig(cmd_rig::RigArgs),
+    /// Two-stage identification from measured data (mechanics, then gas), with intervals and fit %
+    Fit(cmd_fit::FitArgs),
+    /// Equilibrium, poles, the loop broken at a pressure force, gain and phase margins
+    Linearize(cmd_linearize::LinearizeArgs),
+    /// Root locus: the poles over a parameter range
+    Locus(cmd_locus::LocusArgs),
+    /// Simulate a model (stiff BDF); --limit-cycle refines the periodic orbit by shooting
+    Simulate(cmd_simulate::SimulateArgs),
+    /// States, parameters and generated equations of a model, or its bond graph (--graph)
+    Info(cmd_info::InfoArgs),
+    /// Design sweep over a parameter grid: poles, whether the engine runs, its cycle and power
+    Sweep(cmd_sweep::SweepArgs),
+    /// Join the sweep.json files of `stirling sweep --shard` slices into one sweep
+    SweepMerge(cmd_sweep::MergeArgs),
+}
+
+/// Run the command line on the process's arguments and exit with its status (0: done, 2: an
+/// error, printed). A user's binary registers its engines first
+/// (`stirling_models::user_models::register`), then calls this: `stirling fit`, `diagnose`,
+/// `info`, `linearize`, `simulate` ... then take their names.
+pub fn main() {
+    let cli = Cli::parse();
+    if let Err(e) = dispatch(cli.command) {
+        // a reader that stopped early (`| head`) is the end of the output, not an error
+        if common::is_stdout_closed(&e) {
+            std::process::exit(0);
+        }
+        common::note(format_args!("error: {e:#}"));
+        std::process::exit(2);
+    }
+}
+
+/// Run one command from `args` (the first is the program name) without exiting: for a user's
+/// binary or a test that drives the command line in-process. A malformed command line is an
+/// error here too (clap's message, `--help` included).
+pub fn run_args<I, T>(args: I) -> anyhow::Result<()>
+where
+    I: IntoIterator<Item = T>,
+    T: Into<std::ffi::OsString> + Clone,
+{
+    dispatch(Cli::try_parse_from(args)?.command)
+}
+
+fn dispatch(command: Command) -> anyhow::Result<()> {
+    match command {
+        Command::Models { json } => cmd_models::run(json),
+        Command::Diagnose(a) => cmd_diagnose::run(&a),
+        Command::Rig(a) => cmd_rig::run(&a),
+        Command::Fit(a) => cmd_fit::run(&a),
+        Command::Linearize(a) => cmd_linearize::run(&a),
+        Command::Locus(a) => cmd_locus::run(&a),
+        Command::Simulate(a) => cmd_simulate::run(&a),
+        Command::Info(a) => cmd_info::run(&a),
+        Command::Sweep(a) => cmd_sweep::run(&a),
+        Command::SweepMerge(a) => cmd_sweep::merge(&a),
+    }
+}
