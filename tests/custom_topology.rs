@@ -577,11 +577,11 @@ fn the_diagnosis_names_withheld_piston_friction_and_passes_a_clean_record() {
 
 /// The command line serves the engine once a binary registers it (as a user's crate would:
 /// `user_models::register`, then `stirling_cli::main()`): `stirling models` lists it,
-/// `stirling fit` fits it from a CSV of its own sensors and `stirling diagnose` (with its
-/// augmented member) reports the withheld piston friction in report.md.
+/// `stirling rig` measures it with its declared sensors and an effect its augmented member
+/// declares, `stirling fit` fits it from that CSV and `stirling diagnose` reports the
+/// withheld piston friction in report.md.
 #[test]
 fn the_command_line_fits_and_diagnoses_the_registered_engine() {
-    use stirling::models::data::write_csv;
     use stirling::models::user_models::{register, UserModel};
     register(UserModel {
         name: "alternator_engine",
@@ -594,11 +594,46 @@ fn the_command_line_fits_and_diagnoses_the_registered_engine() {
     let dir = std::env::temp_dir().join(format!("stirling_cli_user_{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let csv = dir.join("alternator.csv");
-    write_csv(&csv, &fx_record(0.5).2, &[]).unwrap();
     let run = |args: &[&str]| {
         stirling_cli::run_args(std::iter::once("stirling").chain(args.iter().copied()))
     };
     run(&["models"]).expect("models");
+    // the rig measures it with its declared sensors and the friction the member declares
+    let rig = [
+        "rig",
+        "alternator_engine",
+        "--n",
+        "2",
+        "--effect",
+        "Fcp=0.5",
+        "--t-end",
+        "2",
+    ];
+    let chans = [
+        "--rate",
+        "1000",
+        "--seed",
+        "5",
+        "--channels",
+        "p,x,y,p_bounce",
+        "--force",
+    ];
+    let out = ["--out", csv.to_str().unwrap()];
+    run(&[&rig[..], &chans[..], &out[..]].concat()).expect("rig");
+    let rec = stirling::models::data::read_csv(&csv).unwrap();
+    assert_eq!(rec.channels(), ["p", "x", "y", "p_bounce"]);
+    // the record the library's rig gives with the same settings and seed
+    let lib = fx_record(0.5).2;
+    let (a, b) = (
+        rec.channel("p_bounce").unwrap(),
+        lib.channel("p_bounce").unwrap(),
+    );
+    assert!(
+        (a[500] - b[500]).abs() < 1e-6 * b[500],
+        "{} {}",
+        a[500],
+        b[500]
+    );
     let plot = dir.join("fit.svg");
     let (c, p) = (csv.to_str().unwrap(), plot.to_str().unwrap());
     run(&[
@@ -630,7 +665,7 @@ fn the_command_line_fits_and_diagnoses_the_registered_engine() {
     ];
     run(&[&args[..], &opts[..]].concat()).expect("diagnose");
     let md = std::fs::read_to_string(report.join("report.md")).unwrap();
-    assert!(md.contains("verdict: effect `coulomb`"), "{md}");
+    assert!(md.contains("**Verdict: effect (`coulomb`)**"), "{md}");
     // a name nobody registered lists the registered ones
     let err = run(&["fit", "alternator", "--data", c])
         .unwrap_err()

@@ -13,17 +13,9 @@ pub(super) fn candidates(
     let base = model.name().trim_end_matches("_fx").to_string();
     // a model outside the library (a user's augmented engine) carries an effect when it
     // declares every parameter of it; the sensor effects act on the records of any model
-    let declared = |e: &EffectInfo| {
-        e.target == effects::EffectTarget::Sensor
-            || e.params.iter().all(|q| model.param_index(q.name).is_some())
-    };
-    let library = effects::in_library(&base);
+    let applies = |e: &EffectInfo| effects::applies(e, &base, Some(model));
     let Some(names) = names else {
-        return Ok(if library {
-            effects::effects_for(&base)
-        } else {
-            effects::EFFECTS.iter().filter(|e| declared(e)).collect()
-        });
+        return Ok(effects::EFFECTS.iter().filter(|e| applies(e)).collect());
     };
     let mut v = Vec::new();
     for n in names {
@@ -35,12 +27,7 @@ pub(super) fn candidates(
                 .collect::<Vec<_>>()
                 .join(", "),
         })?;
-        let applies = if library {
-            e.applies_to.contains(&base.as_str())
-        } else {
-            declared(e)
-        };
-        if !applies {
+        if !applies(e) {
             return Err(DiagnoseError::NotApplicable {
                 effect: n.clone(),
                 model: base.clone(),

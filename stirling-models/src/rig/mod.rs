@@ -168,7 +168,7 @@ fn engine(cfg: &RigConfig) -> Result<(Box<dyn Model>, EffectSettings, Vec<f64>),
         Some(t) => outside_engine(cfg, t)?,
         None => augmented(&cfg.model, cfg.n, Closure::Full)?,
     };
-    let fx = EffectSettings::parse(&cfg.model, &cfg.effects)?;
+    let fx = EffectSettings::parse_for(&cfg.model, Some(model.as_ref()), &cfg.effects)?;
     let mut p = crate::params::load(model.as_ref(), cfg.params.as_deref(), &cfg.set)?;
     fx.apply(model.as_ref(), &mut p)?;
     Ok((model, fx, p))
@@ -274,7 +274,10 @@ fn truth(cfg: &RigConfig, model: &dyn Model, p: &[f64], fx: EffectSettings) -> T
 /// Run the rig.
 pub fn run(cfg: &RigConfig) -> Result<RigOutput, RigError> {
     validate(cfg)?;
-    check_seed_channels(&cfg.channels)?;
+    // a registered model's rig reads its declared sensors; the family's, the seed's four
+    if crate::model::user_models::find(&cfg.model).is_none() {
+        check_seed_channels(&cfg.channels)?;
+    }
     let (model, fx, p) = engine(cfg)?;
     let data = record(model.as_ref(), &p, &fx, cfg)?;
     let truth = truth(cfg, model.as_ref(), &p, fx);

@@ -209,6 +209,19 @@ pub fn effects_for(base: &str) -> Vec<&'static EffectInfo> {
         .collect()
 }
 
+/// Whether effect `e` applies to `base`: the library's list for a library base; for any other
+/// model, a sensor effect always and a model effect when `model` (its augmented member)
+/// declares every parameter of it.
+pub fn applies(e: &EffectInfo, base: &str, model: Option<&dyn Model>) -> bool {
+    match canonical(base) {
+        Some((b, _)) => e.applies_to.contains(&b),
+        None => {
+            e.target == EffectTarget::Sensor
+                || model.is_some_and(|m| e.params.iter().all(|q| m.param_index(q.name).is_some()))
+        }
+    }
+}
+
 /// Whether `base` is one of the library's base models (or an alias): its effects are the
 /// library's list; any other model carries the effects whose parameters it declares.
 pub fn in_library(base: &str) -> bool {
@@ -235,9 +248,8 @@ pub fn augmented(
     closure: Closure,
 ) -> Result<Box<dyn Model>, EffectError> {
     if let Some(u) = crate::model::user_models::find(base) {
-        let build = u
-            .augmented
-            .ok_or_else(|| EffectError::NoAugmented(base.to_string()))?;
+        // a model registered without an augmented member carries no model effect
+        let build = u.augmented.unwrap_or(u.build);
         return build(n.unwrap_or(1), closure).map_err(|e| EffectError::Model(e.to_string()));
     }
     let (b, fixed) = canonical(base).ok_or_else(|| EffectError::NoAugmented(base.to_string()))?;
@@ -304,7 +316,17 @@ impl EffectSettings {
     /// Parse `NAME=VALUE` settings: `NAME` is an effect (sets its strength parameter) or an
     /// effect parameter; checks that the effect applies to `base`.
     pub fn parse(base: &str, settings: &[String]) -> Result<Self, EffectError> {
-        let base_c = canonical(base).map(|(b, _)| b).unwrap_or(base);
+        Self::parse_for(base, None, settings)
+    }
+
+    /// [`EffectSettings::parse`] for the augmented member `model` of `base`: a base outside
+    /// the library (a registered user model) carries the effects whose parameters `model`
+    /// declares ([`applies`]).
+    pub fn parse_for(
+        base: &str,
+        model: Option<&dyn Model>,
+        settings: &[String],
+    ) -> Result<Self, EffectError> {
         let mut out = EffectSettings::default();
         for s in settings {
             let (k, v) = s
@@ -329,7 +351,7 @@ impl EffectSettings {
                     EffectError::Unknown(k.to_string(), names.join(", "))
                 })?,
             };
-            if !e.applies_to.contains(&base_c) {
+            if !applies(e, base, model) {
                 return Err(EffectError::NotApplicable {
                     effect: e.name.into(),
                     model: base.into(),
