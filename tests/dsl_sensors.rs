@@ -14,6 +14,7 @@ stirling_model! {
         remove sensor p_hot;
         sensor p_r2: P_regen[2];
         sensor v: v;
+        replace free kd, hr;
     }
 }
 
@@ -108,4 +109,21 @@ fn identification_refuses_a_seed_channel_declared_elsewhere() {
             assert!(check_sensors(family.as_ref()).is_ok(), "{}", entry.name);
         }
     }
+}
+
+/// `free a, b;` declares what a fit frees by default: the family's is the seed's list (the
+/// parameters a member's equations lack, like `Rf` in `cv1`, are left out by the fit), a
+/// derived model replaces it.
+#[test]
+fn the_free_parameters_come_from_the_declaration() {
+    use stirling::models::fit::classify::default_free;
+    let ns = NSection::new(2, Closure::Full).unwrap();
+    let seed = ["kd", "kp", "bd", "bp", "hh", "hk", "Rf"];
+    assert_eq!(ns.declared_free(), seed);
+    assert_eq!(default_free(&ns, &ns.default_params()), seed);
+    let cv1 = Cv1::new(1, Closure::Full).unwrap();
+    assert_eq!(default_free(&cv1, &cv1.default_params()), &seed[..6]);
+    let m = Probed::new(3, Closure::Full).unwrap();
+    assert_eq!(m.declared_free(), ["kd", "hr"]);
+    assert_eq!(default_free(&m, &m.default_params()), ["kd", "hr"]);
 }

@@ -29,6 +29,7 @@
 //!     link matrix[j] -> shell for j in 0..n { conductance: Gms / n } // every section to one wall
 //!     sensor p: P_cold "Pa";       // a measured channel: a CSV column named `p` observes state `P_cold`
 //!     sensor T3: Tw_matrix[3] "K"; // an element of an array (checked against `n` at run time)
+//!     free kd, kp, hh;             // the parameters a fit frees by default
 //! }
 //! ```
 
@@ -182,6 +183,8 @@ pub enum Item {
     Link(LinkAst),
     /// A measured channel: a CSV column observing one state.
     Sensor(SensorAst),
+    /// `free a, b, c;`: the parameters a fit frees by default.
+    Free(Span, Vec<Ident>),
 }
 
 /// `sensor name: STATE "unit";` or `sensor name: STATE[k] "unit";` (unit optional: the
@@ -289,10 +292,15 @@ pub(crate) fn item(input: ParseStream) -> syn::Result<Item> {
         "wall" => Item::Wall(vessel(input)?),
         "link" => link(input, kw.span())?,
         "sensor" => Item::Sensor(sensor(input)?),
+        "free" => {
+            let names = Punctuated::<Ident, Token![,]>::parse_separated_nonempty(input)?;
+            input.parse::<Token![;]>()?;
+            Item::Free(kw.span(), names.into_iter().collect())
+        }
         other => {
             return Err(syn::Error::new(
                 kw.span(),
-                format!("unknown item `{other}`: expected one of name, params, let, gas, body, coupling, space, cv, wall, link, sensor"),
+                format!("unknown item `{other}`: expected one of name, params, let, gas, body, coupling, space, cv, wall, link, sensor, free"),
             ))
         }
     };

@@ -154,6 +154,7 @@ impl Lower {
                 Item::Wall(v) => self.wall(v),
                 Item::Link(l) => self.link(l),
                 Item::Name(_) | Item::Params(_) | Item::Sensor(_) => {}
+                Item::Free(_, names) => self.free(names),
             }
         }
         for it in &ast.items {
@@ -225,6 +226,10 @@ impl Lower {
 
     pub(crate) fn cvs_len(&self) -> usize {
         self.cv_arrays.len()
+    }
+
+    pub(crate) fn is_param(&self, name: &str) -> bool {
+        self.params.contains_key(name)
     }
 
     pub(crate) fn is_param_or_let(&self, name: &str) -> bool {

@@ -180,6 +180,7 @@ fn model_impl(topo: &Topology, spec: &ModelSpec, st: &Statics) -> TokenStream {
     let has_array = topo.has_array();
     let (sf, sz) = (&st.states[0], &st.states[1]);
     let vn = &st.vessel_names;
+    let free = &topo.free;
     let [ft, fl] = &st.texts[0];
     let [zt, zl] = &st.texts[1];
     let call = |what: &str, args: TokenStream| {
@@ -283,6 +284,7 @@ fn model_impl(topo: &Topology, spec: &ModelSpec, st: &Statics) -> TokenStream {
             }
             fn topology(&self) -> &'static #krate::TopologyInfo { &Self::TOPOLOGY }
             fn sensors(&self) -> &'static [#krate::SensorInfo] { Self::SENSORS }
+            fn declared_free(&self) -> &'static [&'static str] { &[#(#free),*] }
         }
     }
 }

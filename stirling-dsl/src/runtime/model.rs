@@ -163,6 +163,11 @@ pub trait Model: Send + Sync {
     fn sensors(&self) -> &'static [SensorInfo] {
         &[]
     }
+    /// The parameters a fit frees by default (`free a, b;`), in declaration order; none by
+    /// default.
+    fn declared_free(&self) -> &'static [&'static str] {
+        &[]
+    }
 
     /// Default parameter values.
     fn default_params(&self) -> Vec<f64> {

@@ -223,6 +223,8 @@ pub struct Topology {
     pub walls: Vec<WallDecl>,
     pub conductions: Vec<ConductionDecl>,
     pub sensors: Vec<SensorDecl>,
+    /// The parameters a fit frees by default (`free a, b;`).
+    pub free: Vec<String>,
 }
 
 impl Topology {

@@ -9,6 +9,20 @@ use super::Lower;
 use crate::ast::SensorAst;
 
 impl Lower {
+    /// `free a, b;`: each a declared parameter, once.
+    pub(super) fn free(&mut self, names: &[syn::Ident]) {
+        for id in names {
+            let name = id.to_string();
+            if !self.is_param(&name) {
+                self.cx.error(id.span(), format!("`free {name}`: no parameter `{name}`; `free` lists the parameters a fit frees by default"));
+            } else if self.topo.free.contains(&name) {
+                self.cx.error(id.span(), format!("`free`: `{name}` twice"));
+            } else {
+                self.topo.free.push(name);
+            }
+        }
+    }
+
     pub(super) fn sensor(&mut self, s: &SensorAst) {
         let name = s.name.to_string();
         if name == "t" {

@@ -45,6 +45,7 @@ pub(super) fn entry(input: ParseStream) -> syn::Result<Entry> {
         }
         Item::Link(l) => (link_key(&l.from, &l.to), l.from.name.span()),
         Item::Sensor(s) => (Key::Sensor(s.name.to_string()), s.name.span()),
+        Item::Free(span, _) => (Key::Free, *span),
     };
     Ok(Entry::Item(Chunk { key, span, tokens }))
 }

@@ -19,6 +19,7 @@ pub(super) enum Key {
     Link(String, String),
     Param(String),
     Sensor(String),
+    Free,
 }
 
 impl Key {
@@ -33,6 +34,7 @@ impl Key {
             Key::Link(a, b) => format!("link `{a} -> {b}`"),
             Key::Param(n) => format!("parameter `{n}`"),
             Key::Sensor(n) => format!("sensor `{n}`"),
+            Key::Free => "`free`".into(),
         }
     }
 
@@ -41,6 +43,7 @@ impl Key {
         match self {
             Key::Name => "name".into(),
             Key::Gas => "gas".into(),
+            Key::Free => "free".into(),
             Key::Let(n) | Key::Body(n) | Key::Vessel(n) | Key::Param(n) | Key::Sensor(n) => {
                 format!("`{n}`")
             }
@@ -74,6 +77,7 @@ impl Key {
             Key::Link(a, b) => format!("link {a} -> {b}"),
             Key::Param(n) => format!("param {n}"),
             Key::Sensor(n) => format!("sensor {n}"),
+            Key::Free => "free".into(),
         }
     }
 }

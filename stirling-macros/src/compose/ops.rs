@@ -37,7 +37,7 @@ pub(super) fn op(input: ParseStream) -> syn::Result<Op> {
         let (key, span) = target(input, "modify")?;
         if matches!(
             key,
-            Key::Param(_) | Key::Let(_) | Key::Name | Key::Sensor(_)
+            Key::Param(_) | Key::Let(_) | Key::Name | Key::Sensor(_) | Key::Free
         ) {
             return Err(syn::Error::new(
                 span,
@@ -70,6 +70,7 @@ pub(super) fn target(input: ParseStream, verb: &str) -> syn::Result<(Key, Span)>
             (Key::Param(n.to_string()), n.span())
         }
         "gas" => (Key::Gas, kw.span()),
+        "free" => (Key::Free, kw.span()),
         "body" => {
             let n = named(input)?;
             (Key::Body(n.to_string()), n.span())
@@ -97,7 +98,7 @@ pub(super) fn target(input: ParseStream, verb: &str) -> syn::Result<(Key, Span)>
         other => {
             return Err(syn::Error::new(
                 kw.span(),
-                format!("`{verb} {other}`: expected one of param, let, gas, body, coupling, space, cv, wall, link, sensor"),
+                format!("`{verb} {other}`: expected one of param, let, gas, body, coupling, space, cv, wall, link, sensor, free"),
             ))
         }
     })

@@ -62,9 +62,19 @@ pub fn classify(
     Ok((mech, gas))
 }
 
-/// Default free parameters that the model uses.
+/// The seed's free parameters, for a model that declares none (`free a, b;`).
+const SEED_FREE: [&str; 7] = ["kd", "kp", "bd", "bp", "hh", "hk", "Rf"];
+
+/// Default free parameters: those the model declares free (`free a, b;`), else the seed's
+/// names it has; either way only those that enter its equations.
 pub fn default_free(model: &dyn Model, p: &[f64]) -> Vec<String> {
-    ["kd", "kp", "bd", "bp", "hh", "hk", "Rf"]
+    let declared = model.declared_free();
+    let names: &[&str] = if declared.is_empty() {
+        &SEED_FREE
+    } else {
+        declared
+    };
+    names
         .iter()
         .map(|s| s.to_string())
         .filter(|s| classify(model, p, std::slice::from_ref(s)).is_ok())

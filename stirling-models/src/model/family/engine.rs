@@ -74,6 +74,9 @@ stirling_macros::stirling_model! {
         body piston(y, w) { mass: mp, spring: kp, damper: bp, quad_damper: bqp }
         coupling displacer, piston { damper: b }
         space bounce { pressure: Pb, faces { displacer: Ar, piston: A - Ar } }
+        // the parameters the seed identifies: a fit frees these by default (those that enter
+        // a member's equations: `cv1` has no `Rf`)
+        free kd, kp, bd, bp, hh, hk, Rf;
         // the seed's position sensors (a member adds its pressure sensors)
         sensor x: x "m";
         sensor y: y "m";
