@@ -95,11 +95,7 @@ fn one(seed: u64, a: &Args) -> Result<Outcome, String> {
     let mut per = Vec::new();
     for name in FREE {
         let truth = out.truth.parameters[name];
-        let e = [id.stage1.as_ref(), id.stage2.as_ref()]
-            .into_iter()
-            .flatten()
-            .find_map(|s| s.estimate(name))
-            .ok_or(format!("{name} not estimated"))?;
+        let e = id.estimate(name).ok_or(format!("{name} not estimated"))?;
         if !e.covers(truth) {
             eprintln!(
                 "seed {seed}: {name} {:.5e} [{:.5e}, {:.5e}], truth {truth:.5e}, start {:.5e}",

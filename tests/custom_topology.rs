@@ -376,46 +376,10 @@ fn the_engine_is_fitted_from_its_own_sensors() {
         ..Default::default()
     };
     let id = fit::identify(&m, &p0, &rec, &opts).expect("fitted");
-    for name in free {
-        let t = value(&m, &truth, name);
-        let e = [id.stage1.as_ref(), id.stage2.as_ref()]
-            .into_iter()
-            .flatten()
-            .find_map(|s| s.estimate(name))
-            .unwrap();
-        eprintln!(
-            "{name}: {:.5e} [{:.5e}, {:.5e}], truth {t:.5e}",
-            e.value, e.ci_low, e.ci_high
-        );
-        assert!(
-            e.covers(t),
-            "{name}: truth {t} outside [{}, {}]",
-            e.ci_low,
-            e.ci_high
-        );
-        assert!(e.ci_high - e.ci_low < 0.5 * t, "{name}: interval too wide");
-    }
+    common::fit::assert_recovered(&id, free.map(|k| (k, value(&m, &truth, k))), 0.5);
     let off = id.offsets.get("p_bounce");
     assert!((off - 50.0).abs() < 30.0, "p_bounce offset {off}");
-    let fr = id
-        .free_run
-        .as_ref()
-        .expect("free run on the held-out block");
-    let (ms, sm) = (
-        fr.measured.as_ref().unwrap(),
-        fr.simulated.as_ref().unwrap(),
-    );
-    for ch in ["x", "y", "p", "p_bounce"] {
-        let amp = |c: &fit::free_run::CycleFeatures| {
-            c.amplitude.iter().find(|a| a.0 == ch).expect("channel").1
-        };
-        let rel = (amp(sm) - amp(ms)) / amp(ms);
-        assert!(
-            rel.abs() < 0.05,
-            "{ch}: free-run amplitude off by {:.2} %",
-            100.0 * rel
-        );
-    }
+    common::fit::assert_free_run_amplitudes(&id, &["x", "y", "p", "p_bounce"], 0.05);
 }
 
 /// Without its bounce-space sensor the record cannot carry the fit: refused by name.

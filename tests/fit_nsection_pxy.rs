@@ -4,6 +4,8 @@
 //! the intervals must cover the truth and the calibrated model's free run must match the
 //! record. The coverage over 20 seeded records is measured by `examples/fit_coverage.rs`.
 
+mod common;
+
 use stirling::dsl::Closure;
 use stirling::models::fit::{self, FitOptions};
 use stirling::models::rig::{self, RigConfig};
@@ -40,47 +42,12 @@ fn pxy_startup_record_recovers_parameters_and_free_run() {
         ..Default::default()
     };
     let id = fit::identify(model.as_ref(), &p0, &out.data, &opts).unwrap();
-    for name in free {
-        let truth = out.truth.parameters[name];
-        let e = [id.stage1.as_ref(), id.stage2.as_ref()]
-            .into_iter()
-            .flatten()
-            .find_map(|s| s.estimate(name))
-            .unwrap();
-        eprintln!(
-            "{name}: {:.5e} [{:.5e}, {:.5e}], truth {truth:.5e}",
-            e.value, e.ci_low, e.ci_high
-        );
-        assert!(
-            e.covers(truth),
-            "{name}: truth {truth} outside [{}, {}]",
-            e.ci_low,
-            e.ci_high
-        );
-        // an honest interval, not a vacuous one
-        assert!(
-            e.ci_high - e.ci_low < 0.3 * truth,
-            "{name}: interval too wide"
-        );
-    }
+    common::fit::assert_recovered(&id, free.map(|k| (k, out.truth.parameters[k])), 0.3);
+    common::fit::assert_free_run_amplitudes(&id, &["x", "y", "p"], 0.05);
     let fr = id
         .free_run
         .as_ref()
         .expect("free run on the held-out block");
-    let (m, s) = (
-        fr.measured.as_ref().unwrap(),
-        fr.simulated.as_ref().unwrap(),
-    );
-    for ch in ["x", "y", "p"] {
-        let amp =
-            |c: &fit::free_run::CycleFeatures| c.amplitude.iter().find(|a| a.0 == ch).unwrap().1;
-        let rel = (amp(s) - amp(m)) / amp(m);
-        assert!(
-            rel.abs() < 0.05,
-            "{ch}: free-run amplitude off by {:.2} %",
-            100.0 * rel
-        );
-    }
     let fe = fr.frequency_error.unwrap();
     assert!(
         fe.abs() < 0.005,

@@ -4,6 +4,8 @@
 //! pressure sensor on the cold side. Measured by the rig with its own sensors and fitted:
 //! the intervals cover the truth.
 
+mod common;
+
 use stirling::dsl::{Closure, Model};
 use stirling::stirling_model;
 
@@ -145,42 +147,7 @@ fn the_gamma_engine_is_fitted_from_its_own_sensors() {
     let free = m.declared_free();
     assert_eq!(free, ["kd", "kp", "bd", "bp", "hh", "hk", "Rf"]);
     let id = fit::identify(&m, &p0, &rec, &FitOptions::default()).expect("fitted");
-    for &name in free {
-        let t = truth[m.param_index(name).unwrap()];
-        let e = [id.stage1.as_ref(), id.stage2.as_ref()]
-            .into_iter()
-            .flatten()
-            .find_map(|s| s.estimate(name))
-            .unwrap();
-        eprintln!(
-            "{name}: {:.5e} [{:.5e}, {:.5e}], truth {t:.5e}",
-            e.value, e.ci_low, e.ci_high
-        );
-        assert!(
-            e.covers(t),
-            "{name}: truth {t} outside [{}, {}]",
-            e.ci_low,
-            e.ci_high
-        );
-        assert!(e.ci_high - e.ci_low < 0.5 * t, "{name}: interval too wide");
-    }
-    let fr = id
-        .free_run
-        .as_ref()
-        .expect("free run on the held-out block");
-    let (ms, sm) = (
-        fr.measured.as_ref().unwrap(),
-        fr.simulated.as_ref().unwrap(),
-    );
-    for ch in ["x", "y", "p"] {
-        let amp = |c: &fit::free_run::CycleFeatures| {
-            c.amplitude.iter().find(|a| a.0 == ch).expect("channel").1
-        };
-        let rel = (amp(sm) - amp(ms)) / amp(ms);
-        assert!(
-            rel.abs() < 0.05,
-            "{ch}: free-run amplitude off by {:.2} %",
-            100.0 * rel
-        );
-    }
+    let truth_of = |k: &'static str| (k, truth[m.param_index(k).unwrap()]);
+    common::fit::assert_recovered(&id, free.iter().map(|&k| truth_of(k)), 0.5);
+    common::fit::assert_free_run_amplitudes(&id, &["x", "y", "p"], 0.05);
 }

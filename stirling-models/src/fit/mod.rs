@@ -181,3 +181,13 @@ pub struct Identification {
     /// Why an optional step (refinement, free run) did not run.
     pub notes: Vec<String>,
 }
+
+impl Identification {
+    /// The estimate of a parameter by name, from the stage that fitted it (stage 1 first).
+    pub fn estimate(&self, name: &str) -> Option<&report::Estimate> {
+        [self.stage1.as_ref(), self.stage2.as_ref()]
+            .into_iter()
+            .flatten()
+            .find_map(|s| s.estimate(name))
+    }
+}
