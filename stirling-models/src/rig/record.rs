@@ -1,0 +1,153 @@
+//! The record a rig run gives: the clean run of the truth model, and what the sensors of the
+//! asked channels read of it (the seed's four where the family has them, any other declared
+//! sensor of the model).
+
+use stirling_dsl::Model;
+
+use super::sensors::{self, read_sensors};
+use super::{RigConfig, RigError};
+use crate::data::Measured;
+use crate::effects::EffectSettings;
+use crate::layout::StateLayout;
+use crate::sim::{simulate, SimOptions};
+
+/// The clean run: from equilibrium with the first state (the displacer) kicked by `x0`, sampled at `rate`
+/// after `settle` (rows: the `count + 1` samples).
+fn clean_run(
+    model: &dyn Model,
+    p: &[f64],
+    cfg: &RigConfig,
+    count: usize,
+) -> Result<Vec<Vec<f64>>, RigError> {
+    let mut x0 = vec![0.0; model.n_states()];
+    model.equilibrium_guess(p, &mut x0);
+    x0[0] += cfg.x0;
+    let dt = 1.0 / cfg.rate;
+    let samples: Vec<f64> = (0..=count).map(|k| cfg.settle + k as f64 * dt).collect();
+    let opts = SimOptions {
+        rtol: 1e-8,
+        atol: 1e-8,
+        ..Default::default()
+    };
+    let traj = simulate(
+        model,
+        p,
+        &x0,
+        cfg.settle + count as f64 * dt,
+        &samples,
+        &opts,
+    )?;
+    Ok(traj.x)
+}
+
+/// The record the sensors of `cfg.channels` give of a clean run of `model`.
+pub(super) fn record(
+    model: &dyn Model,
+    p: &[f64],
+    fx: &EffectSettings,
+    cfg: &RigConfig,
+) -> Result<Measured, RigError> {
+    let lay = StateLayout::working_gas(model);
+    let ps = &lay.pressures;
+    // the seed's channels where the model declares them, else where the family has them
+    let at = |name: &str, fallback: Option<&usize>| match model.sensor_state(name) {
+        Some(s) => s,
+        None => fallback.copied(),
+    };
+    let (Some(ic), Some(ih)) = (at("p", ps.last()), at("p_hot", ps.first())) else {
+        return Err(RigError::NoGas {
+            model: model.name().into(),
+        });
+    };
+    let want = |c: &str| cfg.channels.iter().any(|k| k == c);
+    if want("p_hot") && ps.len() < 2 {
+        return Err(RigError::NoHotSide {
+            model: model.name().into(),
+        });
+    }
+    let pos = &lay.positions;
+    let mut chans = match (at("x", pos.first()), at("y", pos.get(1))) {
+        (Some(a), Some(b)) => sensors::seed_channels((ic, ih, ps.len()), [a, b], fx, cfg),
+        _ => Vec::new(),
+    };
+    for c in &cfg.channels {
+        if !chans.iter().any(|k| &k.name == c) {
+            chans.push(declared_channel(model, c, cfg)?);
+        }
+    }
+    let count = (cfg.t_end * cfg.rate).round() as usize;
+    let dt = 1.0 / cfg.rate;
+    let rows = clean_run(model, p, cfg, count)?;
+    let read = read_sensors(&rows, &chans, cfg)?;
+    let mut data = Measured {
+        source: format!("rig:{}", model.name()),
+        t: (0..=count).map(|k| k as f64 * dt).collect(),
+        ..Default::default()
+    };
+    for (c, v) in chans.iter().zip(read) {
+        if !want(&c.name) {
+            continue;
+        }
+        match c.name.as_str() {
+            "p" => data.p = Some(v),
+            "p_hot" => data.p_hot = Some(v),
+            "x" => data.x = Some(v),
+            "y" => data.y = Some(v),
+            _ => data.others.push((c.name.clone(), v)),
+        }
+    }
+    Ok(data)
+}
+
+/// A channel of `model`'s declared sensor `name`.
+fn declared_channel(
+    model: &dyn Model,
+    name: &str,
+    cfg: &RigConfig,
+) -> Result<sensors::Channel, RigError> {
+    let known = || {
+        model
+            .sensors()
+            .iter()
+            .map(|s| s.name)
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
+    let Some(sensor) = model.sensors().iter().find(|s| s.name == name) else {
+        return Err(RigError::UnknownChannel {
+            channel: name.into(),
+            known: format!("{} (the sensors `{}` declares)", known(), model.name()),
+        });
+    };
+    let Some(Some(state)) = model.sensor_state(name) else {
+        return Err(RigError::UnknownChannel {
+            channel: name.into(),
+            known: format!(
+                "{}; `{}` observes {}, absent at n = {}",
+                known(),
+                name,
+                sensor.state,
+                model.n()
+            ),
+        });
+    };
+    let (offset, sd, pressure) = match sensor.unit {
+        "Pa" => (cfg.offset_p, cfg.noise_p, true),
+        "m" => (0.0, cfg.noise_x, false),
+        unit => {
+            return Err(RigError::SensorUnit {
+                channel: name.into(),
+                unit: unit.into(),
+            })
+        }
+    };
+    Ok(sensors::Channel {
+        name: name.into(),
+        state,
+        tau: 0.0,
+        gain: 0.0,
+        offset,
+        sd,
+        pressure,
+    })
+}
