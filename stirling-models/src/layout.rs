@@ -64,9 +64,8 @@ impl StateLayout {
             _ => last,
         };
         let vessels = model.vessel_names();
-        let base = |s: &str| s.split('[').next().unwrap_or(s).trim().to_string();
         let cv_of = |state: usize| match model.states()[state].kind {
-            StateKind::Pressure(k) => base(&vessels[k]),
+            StateKind::Pressure(k) => vessel_base(&vessels[k]),
             _ => String::new(),
         };
         let chain = linked_to(model, &cv_of(anchor));
@@ -103,12 +102,11 @@ impl StateLayout {
 
 /// The CVs (base names) joined to `start` by mass-flow links, `start` included.
 fn linked_to(model: &dyn Model, start: &str) -> Vec<String> {
-    let base = |s: &str| s.split('[').next().unwrap_or(s).trim().to_string();
     let links: Vec<(String, String)> = model
         .topology()
         .links
         .iter()
-        .map(|l| (base(l.from), base(l.to)))
+        .map(|l| (vessel_base(l.from), vessel_base(l.to)))
         .collect();
     let mut seen = vec![start.to_string()];
     let mut k = 0;
@@ -124,4 +122,9 @@ fn linked_to(model: &dyn Model, start: &str) -> Vec<String> {
         k += 1;
     }
     seen
+}
+
+/// A vessel's name without its section index (`regen[j + 1]` -> `regen`).
+fn vessel_base(s: &str) -> String {
+    s.split('[').next().unwrap_or(s).trim().to_string()
 }

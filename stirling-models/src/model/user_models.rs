@@ -41,7 +41,8 @@ pub fn register(m: UserModel) -> Result<(), RegisterError> {
     let family = crate::FAMILY
         .iter()
         .any(|e| e.name == m.name || e.aliases.contains(&m.name));
-    if family || m.name.ends_with("_fx") && crate::effects::in_library(m.name) {
+    // the library's names too (`cv1_fx`, `nsection_ext`, ...): lookups by name try them first
+    if family || crate::effects::in_library(m.name) {
         return Err(RegisterError::FamilyName(m.name.into()));
     }
     let mut t = table().write().unwrap_or_else(|e| e.into_inner());
