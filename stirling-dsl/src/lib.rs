@@ -132,7 +132,7 @@ pub use topology::{assemble, Topology};
 /// Helpers for generated code only.
 #[doc(hidden)]
 pub mod __private {
-    pub use crate::expr::sign;
+    pub use crate::expr::{sign, tanh};
     pub use crate::topology::Variant;
     pub use serde;
 

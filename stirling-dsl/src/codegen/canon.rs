@@ -9,6 +9,62 @@ use std::collections::HashMap;
 
 use crate::expr::{Arena, At, Id, Node, Sym};
 
+/// `a / b` as the generated code computes it: `a * (1 / b)` unless `b` is a number; a
+/// number over `b` stays one division, `-c / b` as `-(c / b)` (the same value: one division
+/// for `1 / b` and `-1 / b`).
+///
+/// A divisor fixed for the call (`Rf / n`, `eps`, a section's volume) then has its
+/// reciprocal hoisted out of the section loop and shared by every use, so the loop
+/// multiplies where it divided. The rule does not look at what `b` depends on, so an
+/// effect's divisor `b + c x` gives the same bits as the base model's `b` at its null
+/// `c = 0` (`1 / b` is the same division in both): the augmented model at its null stays
+/// the base model bit for bit (tests/effects_nominal.rs).
+pub fn quotient(arena: &mut Arena, a: Id, b: Id) -> Id {
+    match (arena.as_const(a), arena.as_const(b)) {
+        (_, Some(_)) => return arena.div(a, b),
+        (Some(c), None) if c < 0.0 => {
+            let c = arena.num(-c);
+            let q = arena.div(c, b);
+            return arena.neg(q);
+        }
+        (Some(_), None) => return arena.div(a, b),
+        (None, None) => {}
+    }
+    let one = arena.num(1.0);
+    let r = arena.div(one, b);
+    arena.mul(a, r)
+}
+
+/// A copy of `roots` (with their names) in which every division is a [`quotient`], for the
+/// code emitted without value numbering (the sums over the sections): the same bits as the
+/// rows that read the same links.
+pub fn reciprocal_form(src: &Arena, roots: &[Id]) -> (Arena, Vec<Id>) {
+    fn go(src: &Arena, id: Id, dst: &mut Arena, memo: &mut HashMap<Id, Id>) -> Id {
+        if let Some(&r) = memo.get(&id) {
+            return r;
+        }
+        let node = src.node(id).clone();
+        let kids: Vec<Id> = node
+            .children()
+            .iter()
+            .map(|&c| go(src, c, dst, memo))
+            .collect();
+        let r = match node {
+            Node::Named(n, _) => dst.named(src.name(n), kids[0]),
+            Node::Div(..) => quotient(dst, kids[0], kids[1]),
+            _ => dst.make(node.with_children(&kids)),
+        };
+        memo.insert(id, r);
+        r
+    }
+    let (mut dst, mut memo) = (Arena::new(), HashMap::new());
+    let ids = roots
+        .iter()
+        .map(|&r| go(src, r, &mut dst, &mut memo))
+        .collect();
+    (dst, ids)
+}
+
 /// Which section a block of the section loop is specialised to.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum Section {
@@ -73,13 +129,8 @@ impl Canon {
                 .iter()
                 .map(|&c| self.import(src, c))
                 .collect();
-            match (&node, kids.first().and_then(|&k| self.arena.as_const(k))) {
-                // `-c / b` as `-(c / b)` (the same value): one division for `1 / b` and `-1 / b`
-                (Node::Div(..), Some(c)) if c < 0.0 => {
-                    let (c, d) = (self.arena.num(-c), kids[1]);
-                    let q = self.arena.div(c, d);
-                    self.arena.neg(q)
-                }
+            match node {
+                Node::Div(..) => quotient(&mut self.arena, kids[0], kids[1]),
                 _ => self.arena.make(node.with_children(&kids)),
             }
         };

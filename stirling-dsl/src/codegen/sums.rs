@@ -13,6 +13,7 @@
 use proc_macro2::{Ident, TokenStream};
 use quote::{format_ident, quote};
 
+use super::canon::reciprocal_form;
 use super::layout::Layout;
 use super::rows::Output;
 use crate::expr::emit::emit_split;
@@ -53,7 +54,8 @@ fn sum_loop(
     private: &TokenStream,
 ) -> TokenStream {
     let leaf = |s: Sym| lay.leaf(s);
-    let b = emit_split(arena, templates, &leaf, private, &varies);
+    let (arena, templates) = reciprocal_form(arena, templates);
+    let b = emit_split(&arena, &templates, &leaf, private, &varies);
     let (outer, inner, outs) = (b.outer, b.inner, b.outputs);
     let ids: Vec<Ident> = (first..first + outs.len()).map(sum_ident).collect();
     quote! {
@@ -221,7 +223,8 @@ fn one_sum(
         return TokenStream::new();
     }
     let leaf = |s: Sym| lay.leaf(s);
-    let b = emit_split(arena, &roots, &leaf, private, &varies);
+    let (arena, roots) = reciprocal_form(arena, &roots);
+    let b = emit_split(&arena, &roots, &leaf, private, &varies);
     let (outer, inner) = (b.outer, b.inner);
     let (dout, outs) = (&b.outputs[0], &b.outputs[1..]);
     quote! {

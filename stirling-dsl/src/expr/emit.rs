@@ -239,9 +239,11 @@ impl Emitter<'_> {
     }
 
     fn call(&self, f: Func, a: Id, names: &[Option<Ident>]) -> (TokenStream, u8) {
-        if f == Func::Sign {
+        // our own `sign` (`sign(0) = 0`) and `tanh` (inlined, no libm call: expr/tanh.rs)
+        if matches!(f, Func::Sign | Func::Tanh) {
             let (arg, private) = (self.go(a, names).0, self.private);
-            return (quote!(#private::sign(#arg)), P_ATOM);
+            let m = format_ident!("{}", if f == Func::Sign { "sign" } else { "tanh" });
+            return (quote!(#private::#m(#arg)), P_ATOM);
         }
         let arg = self.wrap(a, P_ATOM, names);
         let m = format_ident!("{}", f.name());

@@ -10,10 +10,12 @@ mod node;
 /// Printers.
 pub mod print;
 mod subst;
+mod tanh;
 
 pub use arena::Arena;
 pub use node::{sign, At, Func, Id, Node, Sym};
 pub use print::{Printer, Style};
+pub use tanh::tanh;
 
 #[cfg(test)]
 mod tests;

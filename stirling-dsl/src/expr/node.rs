@@ -94,7 +94,7 @@ impl Func {
             Func::Sqrt => a.sqrt(),
             Func::Ln => a.ln(),
             Func::Exp => a.exp(),
-            Func::Tanh => a.tanh(),
+            Func::Tanh => super::tanh(a),
             Func::Abs => a.abs(),
             Func::Sign => sign(a),
             Func::Sin => a.sin(),
