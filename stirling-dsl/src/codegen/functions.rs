@@ -22,7 +22,7 @@ fn method(
 ) -> TokenStream {
     let mut used = HashSet::new();
     idents(&body, &mut used);
-    let (params, offsets) = (lay.params(&used), lay.offsets(&used));
+    let (params, offsets, slices) = (lay.params(&used), lay.offsets(&used), lay.slices(&used));
     let nf = used.contains("nf").then(|| quote!(let nf = n as f64;));
     quote! {
         #[allow(non_snake_case, unused_variables, unused_parens, unused_assignments, clippy::all)]
@@ -32,6 +32,7 @@ fn method(
             #nf
             #params
             #offsets
+            #slices
             #body
         }
     }

@@ -35,7 +35,8 @@ impl Layout<'_> {
         for b in &self.sys.blocks {
             let id = format_ident!("o_{}", b.name);
             let (sl, al) = (Literal::usize_unsuffixed(s), Literal::usize_unsuffixed(a));
-            if used.contains(&id.to_string()) {
+            let slice = format!("__x_{}", b.name);
+            if used.contains(&id.to_string()) || used.contains(&slice) {
                 out.extend(match (s, a) {
                     (_, 0) => quote! { let #id: usize = #sl; },
                     (0, 1) => quote! { let #id: usize = n; },
@@ -77,6 +78,44 @@ impl Layout<'_> {
         }
     }
 
+    /// The identifier of an array block's slice of the state, e.g. `__x_P_regen`.
+    fn slice_ident(&self, sym: u32) -> Ident {
+        format_ident!("__x_{}", self.sys.blocks[self.block(sym)].name)
+    }
+
+    /// Index of a state element inside its array block.
+    fn in_block(at: At) -> TokenStream {
+        match at {
+            At::Scalar | At::First => quote!(0),
+            At::Rel(0) => quote!(j),
+            At::Rel(k) if k > 0 => {
+                let k = Literal::usize_unsuffixed(k as usize);
+                quote!(j + #k)
+            }
+            At::Rel(k) => {
+                let k = Literal::usize_unsuffixed((-k) as usize);
+                quote!(j - #k)
+            }
+            At::Last => quote!(n - 1),
+        }
+    }
+
+    /// `let __x_P_regen: &[f64] = &x[o_P_regen..o_P_regen + n];` for every array block whose
+    /// slice is named in `used` (after `offsets`).
+    pub fn slices(&self, used: &HashSet<String>) -> TokenStream {
+        let mut out = TokenStream::new();
+        for b in self.sys.blocks.iter().filter(|b| b.array) {
+            let (x, o) = (
+                format_ident!("__x_{}", b.name),
+                format_ident!("o_{}", b.name),
+            );
+            if used.contains(&x.to_string()) {
+                out.extend(quote! { let #x: &[f64] = &x[#o..#o + n]; });
+            }
+        }
+        out
+    }
+
     /// Index expression of a state element.
     pub fn index(&self, block: u32, at: At) -> TokenStream {
         let o = self.offset_ident(block);
@@ -101,6 +140,12 @@ impl Layout<'_> {
             Sym::Param(i) => {
                 let id = Ident::new(&self.topo.params[i as usize].name, Span::call_site());
                 quote!(#id)
+            }
+            Sym::State(b, at) if self.sys.blocks[self.block(b)].array => {
+                // through the block's own slice (`slices`): an index below `n` in a loop over
+                // the sections needs no bounds check
+                let (x, idx) = (self.slice_ident(b), Self::in_block(at));
+                quote!(#x[#idx])
             }
             Sym::State(b, at) => {
                 let idx = self.index(b, at);
