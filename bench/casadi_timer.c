@@ -58,6 +58,10 @@ static double time_function(void *lib, const char *name, const double *z) {
         casadi_int ncol = sp[1], nnz = sp[2] ? sp[0] * ncol : sp[2 + ncol];
         res[i] = calloc(nnz + 1, sizeof(double));
     }
+    /* warm up for 0.2 s first: the first tens of milliseconds of a busy core run slower on
+       this VM (up to 1.5x, from one process to the next), as bench_native's do */
+    double w0 = now();
+    while (now() - w0 < 0.2) eval(arg, res, iw, w, 0);
     /* calibrate: batches of k calls about 2 ms long */
     double t0 = now();
     eval(arg, res, iw, w, 0);

@@ -26,10 +26,23 @@ ROOT = os.path.dirname(HERE)
 TOL = 1e-9
 
 
-def native(path, n, t_end):
+def native(path, n, t_end, kernels_only=False):
     cmd = [path, "--n", str(n), "--json", "--t-end", str(t_end)]
+    if kernels_only:
+        cmd += ["--no-sim", "--no-poles"]
     out = subprocess.run(cmd, check=True, capture_output=True, text=True).stdout
     return json.loads(out)
+
+
+KERNELS = ("rhs", "jac", "rhs_jac", "jac_triplets", "rhs_jac_triplets")
+
+
+def fastest_rounds(ours, rounds):
+    """Each of ours' kernel timings as the fastest of its first measurement and `rounds`."""
+    for r in rounds:
+        for k in KERNELS:
+            if k in r["timings"] and k in ours["timings"]:
+                ours["timings"][k] = min(ours["timings"][k], r["timings"][k])
 
 
 def dense(trip, nx):
@@ -40,13 +53,17 @@ def dense(trip, nx):
 
 
 def rel_err(a, b, groups):
-    """max over entries of |a - b| / max(|b|, 1e-12 * max|b| over the entry's group): relative,
-    with a floor for entries that cancel to round-off (e.g. mass flows near equilibrium)."""
+    """max over entries of |a - b| / max(|b|, 1e-4 * max|b| over the entry's group): relative,
+    with a floor for entries that cancel (a section's mass balance, inflow minus outflow of
+    nearly equal flows): below 1e-4 of the group's largest an entry is compared in absolute
+    terms, so that at TOL = 1e-9 the two may differ by 1e-13 of the group's scale, a few
+    round-offs of the terms that cancelled (a floor of 1e-12, as before Dec 3, passed only
+    when both sides rounded alike, e.g. both divided where one now multiplies by 1 / b)."""
     a, b = np.asarray(a), np.asarray(b)
     worst = 0.0
     for g in groups:
         bg, ag = b[g], a[g]
-        floor = 1e-12 * max(np.abs(bg).max(), 1e-300)
+        floor = 1e-4 * max(np.abs(bg).max(), 1e-300)
         worst = max(worst, float(np.max(np.abs(ag - bg) / np.maximum(np.abs(bg), floor))))
     return worst
 
@@ -96,6 +113,9 @@ def main():
                     help="skip the SciPy simulated second above this n (it takes minutes)")
     ap.add_argument("--t-end", type=float, default=1.0)
     ap.add_argument("--no-casadi-vm", action="store_true", help="skip CVODES with the SX virtual machine")
+    ap.add_argument("--rounds", type=int, default=3,
+                    help="time ours' and CasADi's C kernels in turn this many times each and keep "
+                         "each kernel's fastest (a machine whose speed drifts skews neither)")
     ap.add_argument("--casadi-c-max-n", type=int, default=100,
                     help="above this n CasADi generates no C (gcc -O3 of ~2000 states takes too long): "
                          "its kernels and CVODES run on the SX virtual machine")
@@ -111,7 +131,10 @@ def main():
         assert topo.nx == nx
         print("    casadi", file=sys.stderr, flush=True)
         cas = casadi_model.run(n, params, t_end=a.t_end, rtol=ours["rtol"], atol=ours["atol"],
-                               vm_sim=not a.no_casadi_vm, c_max_n=a.casadi_c_max_n)
+                               vm_sim=not a.no_casadi_vm, c_max_n=a.casadi_c_max_n,
+                               ours_kernels=lambda: native(a.native, n, a.t_end, kernels_only=True),
+                               rounds=a.rounds)
+        fastest_rounds(ours, cas.get("ours_rounds", []))
         print("    scipy", file=sys.stderr, flush=True)
         sci = scipy_model.run(n, params, do_sim=n <= a.scipy_sim_max_n, t_end=a.t_end, rtol=ours["rtol"], atol=ours["atol"])
         # the simulation starts and scales must agree too

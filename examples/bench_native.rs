@@ -82,6 +82,12 @@ fn fd_jacobian(
 /// Median seconds per call of `f`: batches of `k` calls sized to about `batch_s`, `reps` batches
 /// (but at most about `budget_s` in all).
 fn time_per_call(mut f: impl FnMut(), batch_s: f64, reps: usize, budget_s: f64) -> (f64, usize) {
+    // warm up for 0.2 s: on this VM the first tens of milliseconds of a busy core run up to
+    // 1.5x slower, from one process to the next (bench/casadi_timer.c does the same)
+    let w = Instant::now();
+    while w.elapsed().as_secs_f64() < 0.2 {
+        f();
+    }
     // calibrate
     let t0 = Instant::now();
     f();
