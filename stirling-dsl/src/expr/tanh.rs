@@ -27,18 +27,22 @@ const ROUNDER: f64 = 6_755_399_441_055_744.0;
 #[inline(always)]
 pub fn tanh(x: f64) -> f64 {
     let a = x.abs();
-    if !(a < 22.0) {
-        // saturated (the usual case away from a flow reversal), or NaN
-        return if a.is_nan() { x } else { 1.0f64.copysign(x) };
+    if a >= 22.0 {
+        // saturated: the usual case away from a flow reversal
+        1.0f64.copysign(x)
+    } else {
+        unsaturated(x, a) // and NaN
     }
-    unsaturated(x, a)
 }
 
-/// `tanh(x)` for `|x| = a < 22`: out of line, so that the loop around a saturated `tanh`
+/// `tanh(x)` for `|x| = a < 22` or NaN: out of line, so that the loop around a saturated `tanh`
 /// keeps its values in registers.
 #[cold]
 #[inline(never)]
 fn unsaturated(x: f64, a: f64) -> f64 {
+    if a.is_nan() {
+        return x;
+    }
     // e = expm1(y) = s p + (s - 1), so -e = (1 - s) - s p and e + 2 = (1 + s) + s p, where
     // `s p`, `1 - s` and `1 + s` are exact: one rounding each side, no cancellation
     let y = -2.0 * a;
