@@ -1,7 +1,8 @@
 //! Floating-point operations per regenerator section of the generated `nsection` code
 //! (docs/performance.md, "Operations per section"): the body of the loop over the
 //! interior sections of `__rhs_full`, `__jac_full` and `__rhs_jac_full`, counted on the
-//! expansion. Run: `cargo test -p stirling-macros flop_count -- --nocapture`.
+//! expansion, held to the documented counts as ceilings. Run: `cargo test -p
+//! stirling-macros flop_count -- --nocapture`.
 //!
 //! Counted: binary `+ - * /` on `f64` values (index arithmetic inside `[..]` and the row
 //! and column arguments of `sink.add` are integer work and not counted), and calls of
@@ -14,7 +15,7 @@ use crate::ast::ModelAst;
 use crate::expand::expand;
 
 /// `nsection` as one model (the engine base and the `nsection` gas of stirling-models).
-const NSECTION: &str = r#"
+pub(crate) const NSECTION: &str = r#"
     pub model NSectionFlat {
         params {
             R: 287.05 "J/(kg K)", gamma: 1.4 "-", A: 0.0028274 "m^2", Ar: 0.00017671 "m^2",
@@ -212,6 +213,29 @@ fn flop_count() {
     }
     println!("| function | add/sub | mul | div | flops | calls | stores |");
     println!("|---|---|---|---|---|---|---|");
+    // the counts of docs/performance.md, as ceilings: a change of the generator that makes the
+    // section loop do more (a division back, a second `tanh` per link) fails here
+    let ceilings = [
+        ("__rhs_full", 25, 1, 2),
+        ("__jac_full", 53, 1, 9),
+        ("__rhs_jac_full", 65, 1, 11),
+    ];
+    for (m, flops, divs, stores) in ceilings {
+        let c = counts_of(&expansion, m).expect("nsection has an interior loop");
+        assert!(
+            c.flops() <= flops,
+            "{m}: {} flops per section > {flops}",
+            c.flops()
+        );
+        assert!(
+            c.div <= divs,
+            "{m}: {} divisions per section > {divs}",
+            c.div
+        );
+        assert_eq!(c.stores, stores, "{m}: stores per section");
+        let tanh = c.calls.iter().filter(|f| *f == "tanh").count();
+        assert_eq!(tanh, 1, "{m}: one tanh per section (the link's, carried)");
+    }
     for m in ["__rhs_full", "__jac_full", "__rhs_jac_full"] {
         let Some(c) = counts_of(&expansion, m) else {
             println!("| {m} | (no interior loop) |");

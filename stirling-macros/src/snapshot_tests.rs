@@ -229,3 +229,13 @@ fn expansion_per_section() {
 fn equations_per_section_full() {
     insta::assert_snapshot!(equations(PER_SECTION, "model persection, closure full"));
 }
+
+/// The generated Rust of `nsection` itself (the family's engine as one model): the right-hand
+/// side and the Jacobian whose operations per section docs/performance.md counts.
+#[test]
+fn expansion_nsection() {
+    insta::assert_snapshot!(methods(
+        crate::flop_count::NSECTION,
+        &["__rhs_full", "__jac_full"]
+    ));
+}
