@@ -1,4 +1,4 @@
-//! Measured data: a CSV with a header, `t` [s] and any of `p` (cold-side absolute pressure,
+//! Measured data: a CSV with a header, `t` \[s\] and any of `p` (cold-side absolute pressure,
 //! Pa), `p_hot` (Pa), `x`, `y` (m); `#` comment lines. Other columns are kept by name when
 //! every row holds a number there ([`crate::data::Measured::others`]: a channel a model declares with
 //! `sensor name: STATE;`), and set aside with the first bad cell otherwise

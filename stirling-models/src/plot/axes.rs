@@ -15,7 +15,7 @@ pub fn channel_unit(channel: &str) -> &'static str {
     }
 }
 
-/// A measured channel as an axis label, e.g. `p [Pa]`.
+/// A measured channel as an axis label, e.g. `p \[Pa\]`.
 pub fn channel_label(channel: &str) -> String {
     label(channel, channel_unit(channel))
 }

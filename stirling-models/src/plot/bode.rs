@@ -1,4 +1,4 @@
-//! Bode diagram in the style of the seed's Figure 8: magnitude [dB] above phase [deg] over a
+//! Bode diagram in the style of the seed's Figure 8: magnitude \[dB\] above phase \[deg\] over a
 //! logarithmic frequency axis labelled in powers of ten, the 0 dB and -180 deg lines drawn,
 //! the selected gain and phase margins marked at their crossovers and written above the
 //! panels (never over the curve).

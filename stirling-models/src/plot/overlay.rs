@@ -14,7 +14,7 @@ use super::{axes, DrawError};
 /// The colours of the model lines, in order (blue: before, red: after).
 const LINES: [RGBColor; 3] = [BLUE, RED, GREEN];
 
-/// Draw `measured` (dots) and each `(name, values)` line of `channel` against `t` [s], with
+/// Draw `measured` (dots) and each `(name, values)` line of `channel` against `t` \[s\], with
 /// the residuals in a second panel.
 pub fn overlay(
     path: &Path,

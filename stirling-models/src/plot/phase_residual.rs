@@ -26,7 +26,7 @@ fn scale(channel: &str) -> (f64, &'static str) {
     }
 }
 
-/// Draw the panels stacked, phase of the cycle [deg] on the horizontal axes.
+/// Draw the panels stacked, phase of the cycle \[deg\] on the horizontal axes.
 pub fn phase_residual(path: &Path, title: &str, panels: &[Panel]) -> Result<(), DrawError> {
     let err = |e: &dyn std::fmt::Display| DrawError::on(path, e);
     let k = panels.len().max(1);

@@ -1,4 +1,4 @@
-//! PV diagram per vessel over one cycle: pressure [kPa] against volume [cm^3]; the enclosed
+//! PV diagram per vessel over one cycle: pressure \[kPa\] against volume \[cm^3\]; the enclosed
 //! area is the vessel's cycle work, arrowheads along the loop show the direction of the cycle
 //! (clockwise: work done by the gas), a dot marks its start.
 

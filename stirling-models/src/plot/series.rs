@@ -33,7 +33,7 @@ fn finite(t: &[f64], v: &[f64]) -> Vec<(f64, f64)> {
         .collect()
 }
 
-/// Draw `measured` (dots) and `model` (line) of `channel` against `t` [s], the residual below.
+/// Draw `measured` (dots) and `model` (line) of `channel` against `t` \[s\], the residual below.
 pub fn measured_vs_model(
     path: &Path,
     title: &str,

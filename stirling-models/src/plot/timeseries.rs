@@ -1,5 +1,5 @@
 //! Start-up time response in the style of the seed's Figure 3: displacer `x`, piston `y`
-//! [mm] and the pressures [kPa] against time [s], two stacked panels. The legends sit in a
+//! \[mm\] and the pressures \[kPa\] against time \[s\], two stacked panels. The legends sit in a
 //! strip right of the panels (they never hide a trace); the pressure traces are drawn from
 //! wide and pale to narrow so that channels lying on top of each other stay visible.
 
@@ -69,7 +69,7 @@ pub fn startup_svg(
     root.present().map_err(|e| err(&e))
 }
 
-/// The top panel (with its legend strip): `x` and `y` [mm] over `0..t1`.
+/// The top panel (with its legend strip): `x` and `y` \[mm\] over `0..t1`.
 fn positions_panel(
     path: &Path,
     top: &Area,
@@ -119,7 +119,7 @@ fn pressure_range(series: &[Vec<(f64, f64)>]) -> (f64, f64) {
     }
 }
 
-/// The bottom panel (with its legend strip): the pressure traces [kPa] over `0..t1`.
+/// The bottom panel (with its legend strip): the pressure traces \[kPa\] over `0..t1`.
 fn pressure_panel(
     path: &Path,
     bottom: &Area,
