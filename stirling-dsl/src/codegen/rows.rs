@@ -1,6 +1,6 @@
 //! The right-hand side, the analytic Jacobian and the parameter Jacobian of one
 //! system as Rust: the outputs of every row, emitted as one program by
-//! [`super::sections::program`].
+//! [`crate::codegen::sections::program`].
 
 use proc_macro2::{Literal, TokenStream};
 use quote::quote;

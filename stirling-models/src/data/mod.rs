@@ -5,7 +5,7 @@
 //! ([`crate::data::Measured::unread`]), so that a fit asking for one can say where it failed.
 //!
 //! Every malformed input is a [`DataError`] naming the file, the row (1-based line number in
-//! the file) and the column. Sensor offsets are estimated ([`offsets`]), never assumed zero.
+//! the file) and the column. Sensor offsets are estimated ([`offsets`](crate::data::offsets)), never assumed zero.
 
 mod csv;
 /// Sensor offsets, estimated from the data.

@@ -2,7 +2,7 @@
 //! drift) per channel, per harmonic of the cycle (DFT over whole cycles), per phase of the
 //! cycle (binned), per subsystem (stage-1 mechanics driven by measured pressure vs stage-2
 //! gas driven by measured displacements). The free-running comparison, cycle by cycle, is
-//! [`super::sim_gap`].
+//! [`crate::diagnose::sim_gap`].
 
 use serde::Serialize;
 

@@ -1,4 +1,4 @@
-//! Fit and rank the screened candidates ([`super::screen`]): the joint Levenberg-Marquardt
+//! Fit and rank the screened candidates ([`crate::diagnose::screen`]): the joint Levenberg-Marquardt
 //! fit of each effect's strengths (and shapes) with every nominal variable of the stages it
 //! touches, from the nominal optimum (and from the nominal parameters' estimates); then the
 //! held-out error of the fitted model and the held-out BIC change

@@ -1,5 +1,5 @@
 //! The score screen of one candidate: the score test at the effect's null on the joint
-//! problem ([`super::joint`], [`super::score`]). Shape parameters (the end stops' travel) are
+//! problem ([`crate::diagnose::joint`], [`crate::diagnose::score`]). Shape parameters (the end stops' travel) are
 //! inert at a zero strength, so the score test cannot see them (Davies' problem): it is
 //! taken at a grid of travels (fractions of the recorded excursion), the largest statistic
 //! kept with a Bonferroni factor, and the joint fit starts from that travel with the travel

@@ -7,7 +7,7 @@
 //!   gap;
 //! - `no_significant_gap`: no candidate's score is significant: no omitted direction shows a
 //!   systematic deviation beyond the noise (output noise and the input noise driven through
-//!   the subsystems, see [`super::score`]). The held-out BIC alone does not count: on clean
+//!   the subsystems, see [`crate::diagnose::score`]). The held-out BIC alone does not count: on clean
 //!   data an added damping (friction) can lower the held-out error by damping the response to
 //!   input noise, which is not a gap of the model. The reason names the parameters the
 //!   calibration moved by more than [`SHIFT_NOTE_SD`] prior standard deviations (a gap the

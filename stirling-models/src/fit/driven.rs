@@ -10,7 +10,7 @@
 //!   also moves the stage-1 position offsets by the static response `-J_qq^-1 J_qP off`, so the
 //!   prescribed positions depend on it and its sensitivity column carries that input term.
 //!
-//! Gradients are forward sensitivities ([`super::sensitivity`]) on the generated Jacobians.
+//! Gradients are forward sensitivities ([`crate::fit::sensitivity`]) on the generated Jacobians.
 
 use nalgebra::DMatrix;
 use stirling_dsl::Model;

@@ -3,7 +3,7 @@
 //! The body states are prescribed from the measured positions (offsets removed) and their
 //! smoothed derivatives; fitted: the free gas parameters and the pressure offsets. A pressure
 //! offset moves the position offsets stage 1 found by the static response
-//! `-J_qq^-1 J_qP off` ([`super::driven::static_shift`]), so the prescribed positions depend
+//! `-J_qq^-1 J_qP off` ([`crate::fit::driven::static_shift`]), so the prescribed positions depend
 //! on it and its sensitivity column carries that input term.
 
 use stirling_dsl::Model;

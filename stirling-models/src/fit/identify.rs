@@ -1,10 +1,10 @@
-//! The two-stage identification: stage 1 (mechanics, [`super::mechanics`]) and stage 2 (gas,
-//! [`super::gas`]) in turn, then the optional multiple-shooting refinement and the free-run
+//! The two-stage identification: stage 1 (mechanics, [`crate::fit::mechanics`]) and stage 2 (gas,
+//! [`crate::fit::gas`]) in turn, then the optional multiple-shooting refinement and the free-run
 //! validation.
 //!
 //! When the model has several CVs and the record has no hot-side pressure, stage 1 runs twice:
 //! first on the measured `p` alone (for the position offsets stage 2 needs), then, after
-//! stage 2, on `p` plus the gas stage's pressure differences ([`super::unmeasured`]), with
+//! stage 2, on `p` plus the gas stage's pressure differences ([`crate::fit::unmeasured`]), with
 //! the covariance that stage 2's uncertainty carries in.
 
 use std::time::Instant;

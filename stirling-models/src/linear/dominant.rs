@@ -2,9 +2,9 @@
 //! Jacobian, without forming `T' J T`.
 //!
 //! **Operator.** `(J_s - sigma I)^-1` with `J_s = D^-1 J D` (`D` the state scales of
-//! [`super::equilibrium::state_scales`]: a similarity, so the same eigenvalues, but Krylov
+//! [`crate::linear::equilibrium::state_scales`]: a similarity, so the same eigenvalues, but Krylov
 //! vectors whose entries are comparable across pressures, masses and positions), applied by a
-//! complex faer sparse LU ([`super::sparse::ShiftedSolver`]; the symbolic
+//! complex faer sparse LU ([`crate::linear::sparse::ShiftedSolver`]; the symbolic
 //! analysis is shared by all shifts). A Ritz value `theta` of the operator is the pole
 //! `lambda = sigma + 1/theta`.
 //!

@@ -7,7 +7,7 @@
 //! constraint, so it has no zero eigenvalue from the conserved mass. The reduction eliminates
 //! the last mass state (`m_last - m_last* = -` the sum of the other mass deviations at constant
 //! charge): the coordinates keep the model's state names and `A` keeps its sparsity, and it is
-//! similar to the orthogonal reduction of [`super::reduce`]. `basis` gives `T` with
+//! similar to the orthogonal reduction of [`crate::linear::reduce`]. `basis` gives `T` with
 //! `x - x* = T z`. From [`SPARSE_FROM`] states on `A` is also written as triplets, above
 //! [`DENSE_UP_TO`] only so.
 

@@ -9,9 +9,9 @@
 //! equilibrium's Newton system does, to stay regular at `s = 0`; that dense row made the
 //! factorization's fronts dense: `linearize --n 1000` spent 47 s in those solves.) At `s = 0`
 //! alone the constraint is used, by Sherman-Morrison on the sparse matrix
-//! ([`super::sparse::solve_weighted_constrained`]). The system is scaled by
+//! ([`crate::linear::sparse::solve_weighted_constrained`]). The system is scaled by
 //! the state scales `D` and solved by the complex sparse LU of
-//! [`super::sparse::ShiftedSolver`] (symbolic analysis once).
+//! [`crate::linear::sparse::ShiftedSolver`] (symbolic analysis once).
 
 use faer::c64;
 use nalgebra::{Complex, DVector};

@@ -10,7 +10,7 @@
 //! factorization (the staggered corrector of CVODES' sensitivities). Blocks are compared by
 //! value, so a block-diagonal matrix whose blocks differ is still solved exactly; a pattern
 //! that is not block-diagonal with equal block sizes falls back to the refactoring sparse LU
-//! ([`super::refactor_lu`]).
+//! ([`crate::sim::refactor_lu`]).
 
 use diffsol::{FaerContext, FaerSparseMat, FaerVec, LaError, Matrix, MatrixCommon, Vector};
 use diffsol_la::error::LinearSolverError;

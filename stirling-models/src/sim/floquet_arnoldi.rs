@@ -2,7 +2,7 @@
 //! products, for cycles too large for the dense monodromy.
 //!
 //! **Operator.** `D^-1 Phi D` (state-scaled, the same spectrum as `Phi`) applied by
-//! [`super::tangent::TangentFlow::apply`]. The spectrum of a stiff engine's monodromy is a
+//! [`crate::sim::tangent::TangentFlow::apply`]. The spectrum of a stiff engine's monodromy is a
 //! handful of multipliers of order one (the trivial 1, twice with the inventory, the
 //! slow thermal and mechanical modes) and a cloud at `|mu| ~ 0` (the pressure-equalization
 //! modes, damped by `exp(-T / tau)` with `tau` far below the period, and by L-stability

@@ -1,9 +1,9 @@
 //! Newton-Krylov shooting: the limit cycle and its leading Floquet multipliers without
-//! the dense monodromy matrix, for cycles above [`super::SHOOTING_MAX_STATES`] states.
+//! the dense monodromy matrix, for cycles above [`crate::sim::SHOOTING_MAX_STATES`] states.
 //!
-//! Same unknowns `(x0, T)`, scaling, section and inventory as [`super::shooting::shoot`];
-//! the Newton system is solved matrix-free by GMRES ([`super::gmres`]) on products
-//! `D^-1 Phi D v` from [`super::tangent`] (one BDF run of the state per Newton
+//! Same unknowns `(x0, T)`, scaling, section and inventory as [`crate::sim::shooting::shoot`];
+//! the Newton system is solved matrix-free by GMRES ([`crate::sim::gmres`]) on products
+//! `D^-1 Phi D v` from [`crate::sim::tangent`] (one BDF run of the state per Newton
 //! iteration, then linear work on the recorded steps).
 //!
 //! **Squaring the system.** The dense route solves the `(n + 2) x (n + 1)` system

@@ -12,8 +12,8 @@
 //!
 //! One LU of the `3n x 3n` stage matrix per (sub)step serves all `n` columns of
 //! `Phi` (propagated in state-scaled form `D^-1 Phi D`): nalgebra dense LU for small `n`,
-//! the refactoring sparse LU ([`super::refactor_lu`]: column order once, on the union of the
-//! block patterns; pivots kept from step to step) above [`super::SPARSE_THRESHOLD`] states
+//! the refactoring sparse LU ([`crate::sim::refactor_lu`]: column order once, on the union of the
+//! block patterns; pivots kept from step to step) above [`crate::sim::SPARSE_THRESHOLD`] states
 //! (or as [`SimOptions::linear_solver`] says). L-stability makes the stiff
 //! (pressure-equalization) modes decay to ~0 as they should; the stage matrix is a
 //! rational function of `h J`, so a left null vector of `J` (the mass inventory,

@@ -11,7 +11,7 @@
 //!   outputs and stage 2's prescribed positions ([`crate::fit::driven::Sensor`]).
 //!
 //! At the null of the strengths the problem is the nominal calibration, so its Jacobian there
-//! gives the score test ([`super::score`]) and Levenberg-Marquardt from there the joint fit.
+//! gives the score test ([`crate::diagnose::score`]) and Levenberg-Marquardt from there the joint fit.
 
 use nalgebra::DMatrix;
 use stirling_dsl::Model;

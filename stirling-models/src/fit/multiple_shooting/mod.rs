@@ -1,7 +1,7 @@
 //! Multiple-shooting refinement: the training block is cut into segments of a few cycles, each
 //! simulated freely (nothing prescribed) from its own initial state; the weighted output error
 //! of all segments is minimised jointly over the free model parameters, the sensor offsets and
-//! every segment's initial state, by [`super::lm`].
+//! every segment's initial state, by [`crate::fit::lm`].
 //!
 //! Why: a self-excited oscillator drifts in phase over a long free run, so a single-shooting
 //! output error is dominated by the drift; over segments of about two cycles it is not, and the

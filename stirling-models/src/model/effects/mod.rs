@@ -1,5 +1,5 @@
 //! Effects the nominal models leave out (docs/physics.md section 9), as model augmentations
-//! declared through the DSL ([`models`]), and the registry that names them.
+//! declared through the DSL ([`models`](crate::model::effects::models)), and the registry that names them.
 //!
 //! Each model effect is a set of extra parameters of an augmented family member
 //! ([`Cv1Fx`], [`NSectionFx`]) whose null values make it absent; the nominal model is the
