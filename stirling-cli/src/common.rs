@@ -1,6 +1,8 @@
 //! What the commands share: which model, at which `n` and closure, with which parameters
-//! ([`ModelArgs`]); the checked stdout ([`stdout`](crate::common::stdout)); the rule for files written ([`files`](crate::common::files));
-//! the range checks of numeric options ([`ranges`](crate::common::ranges)); the training and held-out blocks.
+//! ([`ModelArgs`](crate::common::ModelArgs)); the checked stdout
+//! ([`stdout`](crate::common::stdout)); the rule for files written
+//! ([`files`](crate::common::files)); the range checks of numeric options
+//! ([`ranges`](crate::common::ranges)); the training and held-out blocks.
 
 mod blocks;
 /// One rule for every file the command line writes (`--out FILE`, `--plot DIR`, `--report DIR`).

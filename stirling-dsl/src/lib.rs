@@ -8,12 +8,12 @@
 //!
 //! ## Map of the crate
 //!
-//! - [`expr`](crate::expr): the hash-consed expression [`Arena`] (folding constructors, [`Arena::diff`],
-//!   substitution, [`Arena::eval`], text/LaTeX [`expr::Printer`](crate::expr::Printer), Rust emission with CSE).
-//! - [`topology`](crate::topology): the declaration ([`Topology`]) and its assembly ([`assemble`]) into
+//! - [`expr`]: the hash-consed expression [`Arena`] (folding constructors, [`Arena::diff`],
+//!   substitution, [`Arena::eval`], text/LaTeX [`expr::Printer`], Rust emission with CSE).
+//! - [`topology`]: the declaration ([`Topology`]) and its assembly ([`assemble`]) into
 //!   equations: faces give both `dV/dt` and the pressure forces, ports the heat, links the
 //!   mass and enthalpy flows (docs/physics.md sections 1, 2, 4).
-//! - [`codegen`](crate::codegen): emission of a whole model ([`codegen::generate`](crate::codegen::generate)), used by the
+//! - [`codegen`]: emission of a whole model ([`codegen::generate`]), used by the
 //!   `stirling_model!` macro at compile time.
 //! - The run-time interface every generated model implements: [`Model`], with
 //!   [`ParamInfo`], [`StateInfo`]/[`StateKind`], [`JacSink`], [`PowerTerms`], [`TopologyInfo`]

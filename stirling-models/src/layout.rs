@@ -1,5 +1,5 @@
-//! Which state of a model is what: the state-layout query every analysis uses instead of
-//! filtering [`Model::states`] by hand.
+//! Which state of a model is what: the state-layout query every analysis uses instead of filtering
+//! [`Model::states`](stirling_dsl::Model::states) by hand.
 
 use stirling_dsl::{Model, StateKind};
 

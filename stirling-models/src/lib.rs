@@ -4,24 +4,24 @@
 //! `stirling_model!` declaration implements, so a topology declared in user code gets the
 //! same equilibrium, poles, margins, limit cycle and plots as the seed's family.
 //!
-//! - [`model`](crate::model): model construction. [`family`]: `schmidt`, `cv1`, `cv2`, `nsection`
+//! - [`model`]: model construction. [`family`]: `schmidt`, `cv1`, `cv2`, `nsection`
 //!   declared with `stirling_model!` on the default engine of docs/physics.md section 8;
 //!   [`effects`]: the effects the nominal models leave out; [`params`]: parameter files,
 //!   overrides and validation; [`registry`]: the family by name, as the command line uses it.
-//! - [`linear`](crate::linear): equilibrium by Newton ([`linear::equilibrium::solve`](crate::linear::equilibrium::solve)), the dynamic poles
-//!   with the inventory mode removed ([`linear::dynamic_poles`](crate::linear::dynamic_poles)), the loop broken at a
+//! - [`linear`]: equilibrium by Newton ([`linear::equilibrium::solve`]), the dynamic poles
+//!   with the inventory mode removed ([`linear::dynamic_poles`]), the loop broken at a
 //!   pressure force with gain and phase margins and Bode/Nyquist data
-//!   ([`linear::linearize`](crate::linear::linearize)), root loci ([`linear::locus`](crate::linear::locus)).
-//! - [`sim`](crate::sim): stiff integration on the analytic Jacobian ([`sim::simulate`](crate::sim::simulate),
-//!   [`sim::integrate`](crate::sim::integrate) for any [`sim::OdeSystem`](crate::sim::OdeSystem), e.g. [`sim::EnergySystem`](crate::sim::EnergySystem) which carries
-//!   the energy budget as a quadrature), limit cycles by shooting with Floquet multipliers
-//!   ([`sim::limit_cycle`](crate::sim::limit_cycle)), cycle work ([`sim::cycle_work`](crate::sim::cycle_work)).
-//! - [`plot`](crate::plot): SVG figures (pole map, Bode, root locus, start-up response, PV diagrams).
-//! - [`data`](crate::data): measured records (CSV) with row and column errors; [`rig`](crate::rig): the virtual test
+//!   ([`linear::linearize`]), root loci ([`linear::locus`]).
+//! - [`sim`]: stiff integration on the analytic Jacobian ([`sim::simulate`], [`sim::integrate()`]
+//!   for any [`sim::OdeSystem`], e.g. [`sim::EnergySystem`] which carries the energy budget as a
+//!   quadrature), limit cycles by shooting with Floquet multipliers ([`sim::limit_cycle`]), cycle
+//!   work ([`sim::cycle_work`]).
+//! - [`plot`]: SVG figures (pole map, Bode, root locus, start-up response, PV diagrams).
+//! - [`data`]: measured records (CSV) with row and column errors; [`rig`]: the virtual test
 //!   rig that writes them from a truth model with effects, noise and offsets.
-//! - [`fit`](crate::fit): the two-stage identification (mechanics driven by pressure, gas driven by
-//!   positions), on the seed's sensors too; [`diagnose`](crate::diagnose): the sim-to-real gap diagnosis.
-//! - [`layout`](crate::layout): which state is what; [`signal`](crate::signal): smoothing, noise level, cycles, harmonics,
+//! - [`fit`]: the two-stage identification (mechanics driven by pressure, gas driven by
+//!   positions), on the seed's sensors too; [`diagnose`]: the sim-to-real gap diagnosis.
+//! - [`layout`]: which state is what; [`signal`]: smoothing, noise level, cycles, harmonics,
 //!   filters and statistical tails shared by the analyses.
 //!
 //! ## Linear analysis

@@ -1,6 +1,7 @@
-//! The checked stdout. A reader that stops early (`stirling models --json | head`) closes the
-//! pipe; the next write then fails with [`StdoutClosed`] inside an `io::Error`, which `main`
-//! turns into a quiet exit instead of a panic. Notes on stderr never fail.
+//! The checked stdout. A reader that stops early (`stirling models --json | head`) closes the pipe;
+//! the next write then fails with [`StdoutClosed`](crate::common::stdout::StdoutClosed) inside an
+//! `io::Error`, which `main` turns into a quiet exit instead of a panic. Notes on stderr never
+//! fail.
 
 use std::fmt;
 use std::io::{self, Write};

@@ -1,6 +1,5 @@
-//! The right-hand side, the analytic Jacobian and the parameter Jacobian of one
-//! system as Rust: the outputs of every row, emitted as one program by
-//! [`crate::codegen::sections::program`].
+//! The right-hand side, the analytic Jacobian and the parameter Jacobian of one system as Rust: the
+//! outputs of every row, emitted as one program by [`crate::codegen::sections::program`].
 
 use proc_macro2::{Literal, TokenStream};
 use quote::quote;

@@ -1,7 +1,7 @@
 //! The node type of the expression arena.
 //!
-//! Nodes refer to their children by [`Id`]; a child is always pushed before its
-//! parent, so the arena's order is a valid evaluation (topological) order.
+//! Nodes refer to their children by [`Id`](crate::expr::node::Id); a child is always pushed before
+//! its parent, so the arena's order is a valid evaluation (topological) order.
 
 /// Index of a node in an [`crate::Arena`].
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]

@@ -1,7 +1,7 @@
 //! Printers: readable text and LaTeX, with named intermediates listed as definitions.
 //!
-//! A [`Style`] decides how leaves and operators look; the traversal (precedence,
-//! parentheses, definitions before use) is shared by both styles.
+//! A [`Style`](crate::expr::print::Style) decides how leaves and operators look; the traversal
+//! (precedence, parentheses, definitions before use) is shared by both styles.
 
 use super::arena::Arena;
 use super::node::{Func, Id, Node, Sym};

@@ -2,11 +2,13 @@
 //!
 //! A generated Jacobian is a straight program that hands its entries `(row, col, value)` to a
 //! writer, in an order fixed by the model and `n` alone (never by the state). Three writers:
-//! - [`JacSink::Dense`]: added into column-major storage;
-//! - [`JacSink::Triplets`]: appended as coordinate triplets (the pattern and the values);
-//! - [`JacValues`]: only the values, in that fixed order, into a slice: what a sparse solver
-//!   wants once it knows the pattern ([`crate::Model::jacobian_pattern`]), 8 bytes per entry
-//!   instead of 24 and no length bookkeeping (the format of CasADi's generated code).
+//! - [`JacSink::Dense`](crate::runtime::jac_sink::JacSink::Dense): added into column-major storage;
+//! - [`JacSink::Triplets`](crate::runtime::jac_sink::JacSink::Triplets): appended as coordinate
+//!   triplets (the pattern and the values);
+//! - [`JacValues`](crate::runtime::jac_sink::JacValues): only the values, in that fixed order, into
+//!   a slice: what a sparse solver wants once it knows the pattern
+//!   ([`crate::Model::jacobian_pattern`]), 8 bytes per entry instead of 24 and no length
+//!   bookkeeping (the format of CasADi's generated code).
 
 /// What a generated Jacobian writes to (`add` accumulates where entries coincide).
 pub trait JacWrite {

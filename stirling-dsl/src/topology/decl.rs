@@ -1,9 +1,10 @@
 //! The topology description: what a `stirling_model!` declares, with every
 //! coefficient already an expression in one shared [`Arena`].
 //!
-//! Symbols used by the expressions: [`Sym::Param`] for parameters, the body
-//! position and velocity blocks (`Sym::State(block, At::Scalar)`, numbered as
-//! [`Topology::pos_block`] and [`Topology::vel_block`] give), [`Sym::Index`] and
+//! Symbols used by the expressions: [`Sym::Param`] for parameters, the body position and velocity
+//! blocks (`Sym::State(block, At::Scalar)`, numbered as
+//! [`Topology::pos_block`](crate::topology::decl::Topology::pos_block) and
+//! [`Topology::vel_block`](crate::topology::decl::Topology::vel_block) give), [`Sym::Index`] and
 //! [`Sym::Count`] inside arrays.
 
 use crate::expr::{Arena, At, Id};
@@ -164,8 +165,8 @@ pub struct End {
     pub at: At,
 }
 
-/// A mass-flow link `from -> to`: `dP = R mdot + Rq mdot |mdot|` (or `mdot = G dP`), carrying upwind enthalpy.
-/// A chain link (`from`/`to` at `Rel` offsets) repeats for `j in 0..n-1`.
+/// A mass-flow link `from -> to`: `dP = R mdot + Rq mdot |mdot|` (or `mdot = G dP`), carrying
+/// upwind enthalpy. A chain link (`from`/`to` at `Rel` offsets) repeats for `j in 0..n-1`.
 #[derive(Clone, Debug)]
 pub struct LinkDecl {
     pub from: End,

@@ -1,11 +1,12 @@
-//! Measured data: a CSV with a header, `t` \[s\] and any of `p` (cold-side absolute pressure,
-//! Pa), `p_hot` (Pa), `x`, `y` (m); `#` comment lines. Other columns are kept by name when
-//! every row holds a number there ([`crate::data::Measured::others`]: a channel a model declares with
-//! `sensor name: STATE;`), and set aside with the first bad cell otherwise
+//! Measured data: a CSV with a header, `t` \[s\] and any of `p` (cold-side absolute pressure, Pa),
+//! `p_hot` (Pa), `x`, `y` (m); `#` comment lines. Other columns are kept by name when every row
+//! holds a number there ([`crate::data::Measured::others`]: a channel a model declares with `sensor
+//! name: STATE;`), and set aside with the first bad cell otherwise
 //! ([`crate::data::Measured::unread`]), so that a fit asking for one can say where it failed.
 //!
-//! Every malformed input is a [`DataError`] naming the file, the row (1-based line number in
-//! the file) and the column. Sensor offsets are estimated ([`offsets`](crate::data::offsets)), never assumed zero.
+//! Every malformed input is a [`DataError`](crate::data::DataError) naming the file, the row
+//! (1-based line number in the file) and the column. Sensor offsets are estimated
+//! ([`offsets`](crate::data::offsets)), never assumed zero.
 
 mod csv;
 /// Sensor offsets, estimated from the data.

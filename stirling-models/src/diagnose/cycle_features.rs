@@ -1,5 +1,5 @@
-//! Per-cycle features of a record (or a simulation of it) and its waveforms by phase of the
-//! cycle: what the simulated gap ([`crate::diagnose::sim_gap`]) compares, cycle by cycle.
+//! Per-cycle features of a record (or a simulation of it) and its waveforms by phase of the cycle:
+//! what the simulated gap ([`crate::diagnose::sim_gap`]) compares, cycle by cycle.
 //!
 //! Cycles run between upward crossings of the displacer `x`. Each gives the frequency, the
 //! amplitudes of `x`, `y`, `p` (half the peak-to-peak), the phase by which `x` leads `y`

@@ -1,6 +1,6 @@
 //! The joint Levenberg-Marquardt fit of one candidate from one start: the strengths from the
-//! one-step estimate, kept on their side of the bound, and, on records without `p_hot`, taken
-//! to the fixed point of the two stages ([`settle`]).
+//! one-step estimate, kept on their side of the bound, and, on records without `p_hot`, taken to
+//! the fixed point of the two stages ([`settle`](crate::diagnose::joint_fit::settle)).
 
 use super::joint::{EffectVar, Joint};
 use super::score::Score;

@@ -1,8 +1,7 @@
-//! **Where**: the residuals of the calibrated nominal model (driven subsystems, no phase
-//! drift) per channel, per harmonic of the cycle (DFT over whole cycles), per phase of the
-//! cycle (binned), per subsystem (stage-1 mechanics driven by measured pressure vs stage-2
-//! gas driven by measured displacements). The free-running comparison, cycle by cycle, is
-//! [`crate::diagnose::sim_gap`].
+//! **Where**: the residuals of the calibrated nominal model (driven subsystems, no phase drift) per
+//! channel, per harmonic of the cycle (DFT over whole cycles), per phase of the cycle (binned), per
+//! subsystem (stage-1 mechanics driven by measured pressure vs stage-2 gas driven by measured
+//! displacements). The free-running comparison, cycle by cycle, is [`crate::diagnose::sim_gap`].
 
 use serde::Serialize;
 

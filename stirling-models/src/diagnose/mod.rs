@@ -1,19 +1,22 @@
 //! The sim-to-real gap diagnosis (method and results: docs/diagnosis.md):
 //! calibrate the nominal model on a training block with the two driven subsystems
 //! ([`crate::fit`]), then
-//! - **where** ([`localize`](crate::diagnose::localize)): residuals per channel, per harmonic of the cycle, per phase of
-//!   the cycle, per subsystem (stage-1 mechanics vs stage-2 gas), and limit-cycle features of
-//!   the measured record against a free run of the calibrated model;
-//! - **which** ([`score`](crate::diagnose::score)): a robust score (Lagrange-multiplier) test of every candidate effect
-//!   at its null, from one Jacobian of the joint problem ([`joint`](crate::diagnose::joint): the calibrated stages the
-//!   effect touches, extended by its variables);
-//! - fit the significant candidates jointly with the nominal variables of those stages and
-//!   rank them by held-out error with a BIC penalty ([`rank`](crate::diagnose::rank));
-//! - **how far** ([`closure`](crate::diagnose::closure)): the fraction of the held-out excess error closed by the winner,
-//!   with a bootstrap interval over whole cycles; the [`verdict`](crate::diagnose::verdict);
-//! - **the gap a user sees** ([`sim_gap`](crate::diagnose::sim_gap)): the calibrated model simulated on its own over the
-//!   held-out block, feature by feature (frequency, amplitudes, phase, work, growth), before
-//!   and after the leading effect, with intervals and one summary closure.
+//! - **where** ([`localize`](crate::diagnose::localize)): residuals per channel, per harmonic of
+//!   the cycle, per phase of the cycle, per subsystem (stage-1 mechanics vs stage-2 gas), and
+//!   limit-cycle features of the measured record against a free run of the calibrated model;
+//! - **which** ([`score`](crate::diagnose::score)): a robust score (Lagrange-multiplier) test of
+//!   every candidate effect at its null, from one Jacobian of the joint problem
+//!   ([`joint`](crate::diagnose::joint): the calibrated stages the effect touches, extended by its
+//!   variables);
+//! - fit the significant candidates jointly with the nominal variables of those stages and rank
+//!   them by held-out error with a BIC penalty ([`rank`](crate::diagnose::rank));
+//! - **how far** ([`closure`](crate::diagnose::closure)): the fraction of the held-out excess error
+//!   closed by the winner, with a bootstrap interval over whole cycles; the
+//!   [`verdict`](crate::diagnose::verdict);
+//! - **the gap a user sees** ([`sim_gap`](crate::diagnose::sim_gap)): the calibrated model
+//!   simulated on its own over the held-out block, feature by feature (frequency, amplitudes,
+//!   phase, work, growth), before and after the leading effect, with intervals and one summary
+//!   closure.
 
 mod blocks;
 mod candidates;

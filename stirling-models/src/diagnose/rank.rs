@@ -1,11 +1,11 @@
-//! Fit and rank the screened candidates ([`crate::diagnose::screen`]): the joint Levenberg-Marquardt
-//! fit of each effect's strengths (and shapes) with every nominal variable of the stages it
-//! touches, from the nominal optimum (and from the nominal parameters' estimates); then the
-//! held-out error of the fitted model and the held-out BIC change
-//! `N_h ln(err_effect / err_nominal) + k ln N_h + dC` (negative: better than nominal), where
-//! `dC` is the change of the prior cost of the nominal parameters ([`crate::fit::prior`]):
-//! an effect that predicts the held-out block as well as the nominal model, but with the
-//! nominal parameters back near their estimates, explains the data better (-2 log posterior).
+//! Fit and rank the screened candidates ([`crate::diagnose::screen`]): the joint
+//! Levenberg-Marquardt fit of each effect's strengths (and shapes) with every nominal variable of
+//! the stages it touches, from the nominal optimum (and from the nominal parameters' estimates);
+//! then the held-out error of the fitted model and the held-out BIC change `N_h ln(err_effect /
+//! err_nominal) + k ln N_h + dC` (negative: better than nominal), where `dC` is the change of the
+//! prior cost of the nominal parameters ([`crate::fit::prior`]): an effect that predicts the
+//! held-out block as well as the nominal model, but with the nominal parameters back near their
+//! estimates, explains the data better (-2 log posterior).
 
 use nalgebra::DVector;
 

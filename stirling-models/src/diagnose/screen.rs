@@ -1,9 +1,8 @@
-//! The score screen of one candidate: the score test at the effect's null on the joint
-//! problem ([`crate::diagnose::joint`], [`crate::diagnose::score`]). Shape parameters (the end stops' travel) are
-//! inert at a zero strength, so the score test cannot see them (Davies' problem): it is
-//! taken at a grid of travels (fractions of the recorded excursion), the largest statistic
-//! kept with a Bonferroni factor, and the joint fit starts from that travel with the travel
-//! free.
+//! The score screen of one candidate: the score test at the effect's null on the joint problem
+//! ([`crate::diagnose::joint`], [`crate::diagnose::score`]). Shape parameters (the end stops'
+//! travel) are inert at a zero strength, so the score test cannot see them (Davies' problem): it is
+//! taken at a grid of travels (fractions of the recorded excursion), the largest statistic kept
+//! with a Bonferroni factor, and the joint fit starts from that travel with the travel free.
 
 use super::context::Context;
 use super::joint::{EffectVar, Joint};

@@ -55,8 +55,8 @@ pub struct RankEntry {
     pub p_value: f64,
     /// Fitted jointly with the nominal parameters (the promising ones only).
     pub fitted: bool,
-    /// BIC change on the held-out block plus the change of the nominal parameters' prior
-    /// cost (negative: better than the nominal model; see [`rank`]).
+    /// BIC change on the held-out block plus the change of the nominal parameters' prior cost
+    /// (negative: better than the nominal model; see [`rank`](super::rank)).
     pub delta_bic: Option<f64>,
     pub holdout_error: Option<f64>,
     pub closure_fraction: Option<f64>,

@@ -1,17 +1,18 @@
 //! The verdict: the leading effect, `unexplained`, or `no_significant_gap`.
 //!
-//! - `effect`: the first-ranked candidate was fitted, its score is significant at the
-//!   family-wise level `alpha` (Bonferroni over the candidates), it lowers the held-out BIC by more than 10,
+//! - `effect`: the first-ranked candidate was fitted, its score is significant at the family-wise
+//!   level `alpha` (Bonferroni over the candidates), it lowers the held-out BIC by more than 10,
 //!   and its closure interval lies above `MIN_CLOSURE`;
 //! - `unexplained`: some candidate is significant, but none closes a significant part of the
 //!   gap;
 //! - `no_significant_gap`: no candidate's score is significant: no omitted direction shows a
-//!   systematic deviation beyond the noise (output noise and the input noise driven through
-//!   the subsystems, see [`crate::diagnose::score`]). The held-out BIC alone does not count: on clean
-//!   data an added damping (friction) can lower the held-out error by damping the response to
-//!   input noise, which is not a gap of the model. The reason names the parameters the
-//!   calibration moved by more than [`SHIFT_NOTE_SD`] prior standard deviations (a gap the
-//!   parameters absorbed) and the leading candidate that fits with them nearer their estimates.
+//!   systematic deviation beyond the noise (output noise and the input noise driven through the
+//!   subsystems, see [`crate::diagnose::score`]). The held-out BIC alone does not count: on clean
+//!   data an added damping (friction) can lower the held-out error by damping the response to input
+//!   noise, which is not a gap of the model. The reason names the parameters the calibration moved
+//!   by more than [`SHIFT_NOTE_SD`](crate::diagnose::verdict::SHIFT_NOTE_SD) prior standard
+//!   deviations (a gap the parameters absorbed) and the leading candidate that fits with them
+//!   nearer their estimates.
 
 use serde::Serialize;
 

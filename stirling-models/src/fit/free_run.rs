@@ -4,9 +4,9 @@
 //! The initial state:
 //! - positions: the smoothed measured displacements minus the position offsets;
 //! - velocities: the derivative of the same Savitzky-Golay smoother the driven stages use;
-//! - pressures: the smoothed measured `p` (and `p_hot` when present) minus the pressure
-//!   offsets; control volumes between the hot and cold ends get the mix of
-//!   [`driven::cold_weight`], as in stage 2;
+//! - pressures: the smoothed measured `p` (and `p_hot` when present) minus the pressure offsets;
+//!   control volumes between the hot and cold ends get the mix of
+//!   [`cold_weight`](crate::fit::static_shift::cold_weight), as in stage 2;
 //! - masses (models with mass states): the model's gas inventory (the charge of
 //!   `equilibrium_guess`) shared in proportion to `P V / T_rest`, i.e. `m = P V / (R T_rest)`
 //!   rescaled so that the total is the charge. Why: the inventory is a parameter of the

@@ -1,9 +1,9 @@
 //! Stage 2: the gas driven by the measured displacements.
 //!
-//! The body states are prescribed from the measured positions (offsets removed) and their
-//! smoothed derivatives; fitted: the free gas parameters and the pressure offsets. A pressure
-//! offset moves the position offsets stage 1 found by the static response
-//! `-J_qq^-1 J_qP off` ([`crate::fit::driven::static_shift`]), so the prescribed positions depend
+//! The body states are prescribed from the measured positions (offsets removed) and their smoothed
+//! derivatives; fitted: the free gas parameters and the pressure offsets. A pressure offset moves
+//! the position offsets stage 1 found by the static response `-J_qq^-1 J_qP off`
+//! ([`static_shift`](crate::fit::static_shift::static_shift)), so the prescribed positions depend
 //! on it and its sensitivity column carries that input term.
 
 use stirling_dsl::Model;

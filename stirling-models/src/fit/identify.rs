@@ -3,9 +3,9 @@
 //! validation.
 //!
 //! When the model has several CVs and the record has no hot-side pressure, stage 1 runs twice:
-//! first on the measured `p` alone (for the position offsets stage 2 needs), then, after
-//! stage 2, on `p` plus the gas stage's pressure differences ([`crate::fit::unmeasured`]), with
-//! the covariance that stage 2's uncertainty carries in.
+//! first on the measured `p` alone (for the position offsets stage 2 needs), then, after stage 2,
+//! on `p` plus the gas stage's pressure differences ([`crate::fit::unmeasured`]), with the
+//! covariance that stage 2's uncertainty carries in.
 
 use std::time::Instant;
 

@@ -1,7 +1,6 @@
-//! What the record says about the model's state: the sensor offsets, the measured channels
-//! matched to the model's states, and a model state estimated from the smoothed record (the
-//! free run's and the multiple shooting's initial states; see [`crate::fit::free_run`] for the
-//! rules).
+//! What the record says about the model's state: the sensor offsets, the measured channels matched
+//! to the model's states, and a model state estimated from the smoothed record (the free run's and
+//! the multiple shooting's initial states; see [`crate::fit::free_run`] for the rules).
 
 use serde::Serialize;
 use stirling_dsl::{Model, StateKind};

@@ -1,12 +1,11 @@
 //! Stage 1: the mechanics (both bodies) driven by the pressures on their faces.
 //!
-//! Every CV pressure the bodies feel is prescribed: the cold side from the measured `p`, the
-//! hot side from `p_hot` when it is measured (sections in between interpolated linearly), and
-//! otherwise from the measured `p` plus the pressure differences `P_i - P_cold` that the gas
-//! stage computes from the measured positions ([`crate::fit::unmeasured`]); a CV outside the
-//! working gas (a closed bounce space) from its own sensor. Fitted: the free
-//! mechanical parameters, the initial body states and the position offsets (which also
-//! absorb the static shift of a pressure offset).
+//! Every CV pressure the bodies feel is prescribed: the cold side from the measured `p`, the hot
+//! side from `p_hot` when it is measured (sections in between interpolated linearly), and otherwise
+//! from the measured `p` plus the pressure differences `P_i - P_cold` that the gas stage computes
+//! from the measured positions ([`crate::fit::unmeasured`]); a CV outside the working gas (a closed
+//! bounce space) from its own sensor. Fitted: the free mechanical parameters, the initial body
+//! states and the position offsets (which also absorb the static shift of a pressure offset).
 
 use stirling_dsl::Model;
 

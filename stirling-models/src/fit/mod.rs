@@ -1,11 +1,13 @@
-//! Identification from measured data, the seed's two stages (Figures 3-5):
-//! stage 1 fits the mechanics driven by the measured pressure, stage 2 the gas model driven by
-//! the measured displacements ([`driven`](crate::fit::driven)), each by Levenberg-Marquardt ([`lm`](crate::fit::lm)) on forward
-//! sensitivities ([`sensitivity`](crate::fit::sensitivity)), with a statistical report ([`report`](crate::fit::report)).
+//! Identification from measured data, the seed's two stages (Figures 3-5): stage 1 fits the
+//! mechanics driven by the measured pressure, stage 2 the gas model driven by the measured
+//! displacements ([`driven`](crate::fit::driven)), each by Levenberg-Marquardt
+//! ([`lm`](crate::fit::lm)) on forward sensitivities ([`sensitivity`](crate::fit::sensitivity)),
+//! with a statistical report ([`report`](crate::fit::report)).
 //!
 //! Then, optionally, a multiple-shooting refinement over short free-running segments
-//! ([`multiple_shooting`](crate::fit::multiple_shooting)) and a free-run validation from the measured initial state
-//! ([`free_run`](crate::fit::free_run)), since a self-excited oscillator drifts in phase.
+//! ([`multiple_shooting`](crate::fit::multiple_shooting)) and a free-run validation from the
+//! measured initial state ([`free_run`](crate::fit::free_run)), since a self-excited oscillator
+//! drifts in phase.
 
 /// Which free parameter belongs to which stage.
 pub mod classify;

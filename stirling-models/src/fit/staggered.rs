@@ -1,7 +1,8 @@
-//! The staggered integration of a [`Driven`] system: its free states as an [`OdeSystem`] of
-//! their own and its sensitivity columns as a [`SensSystem`], so that diffsol's sensitivity
-//! BDF corrects every column with the states' own Newton factorization
-//! ([`crate::sim::sens`]) instead of integrating the augmented system `[z, S]`.
+//! The staggered integration of a [`Driven`](crate::fit::sensitivity::Driven) system: its free
+//! states as an [`OdeSystem`](crate::sim::OdeSystem) of their own and its sensitivity columns as a
+//! [`SensSystem`](crate::sim::SensSystem), so that diffsol's sensitivity BDF corrects every column
+//! with the states' own Newton factorization ([`crate::sim::sens`]) instead of integrating the
+//! augmented system `[z, S]`.
 
 use std::cell::RefCell;
 

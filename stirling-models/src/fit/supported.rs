@@ -1,10 +1,10 @@
-//! Which declared engines the two stages can fit: the measured `p` is read as the pressure
-//! of the working gas's last control volume and the hot side's as its first, with the
-//! sections between them interpolated (the working gas: the CVs joined by mass-flow links to
-//! the one `p` observes, [`StateLayout::working_gas`]). A CV outside it - a closed bounce
-//! space - has a pressure of its own: it must carry a declared sensor the record measures
-//! ([`outside_channels`]), or the model is refused with the CV's name; it is never given the
-//! working gas's pressure.
+//! Which declared engines the two stages can fit: the measured `p` is read as the pressure of the
+//! working gas's last control volume and the hot side's as its first, with the sections between
+//! them interpolated (the working gas: the CVs joined by mass-flow links to the one `p` observes,
+//! [`StateLayout::working_gas`](crate::layout::StateLayout::working_gas)). A CV outside it - a
+//! closed bounce space - has a pressure of its own: it must carry a declared sensor the record
+//! measures ([`outside_channels`](crate::fit::supported::outside_channels)), or the model is
+//! refused with the CV's name; it is never given the working gas's pressure.
 //!
 //! The sensors a model declares (`sensor p: P_cold "Pa";`) must say the same of the four
 //! channels the stages read: `x`, `y` on the two bodies' positions, `p` on the working gas's

@@ -1,7 +1,7 @@
-//! Pressures the mechanics need but the record lacks (the seed's engine measured only the
-//! cold-side `p`): the gas stage, driven by the measured positions, computes every CV's
-//! pressure; its differences to the cold side, `P_i - P_cold`, join the measured `p` as the
-//! prescribed pressures of stage 1 (see [`crate::fit::mechanics`]).
+//! Pressures the mechanics need but the record lacks (the seed's engine measured only the cold-side
+//! `p`): the gas stage, driven by the measured positions, computes every CV's pressure; its
+//! differences to the cold side, `P_i - P_cold`, join the measured `p` as the prescribed pressures
+//! of stage 1 (see [`crate::fit::mechanics`]).
 //!
 //! Why this route: the regenerator pressure drop is set almost entirely by the flow, which
 //! the measured positions fix, so the gas stage predicts it well without any mechanical

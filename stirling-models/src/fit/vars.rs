@@ -64,8 +64,8 @@ pub enum VarKind {
     Param(usize),
     /// The initial value of free state number `pos`.
     Initial(usize),
-    /// An additive offset of output `out`; `du` (per [`Given`], may be empty) is how the
-    /// prescribed inputs move per unit of the offset.
+    /// An additive offset of output `out`; `du` (per [`Given`](super::sensitivity::Given), may be
+    /// empty) is how the prescribed inputs move per unit of the offset.
     Offset { out: usize, du: Vec<f64> },
     /// A sensor distortion (see [`Sensor`]); its column is a central difference of two runs.
     Sensor(Sensor),
@@ -82,7 +82,8 @@ pub enum VarKind {
 #[derive(Clone, Debug)]
 pub enum Sensor {
     /// `measured = (1 + g) true`: the prescribed states `given` (indices into
-    /// [`Stage::given`]) are divided by `1 + g`, the outputs `outputs` multiplied by it.
+    /// [`Stage::given`](super::driven::Stage::given)) are divided by `1 + g`, the outputs `outputs`
+    /// multiplied by it.
     Gain {
         given: Vec<usize>,
         outputs: Vec<usize>,

@@ -4,33 +4,37 @@
 //! **Operator.** `(J_s - sigma I)^-1` with `J_s = D^-1 J D` (`D` the state scales of
 //! [`crate::linear::equilibrium::state_scales`]: a similarity, so the same eigenvalues, but Krylov
 //! vectors whose entries are comparable across pressures, masses and positions), applied by a
-//! complex faer sparse LU ([`crate::linear::sparse::ShiftedSolver`]; the symbolic
-//! analysis is shared by all shifts). A Ritz value `theta` of the operator is the pole
-//! `lambda = sigma + 1/theta`.
+//! complex faer sparse LU ([`crate::linear::sparse::ShiftedSolver`]; the symbolic analysis is
+//! shared by all shifts). A Ritz value `theta` of the operator is the pole `lambda = sigma +
+//! 1/theta`.
 //!
 //! **Inventory.** With mass states, `c J = 0` (`c` = ones on the masses), so `ker c` is
 //! invariant under `J` and under `(J - sigma I)^-1` (`sigma != 0`). The start vector is put in
 //! `ker c` and every new Krylov vector is projected back onto it (only round-off is removed), so
 //! the Ritz values are poles of the reduced `T' J T` and the inventory's zero is never returned.
 //!
-//! **Arnoldi.** `m` steps ([`DominantOptions::krylov`]) with full reorthogonalization (classical
-//! Gram-Schmidt, twice), the Ritz pairs from the eigendecomposition of the `m x m` Hessenberg
-//! matrix. A Ritz pair `(theta, x = V y)` counts as converged when its Ritz residual relative to
-//! `theta`, `|OP x - theta x| / |theta x| = |h_{m+1,m} y_m| / (|theta| |y|)`, is below
-//! [`DominantOptions::tol`]: that is the relative accuracy of `theta`, i.e. of `lambda - sigma`
-//! (ARPACK's rule). A residual of `J_s` itself relative to `|lambda|` cannot go below
-//! `eps |J_s| / |lambda|` (`|J_s|` ~ 1e7 1/s from the pressure-equalization modes, 1e2 for the
-//! working pair) and would reject the working poles at large n.
+//! **Arnoldi.** `m` steps
+//! ([`DominantOptions::krylov`](crate::linear::dominant::DominantOptions::krylov)) with full
+//! reorthogonalization (classical Gram-Schmidt, twice), the Ritz pairs from the eigendecomposition
+//! of the `m x m` Hessenberg matrix. A Ritz pair `(theta, x = V y)` counts as converged when its
+//! Ritz residual relative to `theta`, `|OP x - theta x| / |theta x| = |h_{m+1,m} y_m| / (|theta|
+//! |y|)`, is below [`DominantOptions::tol`](crate::linear::dominant::DominantOptions::tol): that is
+//! the relative accuracy of `theta`, i.e. of `lambda - sigma` (ARPACK's rule). A residual of `J_s`
+//! itself relative to `|lambda|` cannot go below `eps |J_s| / |lambda|` (`|J_s|` ~ 1e7 1/s from the
+//! pressure-equalization modes, 1e2 for the working pair) and would reject the working poles at
+//! large n.
 //!
-//! **Shift rule.** The working frequency is not known in advance. 1) Scan: shifts `j w_k`,
-//! `w_k` log-spaced over [`DominantOptions::band_rad_s`] ([`DominantOptions::per_decade`] per
-//! decade), one Arnoldi run each; every converged Ritz value joins a pool (lower-half-plane
-//! values by their conjugates, duplicates merged by the smaller residual). 2) Refine: at the
-//! rightmost pole of the pool, shifted by `1e-3 |lambda|` along the imaginary axis, one more
-//! Arnoldi run; its converged values replace their neighbours in the pool. 3) Keep the `k`
-//! rightmost poles of the pool (a conjugate pair is never split, so up to `k + 1`). The result is
-//! the rightmost of what lies near the band; a pole far from every shift (for example a very
-//! fast real pressure mode) is not sought: the engine's working modes are not those.
+//! **Shift rule.** The working frequency is not known in advance. 1) Scan: shifts `j w_k`, `w_k`
+//! log-spaced over
+//! [`DominantOptions::band_rad_s`](crate::linear::dominant::DominantOptions::band_rad_s)
+//! ([`DominantOptions::per_decade`](crate::linear::dominant::DominantOptions::per_decade) per
+//! decade), one Arnoldi run each; every converged Ritz value joins a pool (lower-half-plane values
+//! by their conjugates, duplicates merged by the smaller residual). 2) Refine: at the rightmost
+//! pole of the pool, shifted by `1e-3 |lambda|` along the imaginary axis, one more Arnoldi run; its
+//! converged values replace their neighbours in the pool. 3) Keep the `k` rightmost poles of the
+//! pool (a conjugate pair is never split, so up to `k + 1`). The result is the rightmost of what
+//! lies near the band; a pole far from every shift (for example a very fast real pressure mode) is
+//! not sought: the engine's working modes are not those.
 //!
 //! No maintained Rust crate does this on faer matrices (`arpack` 0.0.x binds a system
 //! ARPACK-NG and offers one eigenpair of fixed kind), hence this module.

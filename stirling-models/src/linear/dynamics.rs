@@ -1,11 +1,14 @@
-//! Steps 1-4 of [`crate::linear::linearize`]: equilibrium, Jacobian, inventory reduction and poles, by
-//! one of two routes chosen by size ([`PoleRequest::Auto`]):
+//! Steps 1-4 of [`crate::linear::linearize`]: equilibrium, Jacobian, inventory reduction and poles,
+//! by one of two routes chosen by size
+//! ([`PoleRequest::Auto`](crate::linear::dynamics::PoleRequest::Auto)):
 //!
-//! - **dense** (up to [`DOMINANT_FROM`]` - 1` states, or when all poles are asked for): the dense
-//!   Jacobian, `T' J T` and all its eigenvalues ([`crate::linear::poles`]);
-//! - **sparse dominant** (from [`DOMINANT_FROM`] states): the Jacobian as triplets, the
-//!   equilibrium by the sparse Newton, and the rightmost poles by shift-invert Arnoldi
-//!   ([`crate::linear::dominant`]); `jacobian` and `reduction.a` are then empty (`0 x 0`).
+//! - **dense** (up to [`DOMINANT_FROM`](crate::linear::dynamics::DOMINANT_FROM)` - 1` states, or
+//!   when all poles are asked for): the dense Jacobian, `T' J T` and all its eigenvalues
+//!   ([`crate::linear::poles`]);
+//! - **sparse dominant** (from [`DOMINANT_FROM`](crate::linear::dynamics::DOMINANT_FROM) states):
+//!   the Jacobian as triplets, the equilibrium by the sparse Newton, and the rightmost poles by
+//!   shift-invert Arnoldi ([`crate::linear::dominant`]); `jacobian` and `reduction.a` are then
+//!   empty (`0 x 0`).
 
 use nalgebra::DMatrix;
 use serde::{Deserialize, Serialize};

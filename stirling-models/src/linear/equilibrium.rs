@@ -6,8 +6,9 @@
 //! so `J` is singular: the last mass equation is replaced by the inventory constraint
 //! `c x = c x0` (the charge of the guess), which makes the system regular.
 //!
-//! Above [`SPARSE_FROM`] states the Newton system is solved by a faer sparse LU of the
-//! Jacobian triplets (same matrix, same row replacement); below, by the dense LU as before.
+//! Above [`SPARSE_FROM`](crate::linear::equilibrium::SPARSE_FROM) states the Newton system is
+//! solved by a faer sparse LU of the Jacobian triplets (same matrix, same row replacement); below,
+//! by the dense LU as before.
 //!
 //! Residuals are scaled per state: `r_i = |f_i| / s_i` with `s_i = max(|x0_i|, floor(kind))`,
 //! i.e. the relative rate of change of each state, in 1/s.

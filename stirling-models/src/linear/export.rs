@@ -4,12 +4,12 @@
 //! (`control.ss(A, B, C, D)`) and MATLAB (`ss(A, B, C, D)` after `jsondecode`) read directly.
 //!
 //! `A` has the poles the report gives: with the `full` closure it is reduced by the inventory
-//! constraint, so it has no zero eigenvalue from the conserved mass. The reduction eliminates
-//! the last mass state (`m_last - m_last* = -` the sum of the other mass deviations at constant
+//! constraint, so it has no zero eigenvalue from the conserved mass. The reduction eliminates the
+//! last mass state (`m_last - m_last* = -` the sum of the other mass deviations at constant
 //! charge): the coordinates keep the model's state names and `A` keeps its sparsity, and it is
-//! similar to the orthogonal reduction of [`crate::linear::reduce`]. `basis` gives `T` with
-//! `x - x* = T z`. From [`SPARSE_FROM`] states on `A` is also written as triplets, above
-//! [`DENSE_UP_TO`] only so.
+//! similar to the orthogonal reduction of [`crate::linear::reduce`]. `basis` gives `T` with `x - x*
+//! = T z`. From [`SPARSE_FROM`](crate::linear::export::SPARSE_FROM) states on `A` is also written
+//! as triplets, above [`DENSE_UP_TO`](crate::linear::export::DENSE_UP_TO) only so.
 
 use nalgebra::{DMatrix, DVector};
 use serde::{Deserialize, Serialize};

@@ -4,16 +4,17 @@
 //! back from the states: `x' = A0 x + B u`, `u = -K x`, with `A0 - B K = J`. The open loop is
 //! `L(s) = K (sI - A0)^-1 B` (negative feedback, as MATLAB's `margin`).
 //!
-//! - Channel [`Channel::Body`]`(k)`: `u` is the pressure force on body `k`. `B = e_v / m_k`
-//!   (`e_v` the unit vector of the body's velocity, `m_k` its declared mass),
-//!   `C = grad F_k`, `K = -C`, `A0 = J - B C`; the other bodies' forces stay closed.
-//! - Channel [`Channel::Pressure`] (single-pressure models such as `schmidt` and `cv1`): `u` is
-//!   the common pressure `P - P_eq` acting on every face. Then `grad F_k = a_k grad P` for all
-//!   bodies, `B = sum_k a_k e_vk / m_k`, `C = grad P`, `K = -C`. The face sums `a_k` and
-//!   `grad P` are recovered from the force gradients up to one scalar, fixed by the slope of the
-//!   varying vessel pressure of [`Model::pv`] along `grad F` (a central difference; the scale does not
-//!   change `L`, only the units of `B` and `C`). For `schmidt` this gives
-//!   `B = [0, -Ar/md, 0, -(A-Ar)/mp]'` and `u = P - Pmean`.
+//! - Channel [`Channel::Body`](crate::linear::loop_break::Channel::Body)`(k)`: `u` is the pressure
+//!   force on body `k`. `B = e_v / m_k` (`e_v` the unit vector of the body's velocity, `m_k` its
+//!   declared mass), `C = grad F_k`, `K = -C`, `A0 = J - B C`; the other bodies' forces stay
+//!   closed.
+//! - Channel [`Channel::Pressure`](crate::linear::loop_break::Channel::Pressure) (single-pressure
+//!   models such as `schmidt` and `cv1`): `u` is the common pressure `P - P_eq` acting on every
+//!   face. Then `grad F_k = a_k grad P` for all bodies, `B = sum_k a_k e_vk / m_k`, `C = grad P`,
+//!   `K = -C`. The face sums `a_k` and `grad P` are recovered from the force gradients up to one
+//!   scalar, fixed by the slope of the varying vessel pressure of [`Model::pv`] along `grad F` (a
+//!   central difference; the scale does not change `L`, only the units of `B` and `C`). For
+//!   `schmidt` this gives `B = [0, -Ar/md, 0, -(A-Ar)/mp]'` and `u = P - Pmean`.
 
 use nalgebra::{DMatrix, DVector};
 use serde::Serialize;

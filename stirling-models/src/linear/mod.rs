@@ -1,21 +1,28 @@
 //! Linear analysis of any generated model (docs/physics.md sections 6-7).
 //!
-//! The pipeline of [`linearize`]:
-//! 1. [`equilibrium`](crate::linear::equilibrium): `f(x*) = 0` by Newton with the analytic Jacobian (mass constraint with `full`);
+//! The pipeline of [`linearize`](crate::linear::linearize):
+//! 1. [`equilibrium`](crate::linear::equilibrium): `f(x*) = 0` by Newton with the analytic Jacobian
+//! (mass constraint with `full`);
 //! 2. `J = df/dx (x*)` from the generated Jacobian;
-//! 3. [`reduce`](crate::linear::reduce): the dynamic part `T' J T` on `ker c` and the inventory mode;
+//! 3. [`reduce`](crate::linear::reduce): the dynamic part `T' J T` on `ker c` and the inventory
+//! mode;
 //! 4. [`poles`](crate::linear::poles): the closed-loop poles `eig(T' J T)`;
-//! 5. [`loop_break`](crate::linear::loop_break): the loop broken at a pressure-force (or common-pressure) input,
-//!    `L(s) = K (sI - A0)^-1 B` with `A0 - B K = J`, evaluated by [`response`](crate::linear::response);
-//! 6. [`margins`](crate::linear::margins) of `L(jw)` as MATLAB's `margin`, and [`bode`](crate::linear::bode) / Nyquist data.
+//! 5. [`loop_break`](crate::linear::loop_break): the loop broken at a pressure-force (or
+//! common-pressure) input, `L(s) = K (sI - A0)^-1 B` with `A0 - B K = J`, evaluated by
+//! [`response`](crate::linear::response);
+//! 6. [`margins`](crate::linear::margins) of `L(jw)` as MATLAB's `margin`, and
+//! [`bode`](crate::linear::bode) / Nyquist data.
 //!
-//! Large models (from [`dynamics::DOMINANT_FROM`](crate::linear::dynamics::DOMINANT_FROM) states) take a sparse route: the Newton
-//! system by sparse LU, the dominant poles by shift-invert Arnoldi ([`dominant`](crate::linear::dominant)), `L(jw)` by a
-//! sparse solve per frequency on the full state ([`sparse_response`](crate::linear::sparse_response)); [`DynamicPoles::route`]
-//! and [`LinearReport::route`] say which route was taken.
+//! Large models (from [`dynamics::DOMINANT_FROM`](crate::linear::dynamics::DOMINANT_FROM) states)
+//! take a sparse route: the Newton system by sparse LU, the dominant poles by shift-invert Arnoldi
+//! ([`dominant`](crate::linear::dominant)), `L(jw)` by a sparse solve per frequency on the full
+//! state ([`sparse_response`](crate::linear::sparse_response));
+//! [`DynamicPoles::route`](crate::linear::DynamicPoles::route) and
+//! [`LinearReport::route`](crate::linear::LinearReport::route) say which route was taken.
 //!
-//! [`locus`](crate::linear::locus) repeats 1-4 over a parameter range. [`LinearReport`] is the serializable summary
-//! that `stirling linearize --json` prints.
+//! [`locus`](crate::linear::locus) repeats 1-4 over a parameter range.
+//! [`LinearReport`](crate::linear::LinearReport) is the serializable summary that `stirling
+//! linearize --json` prints.
 
 /// Diagonal balancing (Parlett-Reinsch, radix 2).
 pub mod balance;

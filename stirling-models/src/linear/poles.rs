@@ -2,8 +2,8 @@
 //!
 //! The matrix is balanced first ([`crate::linear::balance`]); the eigenvalues come from faer's real
 //! Schur decomposition, which is fast enough for `nsection` at n = 1000 (2007 dynamic states).
-//! Conjugate pairs are made exactly symmetric. Poles are sorted by decreasing real part
-//! (the least stable first); within a pair the positive imaginary part comes first.
+//! Conjugate pairs are made exactly symmetric. Poles are sorted by decreasing real part (the least
+//! stable first); within a pair the positive imaginary part comes first.
 
 use faer::Mat;
 use nalgebra::DMatrix;

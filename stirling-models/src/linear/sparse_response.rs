@@ -2,16 +2,16 @@
 //! state, `A0 = J - B C`, never forming the dense reduced matrix.
 //!
 //! With mass states `A0` keeps the inventory zero of `J` (`c A0 = -(c B) C = 0`, `B` acts on
-//! velocities) but `B` lies in the invariant `ker c`, so `(sI - A0)^-1 B` lies there too and
-//! equals the reduced response. `sI - A0` is singular only at `s = 0` (the inventory zero),
-//! and `L` is evaluated on `s = jw`, `w > 0` (the analysis grid, the margins' searches), so the
-//! system is solved as it is. (It used to replace the last mass equation by `c z = 0`, as the
-//! equilibrium's Newton system does, to stay regular at `s = 0`; that dense row made the
-//! factorization's fronts dense: `linearize --n 1000` spent 47 s in those solves.) At `s = 0`
-//! alone the constraint is used, by Sherman-Morrison on the sparse matrix
-//! ([`crate::linear::sparse::solve_weighted_constrained`]). The system is scaled by
-//! the state scales `D` and solved by the complex sparse LU of
-//! [`crate::linear::sparse::ShiftedSolver`] (symbolic analysis once).
+//! velocities) but `B` lies in the invariant `ker c`, so `(sI - A0)^-1 B` lies there too and equals
+//! the reduced response. `sI - A0` is singular only at `s = 0` (the inventory zero), and `L` is
+//! evaluated on `s = jw`, `w > 0` (the analysis grid, the margins' searches), so the system is
+//! solved as it is. (It used to replace the last mass equation by `c z = 0`, as the equilibrium's
+//! Newton system does, to stay regular at `s = 0`; that dense row made the factorization's fronts
+//! dense: `linearize --n 1000` spent 47 s in those solves.) At `s = 0` alone the constraint is
+//! used, by Sherman-Morrison on the sparse matrix
+//! ([`crate::linear::sparse::solve_weighted_constrained`]). The system is scaled by the state
+//! scales `D` and solved by the complex sparse LU of [`crate::linear::sparse::ShiftedSolver`]
+//! (symbolic analysis once).
 
 use faer::c64;
 use nalgebra::{Complex, DVector};

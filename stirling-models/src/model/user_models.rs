@@ -1,6 +1,6 @@
-//! Models a user's crate registers at start-up, so that the command line (and every lookup by
-//! name) serves them like the family: a binary calls [`register`] for each of its declared
-//! engines, then runs the command line (`stirling_cli::main()`).
+//! Models a user's crate registers at start-up, so that the command line (and every lookup by name)
+//! serves them like the family: a binary calls [`register`](crate::model::user_models::register)
+//! for each of its declared engines, then runs the command line (`stirling_cli::main()`).
 
 use std::sync::{OnceLock, RwLock};
 

@@ -3,10 +3,11 @@
 //! the selected gain and phase margins marked at their crossovers and written above the
 //! panels (never over the curve).
 //!
-//! [`loop_bode`] is the one Bode figure of a [`Linearization`] (the CLI's `linearize --plot`
-//! and the examples draw the same): the broken loop named in the title, over the frequencies
-//! of the dominant poles (a decade below the slowest to a decade above the fastest, whole
-//! decades), not over the stiff gas poles.
+//! [`loop_bode`](crate::plot::bode::loop_bode) is the one Bode figure of a
+//! [`Linearization`](crate::linear::Linearization) (the CLI's `linearize --plot` and the examples
+//! draw the same): the broken loop named in the title, over the frequencies of the dominant poles
+//! (a decade below the slowest to a decade above the fastest, whole decades), not over the stiff
+//! gas poles.
 
 use std::path::Path;
 

@@ -1,7 +1,7 @@
-//! Root locus: the poles at every parameter value of a [`Locus`], coloured from blue (first
-//! value) to red (last) with a colour bar giving the parameter and its unit; the right half
-//! plane shaded as in the pole map; where the number of right-half-plane poles changes (the
-//! stability crossing) the poles of the first value past it are ringed and the value named.
+//! Root locus: the poles at every parameter value of a [`Locus`](crate::linear::Locus), coloured
+//! from blue (first value) to red (last) with a colour bar giving the parameter and its unit; the
+//! right half plane shaded as in the pole map; where the number of right-half-plane poles changes
+//! (the stability crossing) the poles of the first value past it are ringed and the value named.
 
 use std::path::Path;
 

@@ -16,9 +16,9 @@ pub fn first_order_lag(u: &[f64], dt: f64, tau: f64) -> Vec<f64> {
 
 /// Remove the cosines `k = 1..=m` (DCT-II, orthogonal on the uniform grid) from `v`.
 ///
-/// The cosines depend only on `(n, k)`: they are computed once per thread and kept
-/// ([`cosine`]), so the fits, which project every residual and Jacobian column at every
-/// evaluation, do not recompute them (they took 4 % of a diagnosis).
+/// The cosines depend only on `(n, k)`: they are computed once per thread and kept (`cosine`), so
+/// the fits, which project every residual and Jacobian column at every evaluation, do not recompute
+/// them (they took 4 % of a diagnosis).
 pub fn project_drift(v: &mut [f64], m: usize) {
     let n = v.len();
     if n < 2 {

@@ -1,7 +1,7 @@
-//! The diffsol adapter: an [`OdeSystem`] as diffsol `OdeEquations`, handing the
-//! solver the full analytic Jacobian (no colouring, no Jacobian-vector probing).
+//! The diffsol adapter: an [`OdeSystem`](crate::sim::OdeSystem) as diffsol `OdeEquations`, handing
+//! the solver the full analytic Jacobian (no colouring, no Jacobian-vector probing).
 //!
-//! Two linear-algebra backends share one adapter ([`Backend`]):
+//! Two linear-algebra backends share one adapter ([`Backend`](crate::sim::adapter::Backend)):
 //! - dense: `NalgebraMat` + `NalgebraLU`, the Jacobian written column-major;
 //! - sparse: `FaerSparseMat` + `FaerSparseLU`, the pattern from
 //!   [`OdeSystem::sparsity`] (united with the entries present at the initial

@@ -3,13 +3,13 @@
 //! the solver `diag(I - cJ, ..., I - cJ)`, one copy of the state block per column.
 //!
 //! Why our own: faer's sparse LU factors every block of that matrix anew (on the `p, x, y`
-//! diagnosis it took a third of the run), and diffsol's dense LU factors the whole
-//! `(k + 1) nz` matrix. This solver reads the pattern once ([`block_size`]), factors each
-//! *distinct* block once per Newton-matrix update (dense LU, nalgebra) and solves every block
-//! with the factorization of the block it equals, so `k + 1` equal blocks cost one `nz x nz`
-//! factorization (the staggered corrector of CVODES' sensitivities). Blocks are compared by
-//! value, so a block-diagonal matrix whose blocks differ is still solved exactly; a pattern
-//! that is not block-diagonal with equal block sizes falls back to the refactoring sparse LU
+//! diagnosis it took a third of the run), and diffsol's dense LU factors the whole `(k + 1) nz`
+//! matrix. This solver reads the pattern once ([`block_size`](crate::sim::block_lu::block_size)),
+//! factors each *distinct* block once per Newton-matrix update (dense LU, nalgebra) and solves
+//! every block with the factorization of the block it equals, so `k + 1` equal blocks cost one `nz
+//! x nz` factorization (the staggered corrector of CVODES' sensitivities). Blocks are compared by
+//! value, so a block-diagonal matrix whose blocks differ is still solved exactly; a pattern that is
+//! not block-diagonal with equal block sizes falls back to the refactoring sparse LU
 //! ([`crate::sim::refactor_lu`]).
 
 use diffsol::{FaerContext, FaerSparseMat, FaerVec, LaError, Matrix, MatrixCommon, Vector};

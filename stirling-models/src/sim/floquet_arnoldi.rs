@@ -3,15 +3,18 @@
 //!
 //! **Operator.** `D^-1 Phi D` (state-scaled, the same spectrum as `Phi`) applied by
 //! [`crate::sim::tangent::TangentFlow::apply`]. The spectrum of a stiff engine's monodromy is a
-//! handful of multipliers of order one (the trivial 1, twice with the inventory, the
-//! slow thermal and mechanical modes) and a cloud at `|mu| ~ 0` (the pressure-equalization
-//! modes, damped by `exp(-T / tau)` with `tau` far below the period, and by L-stability
-//! of the Radau steps): plain Arnoldi converges on the leading ones in a few dozen products.
+//! handful of multipliers of order one (the trivial 1, twice with the inventory, the slow thermal
+//! and mechanical modes) and a cloud at `|mu| ~ 0` (the pressure-equalization modes, damped by
+//! `exp(-T / tau)` with `tau` far below the period, and by L-stability of the Radau steps): plain
+//! Arnoldi converges on the leading ones in a few dozen products.
 //!
-//! **Arnoldi.** Full reorthogonalization (classical Gram-Schmidt, twice), a fixed
-//! pseudo-random start vector; every [`ArnoldiOptions::check_every`] steps the eigenvalues
-//! of the `j x j` Hessenberg matrix (nalgebra) give Ritz values, and the run stops when the
-//! `k` leading ones moved by less than [`ArnoldiOptions::tol`] (relative to `max(1, |mu|)`)
+//! **Arnoldi.** Full reorthogonalization (classical Gram-Schmidt, twice), a fixed pseudo-random
+//! start vector; every
+//! [`ArnoldiOptions::check_every`](crate::sim::floquet_arnoldi::ArnoldiOptions::check_every) steps
+//! the eigenvalues of the `j x j` Hessenberg matrix (nalgebra) give Ritz values, and the run stops
+//! when the `k` leading ones moved by less than
+//! [`ArnoldiOptions::tol`](crate::sim::floquet_arnoldi::ArnoldiOptions::tol) (relative to `max(1,
+//! |mu|)`)
 //! since the previous check, or on breakdown (an invariant subspace: the Ritz values are
 //! then exact). The linear-analysis Arnoldi (`linear::dominant`) is complex shift-invert
 //! with a Ritz-residual rule on faer LU solves; the pieces did not fit a real operator on a

@@ -1,15 +1,16 @@
 //! The step loop: adaptive BDF (diffsol, dense LU, analytic Jacobian) on any
-//! [`OdeSystem`], with output at requested sample times, upward zero crossings
-//! of one state (refined on the dense output), nonphysical-state checks after
-//! every accepted step, and solver failures mapped to [`SimError`].
+//! [`OdeSystem`](crate::sim::OdeSystem), with output at requested sample times, upward zero
+//! crossings of one state (refined on the dense output), nonphysical-state checks after every
+//! accepted step, and solver failures mapped to [`SimError`].
 //!
 //! Governing equation: `x' = f(t, x)` with error control
 //! `|err_i| <= rtol |x_i| + atol scale_i` (`scale_i` from [`OdeSystem::scale`]).
 //!
-//! Linear algebra ([`LinearSolverKind`]): dense nalgebra LU (`O(n^3)` per
-//! factorization) for small systems, faer sparse LU on the structural pattern of
-//! [`OdeSystem::sparsity`] for systems of more than [`SPARSE_THRESHOLD`] states
-//! (by default; `nsection` at n = 1000, 2008 states, needs it).
+//! Linear algebra ([`LinearSolverKind`](crate::sim::integrate::LinearSolverKind)): dense nalgebra
+//! LU (`O(n^3)` per factorization) for small systems, faer sparse LU on the structural pattern of
+//! [`OdeSystem::sparsity`] for systems of more than
+//! [`SPARSE_THRESHOLD`](crate::sim::integrate::SPARSE_THRESHOLD) states (by default; `nsection` at
+//! n = 1000, 2008 states, needs it).
 
 use diffsol::{DiffsolError, NalgebraLU, OdeBuilder, OdeSolverMethod, OdeSolverStopReason};
 use serde::Serialize;

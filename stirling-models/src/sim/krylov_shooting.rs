@@ -1,10 +1,10 @@
-//! Newton-Krylov shooting: the limit cycle and its leading Floquet multipliers without
-//! the dense monodromy matrix, for cycles above [`crate::sim::SHOOTING_MAX_STATES`] states.
+//! Newton-Krylov shooting: the limit cycle and its leading Floquet multipliers without the dense
+//! monodromy matrix, for cycles above [`crate::sim::SHOOTING_MAX_STATES`] states.
 //!
-//! Same unknowns `(x0, T)`, scaling, section and inventory as [`crate::sim::shooting::shoot`];
-//! the Newton system is solved matrix-free by GMRES ([`crate::sim::gmres`]) on products
-//! `D^-1 Phi D v` from [`crate::sim::tangent`] (one BDF run of the state per Newton
-//! iteration, then linear work on the recorded steps).
+//! Same unknowns `(x0, T)`, scaling, section and inventory as [`crate::sim::shooting::shoot`]; the
+//! Newton system is solved matrix-free by GMRES ([`crate::sim::gmres`]) on products `D^-1 Phi D v`
+//! from [`crate::sim::tangent`] (one BDF run of the state per Newton iteration, then linear work on
+//! the recorded steps).
 //!
 //! **Squaring the system.** The dense route solves the `(n + 2) x (n + 1)` system
 //! (return map, section row, inventory row) by SVD least squares. It is consistent: with

@@ -1,5 +1,5 @@
-//! A dense LU for small Newton matrices whose right-hand sides come in many lanes (the
-//! sensitivity columns of [`crate::sim::sens`], `n` entries a lane, stored one after the other).
+//! A dense LU for small Newton matrices whose right-hand sides come in many lanes (the sensitivity
+//! columns of [`crate::sim::sens`], `n` entries a lane, stored one after the other).
 //!
 //! Why not diffsol's `NalgebraLU`: it solves lane by lane through nalgebra's generic
 //! triangular solves, which for the few states of a driven subsystem cost more than the

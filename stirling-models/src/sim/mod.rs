@@ -1,22 +1,28 @@
 //! Nonlinear simulation: the stiff integrator on the analytic Jacobian, limit
 //! cycles by shooting, Floquet multipliers, and cycle work.
 //!
-//! - [`integrate`](crate::sim::integrate): BDF step loop (diffsol), samples, crossings, nonphysical checks.
-//! - [`block_lu`](crate::sim::block_lu): the linear solver of repeated-block Newton matrices (sensitivity systems).
+//! - [`integrate`](mod@crate::sim::integrate): BDF step loop (diffsol), samples, crossings,
+//!   nonphysical checks.
+//! - [`block_lu`](crate::sim::block_lu): the linear solver of repeated-block Newton matrices
+//!   (sensitivity systems).
 //! - [`system`](crate::sim::system): the model, energy-quadrature and variational systems.
-//! - [`cycle`](crate::sim::cycle): periodicity from upward crossings of the piston position; amplitudes, phase.
-//! - [`shooting`](crate::sim::shooting): Newton on the return map, monodromy matrix, Floquet multipliers.
+//! - [`cycle`](crate::sim::cycle): periodicity from upward crossings of the piston position;
+//!   amplitudes, phase.
+//! - [`shooting`](crate::sim::shooting): Newton on the return map, monodromy matrix, Floquet
+//!   multipliers.
 //! - [`work`](crate::sim::work): `closed-integral P dV` per vessel, indicated power.
 //!
-//! [`limit_cycle`] chains them: settle from a perturbed state, shoot, measure.
-//! Up to [`SHOOTING_MAX_STATES`] states it shoots with the dense monodromy, above
-//! (up to [`KRYLOV_SHOOTING_MAX_STATES`]) by Newton-Krylov with the leading Floquet
-//! multipliers by Arnoldi, above that it measures the settled cycle; [`limit_cycle_with`]
-//! chooses.
+//! [`limit_cycle`](crate::sim::limit_cycle) chains them: settle from a perturbed state, shoot,
+//! measure. Up to [`SHOOTING_MAX_STATES`](crate::sim::SHOOTING_MAX_STATES) states it shoots with
+//! the dense monodromy, above (up to
+//! [`KRYLOV_SHOOTING_MAX_STATES`](crate::sim::KRYLOV_SHOOTING_MAX_STATES)) by Newton-Krylov with
+//! the leading Floquet multipliers by Arnoldi, above that it measures the settled cycle;
+//! [`limit_cycle_with`](crate::sim::limit_cycle_with) chooses.
 //!
 //! - [`monodromy`](crate::sim::monodromy): the monodromy by Radau IIA along the BDF trajectory.
 //! - [`tangent`](crate::sim::tangent): monodromy-vector products along a recorded BDF trajectory.
-//! - [`krylov_shooting`](crate::sim::krylov_shooting), [`gmres`](crate::sim::gmres), [`floquet_arnoldi`](crate::sim::floquet_arnoldi): the matrix-free route.
+//! - [`krylov_shooting`](crate::sim::krylov_shooting), [`gmres`](crate::sim::gmres),
+//!   [`floquet_arnoldi`](crate::sim::floquet_arnoldi): the matrix-free route.
 
 mod adapter;
 /// A linear solver for block-diagonal Newton matrices whose blocks repeat.

@@ -10,15 +10,14 @@
 //! Z_i - h sum_j a_ij J(t0 + c_j h) Z_j = Phi(t0)   (i = 1..3),   Phi(t0 + h) = Z_3
 //! ```
 //!
-//! One LU of the `3n x 3n` stage matrix per (sub)step serves all `n` columns of
-//! `Phi` (propagated in state-scaled form `D^-1 Phi D`): nalgebra dense LU for small `n`,
-//! the refactoring sparse LU ([`crate::sim::refactor_lu`]: column order once, on the union of the
-//! block patterns; pivots kept from step to step) above [`crate::sim::SPARSE_THRESHOLD`] states
-//! (or as [`SimOptions::linear_solver`] says). L-stability makes the stiff
-//! (pressure-equalization) modes decay to ~0 as they should; the stage matrix is a
-//! rational function of `h J`, so a left null vector of `J` (the mass inventory,
-//! `c J = 0`) stays a left eigenvector of the discrete `Phi` with multiplier 1
-//! exactly.
+//! One LU of the `3n x 3n` stage matrix per (sub)step serves all `n` columns of `Phi` (propagated
+//! in state-scaled form `D^-1 Phi D`): nalgebra dense LU for small `n`, the refactoring sparse LU
+//! ([`crate::sim::refactor_lu`]: column order once, on the union of the block patterns; pivots kept
+//! from step to step) above [`crate::sim::SPARSE_THRESHOLD`] states (or as
+//! [`SimOptions::linear_solver`] says). L-stability makes the stiff (pressure-equalization) modes
+//! decay to ~0 as they should; the stage matrix is a rational function of `h J`, so a left null
+//! vector of `J` (the mass inventory, `c J = 0`) stays a left eigenvector of the discrete `Phi`
+//! with multiplier 1 exactly.
 //!
 //! Cost per step: `O(n^3)` dense, `O(nnz(LU) n)` sparse, against the old
 //! `n (n + 1)` BDF states with an `n^2 x n^2` dense iteration matrix.

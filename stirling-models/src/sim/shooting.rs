@@ -17,12 +17,12 @@
 //! direction), and with the `full` closure a second one is 1 (the conserved
 //! inventory); the cycle is orbitally stable when all others lie inside the unit circle.
 //!
-//! The monodromy comes by default from [`crate::sim::monodromy`]: one BDF run of the
-//! state and a 3-stage Radau IIA propagation of `Phi` along its steps (one LU of
-//! a `3n x 3n` stage matrix per step for all columns, sparse for large `n`).
-//! [`MonodromyMethod::Variational`] keeps the reference route: the `n (n + 1)`-state
-//! variational system under the adaptive BDF (dense iteration matrix; a few dozen
-//! states at most).
+//! The monodromy comes by default from [`crate::sim::monodromy`]: one BDF run of the state and a
+//! 3-stage Radau IIA propagation of `Phi` along its steps (one LU of a `3n x 3n` stage matrix per
+//! step for all columns, sparse for large `n`).
+//! [`MonodromyMethod::Variational`](crate::sim::shooting::MonodromyMethod::Variational) keeps the
+//! reference route: the `n (n + 1)`-state variational system under the adaptive BDF (dense
+//! iteration matrix; a few dozen states at most).
 
 use nalgebra::{DMatrix, DVector};
 use stirling_dsl::{Model, StateKind};

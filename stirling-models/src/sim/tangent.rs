@@ -1,28 +1,28 @@
-//! Monodromy-vector products `Phi v` without the monodromy matrix: the directional
-//! (one-column) form of [`crate::sim::monodromy`].
+//! Monodromy-vector products `Phi v` without the monodromy matrix: the directional (one-column)
+//! form of [`crate::sim::monodromy`].
 //!
-//! [`flow_with_tangent`] integrates the state once by the adaptive BDF and records, for
-//! every accepted step (split into `substeps` equal parts), the step `(t0, h)` and the
-//! state at the three Radau IIA stage times from the dense output. [`TangentFlow::apply`]
-//! then advances one vector `v` along the recorded steps by the same 3-stage Radau IIA
-//! stage system as the dense route,
+//! [`flow_with_tangent`](crate::sim::tangent::flow_with_tangent) integrates the state once by the
+//! adaptive BDF and records, for every accepted step (split into `substeps` equal parts), the step
+//! `(t0, h)` and the state at the three Radau IIA stage times from the dense output.
+//! [`TangentFlow::apply`](crate::sim::tangent::TangentFlow::apply) then advances one vector `v`
+//! along the recorded steps by the same 3-stage Radau IIA stage system as the dense route,
 //!
 //! ```text
 //! (I - h A (x) J_s(t0 + c_j h)) K = (v, v, v),   v <- K_3,
 //! ```
 //!
-//! in state-scaled form (`J_s = D^-1 J D`), so a product is `D^-1 Phi D v` with the
-//! same discrete `Phi` as [`crate::sim::monodromy::flow_with_monodromy_radau`] (to round-off:
-//! same steps, same stage states, same stage matrices). The stage matrix is factored by the
-//! refactoring sparse LU ([`crate::sim::refactor_lu`]: column order once, pivots kept from step
-//! to step); the factors' values of the first steps are kept up to [`TangentFlow`]'s memory
-//! budget, so repeated products (GMRES, Arnoldi) cost one triangular solve per step there
+//! in state-scaled form (`J_s = D^-1 J D`), so a product is `D^-1 Phi D v` with the same discrete
+//! `Phi` as [`crate::sim::monodromy::flow_with_monodromy_radau`] (to round-off: same steps, same
+//! stage states, same stage matrices). The stage matrix is factored by the refactoring sparse LU
+//! ([`crate::sim::refactor_lu`]: column order once, pivots kept from step to step); the factors'
+//! values of the first steps are kept up to [`TangentFlow`](crate::sim::tangent::TangentFlow)'s
+//! memory budget, so repeated products (GMRES, Arnoldi) cost one triangular solve per step there
 //! and a refactorization (no pivot search) only past the budget.
 //!
-//! Why this route and not the staggered sensitivities of [`crate::sim::sens`]: those
-//! re-run the corrector of the BDF for every direction (a full nonlinear run per
-//! product), while here a product is linear work on stored data, and it reproduces the
-//! dense route's `Phi` exactly, which the route-equality test relies on.
+//! Why this route and not the staggered sensitivities of [`crate::sim::sens`]: those re-run the
+//! corrector of the BDF for every direction (a full nonlinear run per product), while here a
+//! product is linear work on stored data, and it reproduces the dense route's `Phi` exactly, which
+//! the route-equality test relies on.
 
 use stirling_dsl::Model;
 

@@ -1,8 +1,8 @@
-//! Design sweeps: a grid over any parameters of any model; at each point the equilibrium's
-//! dominant pole, whether the engine runs, and where it does the limit cycle's frequency,
-//! strokes, phase, work and power. The points run on every core (rayon); a shard runs every
-//! `N`-th point of the grid, and [`merge`] joins the shards' results into the sweep an
-//! unsharded run gives.
+//! Design sweeps: a grid over any parameters of any model; at each point the equilibrium's dominant
+//! pole, whether the engine runs, and where it does the limit cycle's frequency, strokes, phase,
+//! work and power. The points run on every core (rayon); a shard runs every `N`-th point of the
+//! grid, and [`merge`](crate::sweep::merge) joins the shards' results into the sweep an unsharded
+//! run gives.
 
 /// The points: axes, ties, shards.
 pub mod grid;

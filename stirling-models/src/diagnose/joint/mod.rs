@@ -6,12 +6,12 @@
 //! - Model effects (leak, Coulomb friction, end stops, quadratic regenerator friction) are
 //!   parameters of the augmented model: a variable of the stage whose rows they enter, with
 //!   forward sensitivities like any parameter.
-//! - Sensor effects act on both stages: a pressure-transducer lag un-lags stage 1's pressure
-//!   input and lags stage 2's pressure output; a position gain rescales stage 1's position
-//!   outputs and stage 2's prescribed positions ([`crate::fit::driven::Sensor`]).
+//! - Sensor effects act on both stages: a pressure-transducer lag un-lags stage 1's pressure input
+//!   and lags stage 2's pressure output; a position gain rescales stage 1's position outputs and
+//!   stage 2's prescribed positions ([`Sensor`](crate::fit::vars::Sensor)).
 //!
-//! At the null of the strengths the problem is the nominal calibration, so its Jacobian there
-//! gives the score test ([`crate::diagnose::score`]) and Levenberg-Marquardt from there the joint fit.
+//! At the null of the strengths the problem is the nominal calibration, so its Jacobian there gives
+//! the score test ([`crate::diagnose::score`]) and Levenberg-Marquardt from there the joint fit.
 
 use nalgebra::DMatrix;
 use stirling_dsl::Model;

@@ -1,11 +1,12 @@
-//! The self-check. [`run_verdicts`] measures verdicts (issue 15 item 5: effects at two
-//! strengths, causes outside the library, clean records, thresholds tuned on one set of seeds
-//! and the accuracy counted on another). [`run`] and [`run_library`], the older rank check:
-//! for each effect of the library, rig data with that effect (at one or two
-//! strengths) is diagnosed against the nominal model from perturbed starting parameters; the
-//! withheld effect must rank first, and data with no added effect must give
-//! `no_significant_gap`. The diagnosis sees only the CSV the rig writes (read back from a
-//! temporary file), never the truth sidecar.
+//! The self-check. [`run_verdicts`](crate::diagnose::selfcheck::run_verdicts) measures verdicts
+//! (issue 15 item 5: effects at two strengths, causes outside the library, clean records,
+//! thresholds tuned on one set of seeds and the accuracy counted on another).
+//! [`run`](crate::diagnose::selfcheck::run) and
+//! [`run_library`](crate::diagnose::selfcheck::run_library), the older rank check: for each effect
+//! of the library, rig data with that effect (at one or two strengths) is diagnosed against the
+//! nominal model from perturbed starting parameters; the withheld effect must rank first, and data
+//! with no added effect must give `no_significant_gap`. The diagnosis sees only the CSV the rig
+//! writes (read back from a temporary file), never the truth sidecar.
 
 use std::time::Instant;
 
@@ -36,8 +37,8 @@ pub struct SelfCheckOptions {
     pub diagnose: DiagnoseOptions,
     /// Include the clean case (no added effect).
     pub clean: bool,
-    /// Channels of the rig records (see [`RigConfig::channels`]; `p_hot` is dropped for a
-    /// single-CV model).
+    /// Channels of the rig records (see [`RigConfig::channels`](crate::rig::RigConfig::channels);
+    /// `p_hot` is dropped for a single-CV model).
     pub channels: Vec<String>,
 }
 
@@ -98,7 +99,8 @@ pub struct SelfCheck {
     pub cases: Vec<Case>,
     /// Labels of rows (truth) and columns (verdict).
     pub labels: Vec<String>,
-    /// `matrix[truth][verdict]` counts; the last two columns are `unexplained` and `no_significant_gap`.
+    /// `matrix[truth][verdict]` counts; the last two columns are `unexplained` and
+    /// `no_significant_gap`.
     pub matrix: Vec<Vec<usize>>,
     pub columns: Vec<String>,
     /// Cases whose verdict is right.

@@ -1,7 +1,7 @@
 //! Multiple-shooting refinement: the training block is cut into segments of a few cycles, each
-//! simulated freely (nothing prescribed) from its own initial state; the weighted output error
-//! of all segments is minimised jointly over the free model parameters, the sensor offsets and
-//! every segment's initial state, by [`crate::fit::lm`].
+//! simulated freely (nothing prescribed) from its own initial state; the weighted output error of
+//! all segments is minimised jointly over the free model parameters, the sensor offsets and every
+//! segment's initial state, by [`crate::fit::lm`].
 //!
 //! Why: a self-excited oscillator drifts in phase over a long free run, so a single-shooting
 //! output error is dominated by the drift; over segments of about two cycles it is not, and the
@@ -9,8 +9,9 @@
 //!
 //! The Jacobian comes from forward sensitivities of each free segment, `S' = f_x S + f_p` with
 //! `S(0) = [I | 0]` (columns: initial states, then parameters), integrated as a
-//! [`Driven`] system with every state free. The segment joins are not constrained: their
-//! mismatch (the defects, in units of each state's scale) is reported as a consistency check.
+//! [`Driven`](crate::fit::sensitivity::Driven) system with every state free. The segment joins are
+//! not constrained: their mismatch (the defects, in units of each state's scale) is reported as a
+//! consistency check.
 //!
 //! Cost: each segment integrates `n (1 + n + free)` states with a dense Jacobian, so the
 //! refinement suits the small models (`cv1`: 0.3 s on 0.5 s of data); on `nsection` n = 2

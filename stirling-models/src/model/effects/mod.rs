@@ -1,17 +1,18 @@
 //! Effects the nominal models leave out (docs/physics.md section 9), as model augmentations
-//! declared through the DSL ([`models`](crate::model::effects::models)), and the registry that names them.
+//! declared through the DSL (`models.rs`), and the registry that names them.
 //!
 //! Each model effect is a set of extra parameters of an augmented family member
-//! ([`Cv1Fx`], [`NSectionFx`]) whose null values make it absent; the nominal model is the
-//! augmented model at the nulls. Sensor effects (`sensor_lag`, `sensor_gain`) act on the
-//! measured outputs, not on the model (see [`crate::rig`]).
+//! ([`Cv1Fx`](crate::model::effects::Cv1Fx), [`NSectionFx`](crate::model::effects::NSectionFx))
+//! whose null values make it absent; the nominal model is the augmented model at the nulls. Sensor
+//! effects (`sensor_lag`, `sensor_gain`) act on the measured outputs, not on the model (see
+//! [`crate::rig`]).
 //!
-//! The effects that need walls with a temperature state or the orifice law (regenerator matrix
-//! heat capacity, a heater head with finite input, the orifice leak) are declared on a third
-//! augmented member, [`NSectionExtFx`] (base name `nsection_ext`), so that the nominal models
-//! of `cv1` and `nsection` and their default candidate lists stay as they are. Not expressible
-//! yet: the closed bounce space as a control volume with its own heat port as an effect, and
-//! the end-stop contact damper `-cc v` (needs a step function of the position).
+//! The effects that need walls with a temperature state or the orifice law (regenerator matrix heat
+//! capacity, a heater head with finite input, the orifice leak) are declared on a third augmented
+//! member, [`NSectionExtFx`](crate::model::effects::NSectionExtFx) (base name `nsection_ext`), so
+//! that the nominal models of `cv1` and `nsection` and their default candidate lists stay as they
+//! are. Not expressible yet: the closed bounce space as a control volume with its own heat port as
+//! an effect, and the end-stop contact damper `-cc v` (needs a step function of the position).
 
 mod models;
 

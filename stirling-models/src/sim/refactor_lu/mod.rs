@@ -8,15 +8,16 @@
 //! arrays (faer's solve copies the right-hand side through two row permutations, which cost
 //! as much as the triangular sweeps on `nsection` at n = 100).
 //!
-//! A kept pivot can go bad when the matrix drifts (the step size and the Jacobian change
-//! from factorization to factorization); a pivot smaller than [`PIVOT_TOLERANCE`] times the
-//! largest entry below it in its column, or not finite, makes the factorization start over
-//! with fresh partial pivoting. A matrix singular even then is an error at the solve, which
-//! the integrator treats as a failed step.
+//! A kept pivot can go bad when the matrix drifts (the step size and the Jacobian change from
+//! factorization to factorization); a pivot smaller than
+//! [`PIVOT_TOLERANCE`](crate::sim::refactor_lu::PIVOT_TOLERANCE) times the largest entry below it
+//! in its column, or not finite, makes the factorization start over with fresh partial pivoting. A
+//! matrix singular even then is an error at the solve, which the integrator treats as a failed
+//! step.
 //!
-//! The factors of one matrix can be kept ([`LuSnapshot`]: the values only, the pattern is
-//! shared while the pivots hold), which is how the tangent route stores one factorization
-//! per step of a period at half the memory of faer's factors.
+//! The factors of one matrix can be kept ([`LuSnapshot`](crate::sim::refactor_lu::LuSnapshot): the
+//! values only, the pattern is shared while the pivots hold), which is how the tangent route stores
+//! one factorization per step of a period at half the memory of faer's factors.
 //!
 //! Why our own: neither faer nor diffsol has a refactorization with a fixed pivot sequence,
 //! and KLU itself is C (SuiteSparse) that the project does not otherwise need.

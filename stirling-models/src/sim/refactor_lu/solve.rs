@@ -1,7 +1,7 @@
-//! The solves with the factors of [`crate::sim::refactor_lu::RefactorLu`]: `x <- Q U^-1 L^-1 P x`, one
-//! right-hand side (the integrator's Newton steps) or many at once (the dense monodromy's
-//! columns). Two versions on purpose: the one-column sweep is the simulation's hot path and
-//! stays a plain loop; the many-column one runs each factor entry over all columns.
+//! The solves with the factors of [`crate::sim::refactor_lu::RefactorLu`]: `x <- Q U^-1 L^-1 P x`,
+//! one right-hand side (the integrator's Newton steps) or many at once (the dense monodromy's
+//! columns). Two versions on purpose: the one-column sweep is the simulation's hot path and stays a
+//! plain loop; the many-column one runs each factor entry over all columns.
 
 use super::{LuPattern, LuValues};
 
