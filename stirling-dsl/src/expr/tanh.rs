@@ -1,20 +1,22 @@
-//! `tanh` for the generated code: inlined, without a branch on the argument and without a
-//! call into libm.
+//! `tanh` for the generated code, without a call into libm on the usual path.
 //!
 //! Why not `f64::tanh`: every link of a model smooths its upwind switch with a `tanh`, and a
 //! call into libm makes the caller spill every live `xmm` register around it (they are all
-//! caller-saved in the System V ABI) and stops the processor from overlapping one section of
-//! the loop with the next. Inlined, the same value costs about 35 floating-point operations
-//! and one division that overlap with the rest of the section.
+//! caller-saved in the System V ABI) and keeps the processor from overlapping one section of
+//! the loop with the next. Here the saturated case (`|x| >= 22`, where `tanh` rounds to `+-1`:
+//! everywhere but near a flow reversal) is one compare and branch inlined into the caller; the
+//! rest (about 35 floating-point operations and one division) is out of line and cold. One
+//! branch, not two: with the NaN test inline too, the family's release build took three times
+//! as long (docs/performance.md).
 //!
-//! The method: with `a = min(|x|, 22)` (`tanh(22)` rounds to 1), `e = expm1(-2 a)` lies in
-//! `(-1, 0]` and `tanh(a) = -e / (e + 2)`, accurate in relative terms for every `a`.
-//! `y = -2 a` is reduced to `y = k ln 2 + r`, `|r| <= ln 2 / 2`, so that with `s = 2^k` and
-//! `p = expm1(r)` (its Taylor series to degree 13, remainder below 1e-17 relative),
-//! `e = s p + (s - 1)` and `tanh(a) = ((1 - s) - s p) / ((1 + s) + s p)`, where `s p`,
-//! `1 - s` and `1 + s` are exact and neither sum cancels. Accuracy: within 2 units in the last place of the exact
-//! value on 40 000 sampled points in `[1e-10, 20]` (checked against 50-digit decimals; glibc's
-//! `tanh` is also off by up to 2 there), hence within 3 of libm's (test `tanh_matches_libm`).
+//! The method: with `a = |x| < 22`, `e = expm1(-2 a)` lies in `(-1, 0]` and `tanh(a) = -e /
+//! (e + 2)`, accurate in relative terms for every `a`. `y = -2 a` is reduced to `y = k ln 2 +
+//! r`, `|r| <= ln 2 / 2`, so that with `s = 2^k` and `p = expm1(r)` (its Taylor series to
+//! degree 13, remainder below 1e-17 relative), `e = s p + (s - 1)` and `tanh(a) = ((1 - s) - s
+//! p) / ((1 + s) + s p)`, where `s p`, `1 - s` and `1 + s` are exact and neither sum cancels.
+//! Accuracy: within 2 units in the last place of the exact value on 40 000 sampled points in
+//! `[1e-10, 20]` (checked against 50-digit decimals; glibc's `tanh` is also off by up to 2
+//! there), hence within 3 of libm's (test `tanh_matches_libm`).
 
 const LN2_HI: f64 = 6.931_471_803_691_238_164_90e-1; // ln 2 with 32 trailing zero bits
 const LN2_LO: f64 = 1.908_214_929_270_587_700_02e-10; // ln 2 - LN2_HI
