@@ -35,8 +35,7 @@ impl Layout<'_> {
         for b in &self.sys.blocks {
             let id = format_ident!("o_{}", b.name);
             let (sl, al) = (Literal::usize_unsuffixed(s), Literal::usize_unsuffixed(a));
-            let slice = format!("__x_{}", b.name);
-            if used.contains(&id.to_string()) || used.contains(&slice) {
+            if used.contains(&id.to_string()) || used.contains(&slice_of(&b.name).to_string()) {
                 out.extend(match (s, a) {
                     (_, 0) => quote! { let #id: usize = #sl; },
                     (0, 1) => quote! { let #id: usize = n; },
@@ -80,7 +79,7 @@ impl Layout<'_> {
 
     /// The identifier of an array block's slice of the state, e.g. `__x_P_regen`.
     fn slice_ident(&self, sym: u32) -> Ident {
-        format_ident!("__x_{}", self.sys.blocks[self.block(sym)].name)
+        slice_of(&self.sys.blocks[self.block(sym)].name)
     }
 
     /// Index of a state element inside its array block.
@@ -105,10 +104,7 @@ impl Layout<'_> {
     pub fn slices(&self, used: &HashSet<String>) -> TokenStream {
         let mut out = TokenStream::new();
         for b in self.sys.blocks.iter().filter(|b| b.array) {
-            let (x, o) = (
-                format_ident!("__x_{}", b.name),
-                format_ident!("o_{}", b.name),
-            );
+            let (x, o) = (slice_of(&b.name), format_ident!("o_{}", b.name));
             if used.contains(&x.to_string()) {
                 out.extend(quote! { let #x: &[f64] = &x[#o..#o + n]; });
             }
@@ -121,16 +117,10 @@ impl Layout<'_> {
         let o = self.offset_ident(block);
         match at {
             At::Scalar | At::First => quote!(#o),
-            At::Rel(0) => quote!(#o + j),
-            At::Rel(k) if k > 0 => {
-                let k = Literal::usize_unsuffixed(k as usize);
-                quote!(#o + j + #k)
+            _ => {
+                let i = Self::in_block(at);
+                quote!(#o + #i)
             }
-            At::Rel(k) => {
-                let k = Literal::usize_unsuffixed((-k) as usize);
-                quote!(#o + j - #k)
-            }
-            At::Last => quote!(#o + n - 1),
         }
     }
 
@@ -187,4 +177,9 @@ impl Layout<'_> {
             Sym::Sum(k) => format!("S{k}"),
         }
     }
+}
+
+/// The identifier of the slice of the state that holds array block `name`.
+fn slice_of(name: &str) -> Ident {
+    format_ident!("__x_{}", name)
 }
