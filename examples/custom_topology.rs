@@ -74,21 +74,14 @@ stirling_model! {
 
 stirling_model! {
     /// The alternator engine with Coulomb friction on both bodies, `-Fc tanh(v / v_eps)`, at
-    /// its null (`Fcd = Fcp = 0`): the augmented member the diagnosis tests the effect with.
-    /// The parameter names are the effect library's (`coulomb`: `Fcd`, `Fcp`, `v_eps`), so
-    /// the diagnosis offers that candidate for this model.
+    /// its null: the augmented member the diagnosis tests the effect with. Each `effect` item
+    /// names where it acts; the macro adds the force term and its parameters at their null
+    /// (`Fc_displacer = Fc_piston = 0`, `v_eps`), and the diagnosis offers `coulomb` with
+    /// those parameters for this engine.
     pub model AlternatorFx extends alternator_engine {
         name "alternator_engine_fx";
-        params {
-            /// displacer Coulomb friction force (0: none)
-            Fcd: 0.0 "N",
-            /// power-piston Coulomb friction force (0: none)
-            Fcp: 0.0 "N",
-            /// velocity scale of the smoothed Coulomb friction
-            v_eps: 1.0e-3 "m/s",
-        }
-        modify body displacer { force: -Fcd * tanh(v / v_eps) }
-        modify body piston { force: -c_alt * w - Fcp * tanh(w / v_eps) }
+        effect coulomb on displacer;
+        effect coulomb on piston;
     }
 }
 

@@ -13,7 +13,6 @@ mod common;
 #[allow(dead_code)]
 mod ex;
 
-use rand::Rng;
 use stirling::dsl::{Closure, Model};
 use stirling::stirling_model;
 
@@ -350,85 +349,6 @@ stirling_model! {
     }
 }
 
-/// Scaled largest difference of two vectors: `max |a - b| / max(|a|, |b|, floor)` per entry.
-fn worst(a: &[f64], b: &[f64], floor: f64) -> f64 {
-    a.iter()
-        .zip(b)
-        .map(|(x, y)| (x - y).abs() / x.abs().max(y.abs()).max(floor))
-        .fold(0.0, f64::max)
-}
-
-/// `ext` and `hand` are one model: states, defaults, right-hand side, Jacobian and parameter
-/// Jacobian (columns by parameter name) at random states and parameters. Returns the
-/// largest scaled difference seen.
-fn same_model(ext: &dyn Model, hand: &dyn Model, seed: u64) -> f64 {
-    assert_eq!(ext.state_names(), hand.state_names());
-    let names = |m: &dyn Model| {
-        let mut v: Vec<&str> = m.params().iter().map(|p| p.name).collect();
-        v.sort_unstable();
-        v
-    };
-    assert_eq!(names(ext), names(hand), "the same parameters");
-    // column of each of `ext`'s parameters in `hand`
-    let map: Vec<usize> = ext
-        .params()
-        .iter()
-        .map(|p| hand.param_index(p.name).unwrap())
-        .collect();
-    let to_hand = |pe: &[f64]| {
-        let mut ph = vec![0.0; pe.len()];
-        for (k, &i) in map.iter().enumerate() {
-            ph[i] = pe[k];
-        }
-        ph
-    };
-    assert_eq!(
-        to_hand(&ext.default_params()),
-        hand.default_params(),
-        "the same defaults"
-    );
-    let (n, np) = (ext.n_states(), ext.params().len());
-    let mut rng = common::rng(seed);
-    let mut w = 0.0f64;
-    for k in 0..6 {
-        let mut pe = ext.default_params();
-        if k > 0 {
-            pe.iter_mut()
-                .for_each(|v| *v *= 1.0 + 0.05 * rng.gen_range(-1.0..1.0));
-        }
-        let ph = to_hand(&pe);
-        let spread = if k % 2 == 0 {
-            common::Spread::Wide
-        } else {
-            common::Spread::Balanced
-        };
-        let x = common::random_state(ext, &pe, spread, &mut rng);
-        let (mut fe, mut fh) = (vec![0.0; n], vec![0.0; n]);
-        ext.rhs(&pe, &x, 0.0, &mut fe);
-        hand.rhs(&ph, &x, 0.0, &mut fh);
-        let fmax = fe.iter().fold(0.0f64, |a, v| a.max(v.abs()));
-        w = w.max(worst(&fe, &fh, 1e-12 * fmax));
-        let (je, jh) = (
-            ext.jacobian_dense(&pe, &x, 0.0),
-            hand.jacobian_dense(&ph, &x, 0.0),
-        );
-        let jmax = je.iter().fold(0.0f64, |a, v| a.max(v.abs()));
-        w = w.max(worst(&je, &jh, 1e-12 * jmax));
-        let (pje, pjh) = (
-            ext.param_jacobian_dense(&pe, &x, 0.0),
-            hand.param_jacobian_dense(&ph, &x, 0.0),
-        );
-        // column-major n x np: ext's column c is hand's column map[c]
-        let mut pjh_e = vec![0.0; n * np];
-        for c in 0..np {
-            pjh_e[n * c..n * (c + 1)].copy_from_slice(&pjh[n * map[c]..n * (map[c] + 1)]);
-        }
-        let pmax = pje.iter().fold(0.0f64, |a, v| a.max(v.abs()));
-        w = w.max(worst(&pje, &pjh_e, 1e-12 * pmax));
-    }
-    w
-}
-
 const ROUND_OFF: f64 = 1e-12;
 
 #[test]
@@ -440,7 +360,7 @@ fn replace_in_place_is_the_hand_written_model() {
             let names = e.state_names();
             // the bounce CV keeps the space's place: first of the pressures
             assert_eq!(names[4], "P_bounce", "{names:?}");
-            let w = same_model(&e, &h, 11 + n as u64);
+            let w = common::same::same_model(&e, &h, 11 + n as u64);
             println!("closed bounce, n = {n} ({closure}): worst scaled difference {w:.2e}");
             assert!(w <= ROUND_OFF, "n = {n} ({closure}): {w:.2e}");
         }
@@ -453,7 +373,7 @@ fn every_kind_of_change_is_the_hand_written_model() {
         for closure in [Closure::Full, Closure::Frozen] {
             let e = Variant::new(n, closure).unwrap();
             let h = HandVariant::new(n, closure).unwrap();
-            let w = same_model(&e, &h, 21 + n as u64);
+            let w = common::same::same_model(&e, &h, 21 + n as u64);
             println!("variant, n = {n} ({closure}): worst scaled difference {w:.2e}");
             assert!(w <= ROUND_OFF, "n = {n} ({closure}): {w:.2e}");
         }
@@ -467,7 +387,7 @@ fn the_example_engine_is_its_former_full_declaration() {
     for n in [1, 2, 10] {
         let e = ex::AlternatorEngine::new(n, Closure::Full).unwrap();
         let h = HandAlternator::new(n, Closure::Full).unwrap();
-        let w = same_model(&e, &h, 31 + n as u64);
+        let w = common::same::same_model(&e, &h, 31 + n as u64);
         println!("alternator engine, n = {n}: worst scaled difference {w:.2e}");
         assert!(w <= ROUND_OFF, "n = {n}: {w:.2e}");
     }

@@ -476,7 +476,7 @@ fn fx_record(fcp: f64) -> (ex::AlternatorFx, Vec<f64>, stirling::models::data::M
     let m = ex::AlternatorFx::new(2, Closure::Full).unwrap();
     let nominal = stirling::models::effects::nominal_params(&m);
     let mut truth = nominal.clone();
-    truth[m.param_index("Fcp").unwrap()] = fcp;
+    truth[m.param_index("Fc_piston").unwrap()] = fcp;
     let cfg = RigConfig {
         t_end: 2.0,
         rate: 1000.0,
@@ -509,8 +509,8 @@ fn diagnose_options() -> stirling::models::diagnose::DiagnoseOptions {
 }
 
 /// The diagnosis on the engine's own sensors names a withheld Coulomb friction on its
-/// piston (the effect the engine's augmented member declares with the library's parameter
-/// names), and finds no significant gap on a clean record. A 2 s start-up record: the
+/// piston (the effect the engine's augmented member declares with `effect` items on both
+/// bodies), and finds no significant gap on a clean record. A 2 s start-up record: the
 /// amplitude grows, which is what tells Coulomb friction (its equivalent damping falls with
 /// amplitude) from the viscous `bp` that absorbs it on a record at steady amplitude (1 s
 /// after 0.1 s of settling: not significant, `bp` moved x5.8); seeds 5 and 6 both give
@@ -526,6 +526,26 @@ fn the_diagnosis_names_withheld_piston_friction_and_passes_a_clean_record() {
     );
     assert_eq!(d.verdict.verdict, "effect", "{}", d.verdict.reason);
     assert_eq!(d.verdict.effect.as_deref(), Some("coulomb"));
+    // the candidate is the engine's own: its parameters are those its `effect` items declare,
+    // and the fit puts the friction on the piston
+    let entry = d.ranking.iter().find(|e| e.effect == "coulomb").unwrap();
+    let at = |name: &str| {
+        entry
+            .params
+            .iter()
+            .find(|q| q.name == name)
+            .map(|q| q.value)
+    };
+    let (on_piston, on_displacer) = (at("Fc_piston").unwrap(), at("Fc_displacer").unwrap());
+    eprintln!("Fc_piston {on_piston}, Fc_displacer {on_displacer}");
+    assert!(
+        (0.25..1.0).contains(&on_piston),
+        "Fc_piston {on_piston} (truth 0.5)"
+    );
+    assert!(
+        on_displacer.abs() < 0.5 * on_piston,
+        "Fc_displacer {on_displacer}"
+    );
     let (m, p0, rec) = fx_record(0.0);
     let d = diagnose(&m, &p0, &rec, &diagnose_options()).expect("diagnosed");
     eprintln!(
@@ -569,7 +589,7 @@ fn the_command_line_fits_and_diagnoses_the_registered_engine() {
         "--n",
         "2",
         "--effect",
-        "Fcp=0.5",
+        "Fc_piston=0.5",
         "--t-end",
         "2",
     ];

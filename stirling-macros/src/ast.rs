@@ -134,6 +134,7 @@ pub struct PortAst {
 }
 
 /// `name` or `name[index]`.
+#[derive(Clone)]
 pub struct EndAst {
     pub name: Ident,
     pub index: Option<Expr>,
@@ -185,6 +186,8 @@ pub enum Item {
     Sensor(SensorAst),
     /// `free a, b, c;`: the parameters a fit frees by default.
     Free(Span, Vec<Ident>),
+    /// `effect coulomb on piston;`: an effect at its null (applied before the check).
+    Effect(crate::effects::EffectAst),
 }
 
 /// `sensor name: STATE "unit";` or `sensor name: STATE[k] "unit";` (unit optional: the
@@ -292,6 +295,7 @@ pub(crate) fn item(input: ParseStream) -> syn::Result<Item> {
         "wall" => Item::Wall(vessel(input)?),
         "link" => link(input, kw.span())?,
         "sensor" => Item::Sensor(sensor(input)?),
+        "effect" => Item::Effect(input.parse()?),
         "free" => {
             let names = Punctuated::<Ident, Token![,]>::parse_separated_nonempty(input)?;
             input.parse::<Token![;]>()?;
@@ -300,7 +304,7 @@ pub(crate) fn item(input: ParseStream) -> syn::Result<Item> {
         other => {
             return Err(syn::Error::new(
                 kw.span(),
-                format!("unknown item `{other}`: expected one of name, params, let, gas, body, coupling, space, cv, wall, link, sensor, free"),
+                format!("unknown item `{other}`: expected one of name, params, let, gas, body, coupling, space, cv, wall, link, sensor, free, effect"),
             ))
         }
     };

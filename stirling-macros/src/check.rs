@@ -153,7 +153,7 @@ impl Lower {
                 Item::Cv(v) => self.cv(v),
                 Item::Wall(v) => self.wall(v),
                 Item::Link(l) => self.link(l),
-                Item::Name(_) | Item::Params(_) | Item::Sensor(_) => {}
+                Item::Name(_) | Item::Params(_) | Item::Sensor(_) | Item::Effect(_) => {}
                 Item::Free(_, names) => self.free(names),
             }
         }

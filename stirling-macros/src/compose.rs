@@ -35,6 +35,7 @@ use syn::{Attribute, Ident, Token, Visibility};
 use crate::ast::ModelAst;
 
 mod body;
+pub(crate) use body::end_str;
 mod find;
 mod items;
 mod merge;

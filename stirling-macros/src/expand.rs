@@ -8,8 +8,10 @@ use crate::ast::ModelAst;
 use crate::check::lower;
 
 /// The whole expansion of one `stirling_model!` invocation.
-pub fn expand(ast: ModelAst) -> syn::Result<TokenStream> {
-    let topo = lower(&ast)?;
+pub fn expand(mut ast: ModelAst) -> syn::Result<TokenStream> {
+    let effects = crate::effects::apply(&mut ast)?;
+    let mut topo = lower(&ast)?;
+    topo.effects = effects;
     let spec = ModelSpec {
         ident: ast.ident.clone(),
         vis: ast.vis.to_token_stream(),

@@ -7,6 +7,7 @@
 mod ast;
 mod check;
 mod compose;
+mod effects;
 mod expand;
 mod expr;
 mod links;

@@ -4,6 +4,7 @@
 
 pub mod fit;
 pub mod models;
+pub mod same;
 
 use rand::rngs::StdRng;
 use rand::{Rng, SeedableRng};

@@ -34,6 +34,15 @@ pub fn sensors(topo: &Topology, krate: &TokenStream) -> TokenStream {
     quote! { &[#(#items),*] }
 }
 
+/// `&[EffectSite { .. }, ..]`.
+pub fn effect_sites(topo: &Topology, krate: &TokenStream) -> TokenStream {
+    let items = topo.effects.iter().map(|e| {
+        let (effect, at, params) = (&e.effect, &e.at, &e.params);
+        quote! { #krate::EffectSite { effect: #effect, at: #at, params: &[#(#params),*] } }
+    });
+    quote! { &[#(#items),*] }
+}
+
 /// Vessel-element offset of CV `i`: `(scalars before, arrays before)`.
 fn cv_element_offset(topo: &Topology, i: usize) -> (usize, usize) {
     let before = &topo.cvs[..i];

@@ -59,6 +59,7 @@ pub fn generate(mut topo: Topology, spec: &ModelSpec) -> TokenStream {
         params: info::params(&topo, krate),
         bodies: info::bodies(&topo, krate),
         sensors: info::sensors(&topo, krate),
+        effect_sites: info::effect_sites(&topo, krate),
         topology: info::topology(&topo, &lay, krate),
         vessel_names: info::vessel_names(&topo),
         states,
@@ -72,6 +73,7 @@ struct Statics {
     params: TokenStream,
     bodies: TokenStream,
     sensors: TokenStream,
+    effect_sites: TokenStream,
     topology: TokenStream,
     vessel_names: TokenStream,
     states: Vec<TokenStream>,
@@ -85,6 +87,7 @@ fn items(topo: &Topology, spec: &ModelSpec, st: &Statics, parts: &[TokenStream])
     let (name, doc, has_array) = (&topo.name, &topo.doc, topo.has_array());
     let (full_part, frozen_part) = (&parts[0], &parts[1]);
     let (p, b, sn, tp) = (&st.params, &st.bodies, &st.sensors, &st.topology);
+    let fx = &st.effect_sites;
     quote! {
         #[doc = #doc]
         #[doc = ""]
@@ -102,6 +105,8 @@ fn items(topo: &Topology, spec: &ModelSpec, st: &Statics, parts: &[TokenStream])
             pub const BODIES: &'static [#krate::BodyInfo] = #b;
             /// The declared sensors (measured channels).
             pub const SENSORS: &'static [#krate::SensorInfo] = #sn;
+            /// The effects applied by `effect` items, at their null.
+            pub const EFFECT_SITES: &'static [#krate::EffectSite] = #fx;
             /// The declared topology.
             pub const TOPOLOGY: #krate::TopologyInfo = #tp;
             /// Whether the topology has an array of CVs, so that `n` matters.
@@ -284,6 +289,7 @@ fn model_impl(topo: &Topology, spec: &ModelSpec, st: &Statics) -> TokenStream {
             }
             fn topology(&self) -> &'static #krate::TopologyInfo { &Self::TOPOLOGY }
             fn sensors(&self) -> &'static [#krate::SensorInfo] { Self::SENSORS }
+            fn effect_sites(&self) -> &'static [#krate::EffectSite] { Self::EFFECT_SITES }
             fn declared_free(&self) -> &'static [&'static str] { &[#(#free),*] }
         }
     }

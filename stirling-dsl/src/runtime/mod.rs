@@ -9,7 +9,9 @@ mod topology_info;
 pub use dot::to_dot;
 pub use error::ModelError;
 pub use jac_sink::{JacSink, JacValues, JacWrite};
-pub use model::{BodyInfo, Model, ParamInfo, PowerTerms, SensorInfo, StateInfo, StateKind};
+pub use model::{
+    BodyInfo, EffectSite, Model, ParamInfo, PowerTerms, SensorInfo, StateInfo, StateKind,
+};
 pub use topology_info::{
     ConductionInfo, FaceInfo, LinkInfo, PortInfo, TopologyInfo, VesselInfo, WallInfo,
 };

@@ -46,6 +46,18 @@ pub struct SensorInfo {
     pub unit: &'static str,
 }
 
+/// An effect applied to the model where it names it (`effect coulomb on piston;`), at its
+/// null: what the diagnosis may test on this model.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct EffectSite {
+    /// The effect (`coulomb`, `end_stops`, `leak`).
+    pub effect: &'static str,
+    /// Where it acts, as written (`piston`, `cold -> bounce`).
+    pub at: &'static str,
+    /// Its parameters, the strength first.
+    pub params: &'static [&'static str],
+}
+
 /// A body of the topology.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct BodyInfo {
@@ -161,6 +173,11 @@ pub trait Model: Send + Sync {
     /// The measured channels declared with the model (`sensor` items), in declaration order;
     /// none by default.
     fn sensors(&self) -> &'static [SensorInfo] {
+        &[]
+    }
+    /// The effects applied by `effect` items (at their null), in declaration order; none by
+    /// default.
+    fn effect_sites(&self) -> &'static [EffectSite] {
         &[]
     }
     /// The parameters a fit frees by default (`free a, b;`), in declaration order; none by

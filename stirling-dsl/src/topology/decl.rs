@@ -198,7 +198,17 @@ impl LinkDecl {
     }
 }
 
-/// A whole declared model.
+/// An effect applied where the model names it (`effect coulomb on piston;`), at its null.
+#[derive(Clone, Debug)]
+pub struct EffectSiteDecl {
+    /// The effect (`coulomb`, `end_stops`, `leak`).
+    pub effect: String,
+    /// Where it acts, as written (`piston`, `cold -> bounce`).
+    pub at: String,
+    /// Its parameters, the strength first.
+    pub params: Vec<String>,
+}
+
 /// A measured channel: a CSV column observing one state.
 #[derive(Clone, Debug)]
 pub struct SensorDecl {
@@ -209,6 +219,7 @@ pub struct SensorDecl {
     pub unit: String,
 }
 
+/// A whole declared model.
 #[derive(Clone, Debug, Default)]
 pub struct Topology {
     pub name: String,
@@ -226,6 +237,8 @@ pub struct Topology {
     pub sensors: Vec<SensorDecl>,
     /// The parameters a fit frees by default (`free a, b;`).
     pub free: Vec<String>,
+    /// The effects applied by `effect` items.
+    pub effects: Vec<EffectSiteDecl>,
 }
 
 impl Topology {

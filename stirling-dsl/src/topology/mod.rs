@@ -14,7 +14,7 @@ mod walls;
 
 pub use assemble::assemble;
 pub use decl::{
-    BodyDecl, ConductionDecl, CouplingDecl, CvDecl, End, FaceDecl, GasDecl, HeatEnd, LinkDecl,
-    ParamDecl, PortDecl, SensorDecl, SpaceDecl, Topology, Vessel, WallDecl,
+    BodyDecl, ConductionDecl, CouplingDecl, CvDecl, EffectSiteDecl, End, FaceDecl, GasDecl,
+    HeatEnd, LinkDecl, ParamDecl, PortDecl, SensorDecl, SpaceDecl, Topology, Vessel, WallDecl,
 };
 pub use system::{BlockInfo, BlockKind, Row, System, Variant, VesselTerms, WallTerms, VARIANTS};

@@ -46,11 +46,12 @@ pub(super) fn entry(input: ParseStream) -> syn::Result<Entry> {
         Item::Link(l) => (link_key(&l.from, &l.to), l.from.name.span()),
         Item::Sensor(s) => (Key::Sensor(s.name.to_string()), s.name.span()),
         Item::Free(span, _) => (Key::Free, *span),
+        Item::Effect(e) => (Key::Effect(e.kind.to_string(), e.site.describe()), e.span),
     };
     Ok(Entry::Item(Chunk { key, span, tokens }))
 }
 
-pub(super) fn end_str(e: &EndAst) -> String {
+pub(crate) fn end_str(e: &EndAst) -> String {
     match &e.index {
         Some(i) => format!("{}[{}]", e.name, i.to_token_stream()),
         None => e.name.to_string(),

@@ -20,6 +20,8 @@ pub(super) enum Key {
     Param(String),
     Sensor(String),
     Free,
+    /// An effect and where it acts.
+    Effect(String, String),
 }
 
 impl Key {
@@ -35,6 +37,7 @@ impl Key {
             Key::Param(n) => format!("parameter `{n}`"),
             Key::Sensor(n) => format!("sensor `{n}`"),
             Key::Free => "`free`".into(),
+            Key::Effect(e, at) => format!("`effect {e}` on `{at}`"),
         }
     }
 
@@ -49,6 +52,7 @@ impl Key {
             }
             Key::Coupling(a, b) => format!("`{a}, {b}`"),
             Key::Link(a, b) => format!("`{a} -> {b}`"),
+            Key::Effect(e, at) => format!("`{e}` on `{at}`"),
         }
     }
 
@@ -78,6 +82,7 @@ impl Key {
             Key::Param(n) => format!("param {n}"),
             Key::Sensor(n) => format!("sensor {n}"),
             Key::Free => "free".into(),
+            Key::Effect(e, at) => format!("effect {e} on {at}"),
         }
     }
 }

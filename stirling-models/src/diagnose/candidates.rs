@@ -11,14 +11,19 @@ pub(super) fn candidates(
     names: &Option<Vec<String>>,
 ) -> Result<Vec<&'static EffectInfo>, DiagnoseError> {
     let base = model.name().trim_end_matches("_fx").to_string();
-    // a model outside the library (a user's augmented engine) carries an effect when it
-    // declares every parameter of it; the sensor effects act on the records of any model
-    let applies = |e: &EffectInfo| effects::applies(e, &base, Some(model));
+    // a model outside the library (a user's augmented engine) carries the effects it names
+    // with `effect` items, or else those whose every parameter it declares; the sensor effects
+    // act on the records of any model
+    let pool = effects::carried(&base, Some(model));
     let Some(names) = names else {
-        return Ok(effects::EFFECTS.iter().filter(|e| applies(e)).collect());
+        return Ok(pool);
     };
     let mut v = Vec::new();
     for n in names {
+        if let Some(e) = pool.iter().find(|e| e.name == n) {
+            v.push(*e);
+            continue;
+        }
         let e = effects::effect(n).ok_or_else(|| DiagnoseError::UnknownEffect {
             name: n.clone(),
             known: effects::EFFECTS
@@ -27,14 +32,11 @@ pub(super) fn candidates(
                 .collect::<Vec<_>>()
                 .join(", "),
         })?;
-        if !applies(e) {
-            return Err(DiagnoseError::NotApplicable {
-                effect: n.clone(),
-                model: base.clone(),
-                applies: e.applies_to.join(", "),
-            });
-        }
-        v.push(e);
+        return Err(DiagnoseError::NotApplicable {
+            effect: n.clone(),
+            model: base.clone(),
+            applies: e.applies_to.join(", "),
+        });
     }
     Ok(v)
 }

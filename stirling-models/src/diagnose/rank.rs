@@ -157,6 +157,7 @@ fn fit_candidate(
         best
     };
     entry.params = estimates(&joint, &res, &fixed);
+    entry.moved = moved(e, &entry.params);
     let ev = ctx.eval_joint(&joint, &res.x, joint.effect_values(&res.x))?;
     let k = joint.effect.len() - fixed.len();
     let n_h = ctx.holdout_points(nominal_eval) as f64;
@@ -243,11 +244,13 @@ fn best_fit(
 /// Whether a fitted candidate moved a strength off its null (a fit that returns every
 /// strength to its null is the nominal model again and explains nothing).
 fn active(e: &RankEntry) -> bool {
-    let Some(info) = crate::effects::effect(&e.effect) else {
-        return true;
-    };
-    e.params.iter().any(|q| {
-        info.params
+    e.moved
+}
+
+/// Whether the estimates of `e`'s parameters have a strength off its null.
+fn moved(e: &EffectInfo, params: &[EffectEstimate]) -> bool {
+    params.iter().any(|q| {
+        e.params
             .iter()
             .any(|p| p.name == q.name && p.null.is_some_and(|n| q.value != n))
     })

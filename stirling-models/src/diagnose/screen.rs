@@ -94,6 +94,7 @@ fn empty_entry(e: &EffectInfo) -> RankEntry {
         params: Vec::new(),
         note: None,
         seconds: 0.0,
+        moved: false,
     }
 }
 

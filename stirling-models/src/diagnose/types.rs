@@ -68,6 +68,9 @@ pub struct RankEntry {
     pub note: Option<String>,
     /// Time spent screening and fitting this candidate (s).
     pub seconds: f64,
+    /// The fit moved a strength off its null (else it is the nominal model again).
+    #[serde(skip)]
+    pub moved: bool,
 }
 
 /// A fitted effect parameter.

@@ -15,6 +15,7 @@
 //! an effect, and the end-stop contact damper `-cc v` (needs a step function of the position).
 
 mod models;
+mod sites;
 
 pub use models::{
     Cv1Fx, Cv1FxParams, NSectionExtFx, NSectionExtFxParams, NSectionFx, NSectionFxParams,
@@ -223,6 +224,20 @@ pub fn applies(e: &EffectInfo, base: &str, model: Option<&dyn Model>) -> bool {
     }
 }
 
+/// The effects `base` carries, `model` its augmented member: the library's list for a library
+/// base; for any other model, those it names with `effect` items (one per effect, over all its
+/// sites, under its parameter names) and the sensor effects, or, for a model without `effect`
+/// items, the library's effects whose every parameter it declares ([`applies`]).
+pub fn carried(base: &str, model: Option<&dyn Model>) -> Vec<&'static EffectInfo> {
+    if let (None, Some(m)) = (canonical(base), model) {
+        let named = sites::from_sites(m);
+        if !named.is_empty() {
+            return named;
+        }
+    }
+    EFFECTS.iter().filter(|e| applies(e, base, model)).collect()
+}
+
 /// Whether `base` is one of the library's base models (or an alias): its effects are the
 /// library's list; any other model carries the effects whose parameters it declares.
 pub fn in_library(base: &str) -> bool {
@@ -294,7 +309,7 @@ pub fn check_range(name: &str, v: f64) -> Result<(), EffectError> {
 /// Parameters of the augmented model with every effect at its null (the nominal model).
 pub fn nominal_params(model: &dyn Model) -> Vec<f64> {
     let mut p = model.default_params();
-    for e in EFFECTS {
+    for e in EFFECTS.iter().chain(sites::from_sites(model)) {
         for q in e.params {
             if let (Some(null), Some(i)) = (q.null, model.param_index(q.name)) {
                 p[i] = null;
@@ -329,6 +344,7 @@ impl EffectSettings {
         settings: &[String],
     ) -> Result<Self, EffectError> {
         let mut out = EffectSettings::default();
+        let pool = carried(base, model);
         for s in settings {
             let (k, v) = s
                 .split_once('=')
@@ -339,8 +355,14 @@ impl EffectSettings {
                 .ok()
                 .filter(|v: &f64| v.is_finite())
                 .ok_or_else(|| EffectError::BadSetting(s.clone()))?;
-            let (e, p) = match effect(k) {
-                Some(e) => (e, e.strength()),
+            let in_pool = pool.iter().find_map(|e| {
+                if e.name == k {
+                    return Some((*e, e.strength()));
+                }
+                e.params.iter().find(|p| p.name == k).map(|p| (*e, p))
+            });
+            let (e, p) = match in_pool.or_else(|| effect(k).map(|e| (e, e.strength()))) {
+                Some(found) => found,
                 None => effect_of_param(k).ok_or_else(|| {
                     let names: Vec<String> = EFFECTS
                         .iter()
@@ -352,7 +374,7 @@ impl EffectSettings {
                     EffectError::Unknown(k.to_string(), names.join(", "))
                 })?,
             };
-            if !applies(e, base, model) {
+            if !pool.iter().any(|x| std::ptr::eq(*x, e)) {
                 return Err(EffectError::NotApplicable {
                     effect: e.name.into(),
                     model: base.into(),

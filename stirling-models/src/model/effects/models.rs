@@ -8,7 +8,10 @@
 //! - quadratic regenerator friction (`nsection` only): `quadratic: Rq` on the regenerator links,
 //!   split like `Rf` (`Rq/(2n)` at the ends, `Rq/n` between sections).
 
-// The effects change the frame's items with `modify` (docs/custom-topologies.md, "Composition").
+// The effects that act on a body or between two volumes are `effect` items, named where they act
+// (docs/custom-topologies.md, "Effects"); the rest change the frame's items with `modify`
+// (docs/custom-topologies.md, "Composition"). The parameters are declared here, with the
+// library's names and docs, so the `effect` items add none of their own.
 
 // `nsection_fx_engine` is crate-local: extending it calls back through the `stirling_model` in scope.
 use stirling_macros::stirling_model;
@@ -16,8 +19,10 @@ use stirling_macros::stirling_model;
 stirling_macros::stirling_model! {
     /// `cv1` with the DSL-expressible effects (leak, Coulomb friction, end stops) at null values.
     pub model Cv1Fx extends default_engine {
-        modify body displacer { force: -Fcd * tanh(v / v_eps) - kc * ((abs(x) - xmax) + abs(abs(x) - xmax)) / 2.0 * sign(x) }
-        modify body piston { force: -Fcp * tanh(w / v_eps) - kc * ((abs(y) - ymax) + abs(abs(y) - ymax)) / 2.0 * sign(y) }
+        effect coulomb on displacer as Fcd, v_eps;
+        effect end_stops on displacer as kc, xmax;
+        effect coulomb on piston as Fcp, v_eps;
+        effect end_stops on piston as kc, ymax;
         modify space bounce { temperature: Tk }
         name "cv1_fx";
         params {
@@ -43,7 +48,7 @@ stirling_macros::stirling_model! {
             port cold { h: hk, area: Awc0 + pi * D * (x - y), wall: Tk },
             port regen { h: hr, area: Awr, wall: (Th + Tk) / 2.0 },
         }
-        link gas -> bounce { conductance: Gleak }
+        effect leak gas -> bounce as Gleak;
     }
 }
 
@@ -52,8 +57,10 @@ stirling_macros::stirling_model! {
     /// quadratic regenerator friction) at null values: the frame of [`NSectionFx`] and
     /// [`NSectionExtFx`].
     base nsection_fx_engine extends nsection_engine {
-        modify body displacer { force: -Fcd * tanh(v / v_eps) - kc * ((abs(x) - xmax) + abs(abs(x) - xmax)) / 2.0 * sign(x) }
-        modify body piston { force: -Fcp * tanh(w / v_eps) - kc * ((abs(y) - ymax) + abs(abs(y) - ymax)) / 2.0 * sign(y) }
+        effect coulomb on displacer as Fcd, v_eps;
+        effect end_stops on displacer as kc, xmax;
+        effect coulomb on piston as Fcp, v_eps;
+        effect end_stops on piston as kc, ymax;
         modify space bounce { temperature: Tk }
         params {
             /// seal-leak conductance, cold space to bounce space (0: no leak)
@@ -76,7 +83,7 @@ stirling_macros::stirling_model! {
         modify link hot -> regen[0] { quadratic: Rq / (2.0 * n) }
         modify link regen[j] -> regen[j + 1] { quadratic: Rq / n }
         modify link regen[n - 1] -> cold { quadratic: Rq / (2.0 * n) }
-        link cold -> bounce { conductance: Gleak }
+        effect leak cold -> bounce as Gleak;
     }
 }
 

@@ -1,0 +1,112 @@
+//! The effects an `effect` item can name: where each acts, its parameters (the strength
+//! first, null 0) and its term.
+
+use syn::{Expr, Ident};
+
+/// Where an effect of a kind acts.
+pub enum Where {
+    /// On a body (`on <body>`): a force term.
+    Body,
+    /// Between two volumes (`<from> -> <to>`): a mass-flow link.
+    Between,
+}
+
+/// A parameter: its default name (`{0}`: the body or first end, `{1}`: the body's position
+/// or the second end), default value (the strength's is its null, 0), unit and doc (`{site}`:
+/// where the effect acts).
+pub struct ParamKind {
+    pub name: &'static str,
+    pub default: f64,
+    pub unit: &'static str,
+    pub doc: &'static str,
+}
+
+/// An effect kind.
+pub struct Kind {
+    pub name: &'static str,
+    pub site: Where,
+    pub params: &'static [ParamKind],
+    /// The term from the parameter names and the site's two names (a body's position and
+    /// velocity; a link's two ends): the force subtracted from the body's, or the link's
+    /// conductance.
+    pub term: fn(&[Ident], &Ident, &Ident) -> Expr,
+}
+
+const fn param(
+    name: &'static str,
+    default: f64,
+    unit: &'static str,
+    doc: &'static str,
+) -> ParamKind {
+    ParamKind {
+        name,
+        default,
+        unit,
+        doc,
+    }
+}
+
+/// Coulomb friction, smoothed: `Fc tanh(v / v_eps)`.
+fn coulomb(p: &[Ident], _pos: &Ident, vel: &Ident) -> Expr {
+    let (fc, eps) = (&p[0], &p[1]);
+    syn::parse_quote!(#fc * tanh(#vel / #eps))
+}
+
+/// End stops: `kc relu(|q| - q_max) sign(q)`, `relu(u) = (u + |u|) / 2`.
+fn end_stops(p: &[Ident], pos: &Ident, _vel: &Ident) -> Expr {
+    let (kc, qmax) = (&p[0], &p[1]);
+    syn::parse_quote!(#kc * ((abs(#pos) - #qmax) + abs(abs(#pos) - #qmax)) / 2.0 * sign(#pos))
+}
+
+/// A seal leak: the link's conductance.
+fn leak(p: &[Ident], _from: &Ident, _to: &Ident) -> Expr {
+    let g = &p[0];
+    syn::parse_quote!(#g)
+}
+
+pub const KINDS: &[Kind] = &[
+    Kind {
+        name: "coulomb",
+        site: Where::Body,
+        params: &[
+            param(
+                "Fc_{0}",
+                0.0,
+                "N",
+                "Coulomb friction force on {site} (0: none)",
+            ),
+            param(
+                "v_eps",
+                1.0e-3,
+                "m/s",
+                "velocity scale of the smoothed Coulomb friction",
+            ),
+        ],
+        term: coulomb,
+    },
+    Kind {
+        name: "end_stops",
+        site: Where::Body,
+        params: &[
+            param(
+                "kc_{0}",
+                0.0,
+                "N/m",
+                "end-stop contact stiffness on {site} (0: no stops)",
+            ),
+            param("{1}max", 0.01, "m", "travel of {site} to its end stops"),
+        ],
+        term: end_stops,
+    },
+    Kind {
+        name: "leak",
+        site: Where::Between,
+        params: &[param(
+            "Gleak_{0}_{1}",
+            0.0,
+            "kg/(s Pa)",
+            "seal-leak conductance {site} (0: no leak)",
+        )],
+        term: leak,
+    },
+];

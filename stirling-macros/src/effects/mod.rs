@@ -1,0 +1,198 @@
+//! `effect` items: an effect the nominal model leaves out, applied where the model names it,
+//! at its null (docs/custom-topologies.md, "Effects"):
+//!
+//! ```text
+//! effect coulomb on piston;              // force -Fc_piston tanh(w / v_eps) on the piston
+//! effect end_stops on displacer;         // -kc_displacer relu(|x| - xmax) sign(x)
+//! effect leak cold -> bounce;            // link cold -> bounce { conductance: Gleak_cold_bounce }
+//! effect coulomb on piston as Fcp;       // the strength named `Fcp` (then the shape, `as Fcp, v_eps`)
+//! ```
+//!
+//! Each declares its parameters at their null (a strength of 0: the effect is absent) unless
+//! the model declares them already, adds its term, and is listed with its parameters in
+//! `Model::effect_sites`, which the diagnosis reads to know what it may test. Applied to the
+//! parsed model before the check, so a term is checked like one written by hand.
+
+mod kinds;
+mod parse;
+
+pub use parse::{EffectAst, Site};
+
+use stirling_dsl::topology::EffectSiteDecl;
+use syn::{Expr, Ident};
+
+use crate::ast::{BodyAst, Field, Item, LinkAst, ModelAst, ParamAst};
+use kinds::{Kind, Where, KINDS};
+
+/// Apply every `effect` item of `ast` (removed from its items) and return the sites.
+pub fn apply(ast: &mut ModelAst) -> syn::Result<Vec<EffectSiteDecl>> {
+    let (effects, rest): (Vec<Item>, Vec<Item>) = std::mem::take(&mut ast.items)
+        .into_iter()
+        .partition(|it| matches!(it, Item::Effect(_)));
+    ast.items = rest;
+    let mut sites: Vec<EffectSiteDecl> = Vec::new();
+    let mut added: Vec<ParamAst> = Vec::new();
+    let mut errors: Option<syn::Error> = None;
+    for it in effects {
+        let Item::Effect(e) = it else { continue };
+        match one(ast, &e, &mut added) {
+            Ok(site)
+                if sites
+                    .iter()
+                    .any(|s| s.effect == site.effect && s.at == site.at) =>
+            {
+                let msg = format!("`effect {} on {}` twice", site.effect, site.at);
+                push(&mut errors, syn::Error::new(e.span, msg));
+            }
+            Ok(site) => sites.push(site),
+            Err(err) => push(&mut errors, err),
+        }
+    }
+    if let Some(err) = errors {
+        return Err(err);
+    }
+    if !added.is_empty() {
+        ast.items.push(Item::Params(added));
+    }
+    Ok(sites)
+}
+
+fn push(errors: &mut Option<syn::Error>, e: syn::Error) {
+    match errors {
+        Some(all) => all.combine(e),
+        None => *errors = Some(e),
+    }
+}
+
+/// Apply one effect: its parameters (those the model lacks into `added`) and its term.
+fn one(
+    ast: &mut ModelAst,
+    e: &EffectAst,
+    added: &mut Vec<ParamAst>,
+) -> syn::Result<EffectSiteDecl> {
+    let name = e.kind.to_string();
+    let Some(kind) = KINDS.iter().find(|k| k.name == name) else {
+        let known: Vec<&str> = KINDS.iter().map(|k| k.name).collect();
+        let msg = format!(
+            "unknown effect `{name}`: expected one of {}",
+            known.join(", ")
+        );
+        return Err(syn::Error::new(e.span, msg));
+    };
+    if e.names.len() > kind.params.len() {
+        let msg = format!(
+            "effect `{name}` has {} parameter(s), {} named after `as`",
+            kind.params.len(),
+            e.names.len()
+        );
+        return Err(syn::Error::new(e.span, msg));
+    }
+    let names = match (&kind.site, &e.site) {
+        (Where::Body, Site::Body(b)) => on_body(ast, kind, e, b)?,
+        (Where::Between, Site::Between(from, to)) => {
+            let names = param_names(kind, e, &[&from.name.to_string(), &to.name.to_string()]);
+            ast.items.push(Item::Link(LinkAst {
+                span: e.span,
+                from: from.clone(),
+                to: to.clone(),
+                range: None,
+                fields: vec![Field {
+                    name: Ident::new("conductance", e.span),
+                    value: (kind.term)(&names, &from.name, &to.name),
+                }],
+            }));
+            names
+        }
+        (Where::Body, _) => {
+            let msg = format!("effect `{name}` acts on a body: write `effect {name} on <body>;`");
+            return Err(syn::Error::new(e.span, msg));
+        }
+        (Where::Between, _) => {
+            let msg = format!(
+                "effect `{name}` acts between two volumes: write `effect {name} <from> -> <to>;`"
+            );
+            return Err(syn::Error::new(e.span, msg));
+        }
+    };
+    declare(ast, kind, &names, &e.site.describe(), added);
+    Ok(EffectSiteDecl {
+        effect: name,
+        at: e.site.describe(),
+        params: names.iter().map(Ident::to_string).collect(),
+    })
+}
+
+/// The effect's term appended to the body's `force`.
+fn on_body(ast: &mut ModelAst, kind: &Kind, e: &EffectAst, b: &Ident) -> syn::Result<Vec<Ident>> {
+    let body = ast.items.iter_mut().find_map(|it| match it {
+        Item::Body(x) if x.name == *b => Some(x),
+        _ => None,
+    });
+    let Some(body) = body else {
+        let msg = format!(
+            "effect `{}` on `{b}`: no body `{b}`; it acts on a declared body",
+            kind.name
+        );
+        return Err(syn::Error::new(b.span(), msg));
+    };
+    let names = param_names(kind, e, &[&b.to_string(), &body.pos.to_string()]);
+    let term = (kind.term)(&names, &body.pos, &body.vel);
+    add_force(body, term);
+    Ok(names)
+}
+
+/// `force: F` becomes `force: F - term` (`force: -term` when there was none).
+fn add_force(body: &mut BodyAst, term: Expr) {
+    match body.fields.iter_mut().find(|f| f.name == "force") {
+        Some(f) => {
+            let old = &f.value;
+            f.value = syn::parse_quote!(#old - #term);
+        }
+        None => body.fields.push(Field {
+            name: Ident::new("force", body.name.span()),
+            value: syn::parse_quote!(-#term),
+        }),
+    }
+}
+
+/// The parameter names: those after `as`, then the defaults (`{0}`, `{1}`: the site's names).
+fn param_names(kind: &Kind, e: &EffectAst, site: &[&str]) -> Vec<Ident> {
+    kind.params
+        .iter()
+        .enumerate()
+        .map(|(k, p)| match e.names.get(k) {
+            Some(n) => n.clone(),
+            None => Ident::new(&fill(p.name, site), e.span),
+        })
+        .collect()
+}
+
+fn fill(pattern: &str, site: &[&str]) -> String {
+    site.iter()
+        .enumerate()
+        .fold(pattern.to_string(), |s, (k, v)| {
+            s.replace(&format!("{{{k}}}"), v)
+        })
+}
+
+/// Declare the parameters the model does not declare, at their defaults.
+fn declare(ast: &ModelAst, kind: &Kind, names: &[Ident], site: &str, added: &mut Vec<ParamAst>) {
+    let in_model = |n: &str| {
+        ast.items
+            .iter()
+            .any(|it| matches!(it, Item::Params(ps) if ps.iter().any(|p| p.name == n)))
+    };
+    for (p, name) in kind.params.iter().zip(names) {
+        let n = name.to_string();
+        if in_model(&n) || added.iter().any(|q| q.name == n) {
+            continue;
+        }
+        let default = p.default;
+        added.push(ParamAst {
+            doc: p.doc.replace("{site}", site),
+            name: name.clone(),
+            default: syn::parse_quote!(#default),
+            unit: p.unit.to_string(),
+        });
+    }
+}

@@ -1,0 +1,192 @@
+//! `effect` items (docs/custom-topologies.md, "Effects"): an effect named where it acts is the
+//! model with the effect's term written by hand (same states, parameters, defaults, right-hand
+//! side and Jacobians, the effect switched on or off), it is absent at its null bit for bit,
+//! its Jacobians match finite differences, and the model lists it in `Model::effect_sites`,
+//! from which the diagnosis takes its candidates under the model's own parameter names.
+
+mod common;
+
+use stirling::dsl::{Closure, EffectSite, Model};
+use stirling::models::effects;
+use stirling::stirling_model;
+
+stirling_model! {
+    /// `nsection` with Coulomb friction on the piston, end stops on the displacer and a seal
+    /// leak from the cold space into the bounce space, named where they act.
+    pub model Named extends stirling::models::nsection_engine {
+        modify space bounce { temperature: Tk }
+        effect coulomb on piston;
+        effect end_stops on displacer;
+        effect leak cold -> bounce;
+    }
+}
+
+stirling_model! {
+    /// The same, written by hand.
+    pub model Hand extends stirling::models::nsection_engine {
+        modify space bounce { temperature: Tk }
+        params {
+            /// Coulomb friction force on piston (0: none)
+            Fc_piston: 0.0 "N",
+            /// velocity scale of the smoothed Coulomb friction
+            v_eps: 1.0e-3 "m/s",
+            /// end-stop contact stiffness on displacer (0: no stops)
+            kc_displacer: 0.0 "N/m",
+            /// travel of displacer to its end stops
+            xmax: 0.01 "m",
+            /// seal-leak conductance cold -> bounce (0: no leak)
+            Gleak_cold_bounce: 0.0 "kg/(s Pa)",
+        }
+        modify body piston { force: -Fc_piston * tanh(w / v_eps) }
+        modify body displacer { force: -kc_displacer * ((abs(x) - xmax) + abs(abs(x) - xmax)) / 2.0 * sign(x) }
+        link cold -> bounce { conductance: Gleak_cold_bounce }
+    }
+}
+
+stirling_model! {
+    /// The nominal model the effects are added to.
+    pub model Plain extends stirling::models::nsection_engine {
+        modify space bounce { temperature: Tk }
+    }
+}
+
+/// The parameters `Named` declares, in order, with their docs and units.
+#[test]
+fn the_effects_declare_their_parameters_at_their_null() {
+    let m = Named::new(2, Closure::Full).unwrap();
+    let added: Vec<(&str, f64, &str)> = m
+        .params()
+        .iter()
+        .skip(Plain::new(2, Closure::Full).unwrap().params().len())
+        .map(|p| (p.name, p.default, p.unit))
+        .collect();
+    assert_eq!(
+        added,
+        [
+            ("Fc_piston", 0.0, "N"),
+            ("v_eps", 1.0e-3, "m/s"),
+            ("kc_displacer", 0.0, "N/m"),
+            ("xmax", 0.01, "m"),
+            ("Gleak_cold_bounce", 0.0, "kg/(s Pa)"),
+        ]
+    );
+    assert_eq!(
+        m.effect_sites(),
+        [
+            EffectSite {
+                effect: "coulomb",
+                at: "piston",
+                params: &["Fc_piston", "v_eps"]
+            },
+            EffectSite {
+                effect: "end_stops",
+                at: "displacer",
+                params: &["kc_displacer", "xmax"]
+            },
+            EffectSite {
+                effect: "leak",
+                at: "cold -> bounce",
+                params: &["Gleak_cold_bounce"]
+            },
+        ]
+    );
+}
+
+/// Named where they act or written by hand: one model, with the effects on (the random
+/// parameters move every strength off its null) and at their defaults (off).
+#[test]
+fn an_effect_named_where_it_acts_is_its_hand_written_term() {
+    for n in [1, 2, 5] {
+        for closure in [Closure::Full, Closure::Frozen] {
+            let (named, hand) = (
+                Named::new(n, closure).unwrap(),
+                Hand::new(n, closure).unwrap(),
+            );
+            let mut on = named.default_params();
+            for (name, v) in [
+                ("Fc_piston", 0.8),
+                ("kc_displacer", 2e5),
+                ("Gleak_cold_bounce", 2e-8),
+            ] {
+                on[named.param_index(name).unwrap()] = v;
+            }
+            let w = common::same::same_model(&named, &hand, 7 + n as u64);
+            assert!(w < 1e-12, "n = {n} ({closure}): off by {w:e}");
+            // with the strengths on, the right-hand sides agree bit for bit
+            let x =
+                common::random_state(&named, &on, common::Spread::Balanced, &mut common::rng(3));
+            let ph: Vec<f64> = hand
+                .params()
+                .iter()
+                .map(|p| on[named.param_index(p.name).unwrap()])
+                .collect();
+            let (mut a, mut b) = (vec![0.0; x.len()], vec![0.0; x.len()]);
+            named.rhs(&on, &x, 0.0, &mut a);
+            hand.rhs(&ph, &x, 0.0, &mut b);
+            assert_eq!(a, b, "n = {n} ({closure}): effects on");
+            let mut off = vec![0.0; x.len()];
+            named.rhs(&named.default_params(), &x, 0.0, &mut off);
+            assert_ne!(a, off, "n = {n}: the strengths change the model");
+        }
+    }
+}
+
+/// At the null the augmented model is the nominal one, bit for bit (the invariant the
+/// diagnosis stands on); and its Jacobians match finite differences with the effects on.
+#[test]
+fn at_the_null_the_effects_are_absent_and_the_jacobians_hold() {
+    for n in [1, 3] {
+        let (named, plain) = (
+            Named::new(n, Closure::Full).unwrap(),
+            Plain::new(n, Closure::Full).unwrap(),
+        );
+        let p = named.default_params();
+        let pp = plain.default_params();
+        let x = common::random_state(&plain, &pp, common::Spread::Wide, &mut common::rng(5));
+        let (mut a, mut b) = (vec![0.0; x.len()], vec![0.0; x.len()]);
+        named.rhs(&p, &x, 0.0, &mut a);
+        plain.rhs(&pp, &x, 0.0, &mut b);
+        let bits = |v: &[f64]| v.iter().map(|f| f.to_bits()).collect::<Vec<_>>();
+        assert_eq!(bits(&a), bits(&b), "n = {n}: at the null");
+        common::assert_jacobians(&named, &format!("named effects n = {n}"), 43, 3);
+    }
+}
+
+/// The diagnosis offers the effects the model names, one candidate per effect, with the
+/// model's parameter names, and the sensor effects; a library effect the model does not
+/// name is refused.
+#[test]
+fn the_diagnosis_takes_its_candidates_from_the_named_effects() {
+    let m = Named::new(2, Closure::Full).unwrap();
+    let pool = effects::carried("named", Some(&m));
+    let names: Vec<&str> = pool.iter().map(|e| e.name).collect();
+    assert_eq!(
+        names,
+        ["coulomb", "end_stops", "leak", "sensor_lag", "sensor_gain"]
+    );
+    let params = |e: &str| -> Vec<(&str, Option<f64>)> {
+        let e = pool.iter().find(|x| x.name == e).unwrap();
+        e.params.iter().map(|q| (q.name, q.null)).collect()
+    };
+    assert_eq!(
+        params("coulomb"),
+        [("Fc_piston", Some(0.0)), ("v_eps", None)]
+    );
+    assert_eq!(params("leak"), [("Gleak_cold_bounce", Some(0.0))]);
+    // the rig sets an effect by its name (its strength) or a parameter
+    let set = effects::EffectSettings::parse_for(
+        "named",
+        Some(&m),
+        &["coulomb=0.5".into(), "xmax=0.008".into()],
+    )
+    .unwrap();
+    assert_eq!(
+        set.model,
+        [("Fc_piston".to_string(), 0.5), ("xmax".to_string(), 0.008)]
+    );
+    let err =
+        effects::EffectSettings::parse_for("named", Some(&m), &["Rq=1e9".into()]).unwrap_err();
+    assert!(err.to_string().contains("does not apply"), "{err}");
+    let p = effects::nominal_params(&m);
+    assert_eq!(p, m.default_params());
+}
