@@ -24,18 +24,23 @@ use syn::{Expr, Ident};
 use crate::ast::{BodyAst, Field, Item, LinkAst, ModelAst, ParamAst};
 use kinds::{Kind, Where, KINDS};
 
-/// Apply every `effect` item of `ast` (removed from its items) and return the sites.
+/// Apply every `effect` item of `ast` and return the sites. A link an effect adds takes the
+/// item's place (so a model's links keep the order they are written in); the parameters the
+/// effects add come last.
 pub fn apply(ast: &mut ModelAst) -> syn::Result<Vec<EffectSiteDecl>> {
-    let (effects, rest): (Vec<Item>, Vec<Item>) = std::mem::take(&mut ast.items)
-        .into_iter()
-        .partition(|it| matches!(it, Item::Effect(_)));
-    ast.items = rest;
+    let mut effects: Vec<(usize, EffectAst)> = Vec::new();
+    for it in std::mem::take(&mut ast.items) {
+        match it {
+            Item::Effect(e) => effects.push((ast.items.len(), e)),
+            other => ast.items.push(other),
+        }
+    }
     let mut sites: Vec<EffectSiteDecl> = Vec::new();
     let mut added: Vec<ParamAst> = Vec::new();
+    let mut links: Vec<(usize, Item)> = Vec::new();
     let mut errors: Option<syn::Error> = None;
-    for it in effects {
-        let Item::Effect(e) = it else { continue };
-        match one(ast, &e, &mut added) {
+    for (at, e) in effects {
+        match one(ast, &e, &mut added, &mut |item| links.push((at, item))) {
             Ok(site)
                 if sites
                     .iter()
@@ -51,6 +56,9 @@ pub fn apply(ast: &mut ModelAst) -> syn::Result<Vec<EffectSiteDecl>> {
     if let Some(err) = errors {
         return Err(err);
     }
+    for (at, item) in links.into_iter().rev() {
+        ast.items.insert(at, item);
+    }
     if !added.is_empty() {
         ast.items.push(Item::Params(added));
     }
@@ -64,11 +72,13 @@ fn push(errors: &mut Option<syn::Error>, e: syn::Error) {
     }
 }
 
-/// Apply one effect: its parameters (those the model lacks into `added`) and its term.
+/// Apply one effect: its parameters (those the model lacks into `added`) and its term (a
+/// force term in place, a link given to `link`).
 fn one(
     ast: &mut ModelAst,
     e: &EffectAst,
     added: &mut Vec<ParamAst>,
+    link: &mut dyn FnMut(Item),
 ) -> syn::Result<EffectSiteDecl> {
     let name = e.kind.to_string();
     let Some(kind) = KINDS.iter().find(|k| k.name == name) else {
@@ -91,7 +101,7 @@ fn one(
         (Where::Body, Site::Body(b)) => on_body(ast, kind, e, b)?,
         (Where::Between, Site::Between(from, to)) => {
             let names = param_names(kind, e, &[&from.name.to_string(), &to.name.to_string()]);
-            ast.items.push(Item::Link(LinkAst {
+            link(Item::Link(LinkAst {
                 span: e.span,
                 from: from.clone(),
                 to: to.clone(),
