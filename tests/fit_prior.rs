@@ -12,6 +12,7 @@ fn var(initial: f64, scale: f64, prior: Option<f64>) -> Var {
         scale,
         kind: VarKind::Param(0),
         prior,
+        bounds: None,
     }
 }
 

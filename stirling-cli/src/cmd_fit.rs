@@ -29,9 +29,14 @@ pub struct FitArgs {
     /// Measured data (CSV: t and p, x, y; p_hot optional)
     #[arg(long)]
     pub data: PathBuf,
-    /// Free parameters, comma-separated (default kd,kp,bd,bp,hh,hk,Rf where used)
+    /// Free parameters, comma-separated (default: those the model declares with `free`, else
+    /// kd,kp,bd,bp,hh,hk,Rf where used)
     #[arg(long, value_delimiter = ',')]
     pub free: Option<Vec<String>>,
+    /// Bounds of free parameters (TOML `kd = [100.0, 2000.0]` or JSON), over those the model
+    /// declares; the fit stays inside them
+    #[arg(long, value_name = "FILE")]
+    pub bounds: Option<PathBuf>,
     /// Training block a:b in seconds (default: first 70 %)
     #[arg(long, allow_hyphen_values = true)]
     pub train: Option<String>,
@@ -62,8 +67,13 @@ pub fn run(a: &FitArgs) -> anyhow::Result<()> {
     let (train, holdout) = common::blocks(a.train.as_deref(), a.holdout.as_deref(), &data, 0.7)?;
     let model = stirling_models::build(&a.model, a.with.n, Closure::Full)?;
     let p0 = a.with.load(model.as_ref())?;
+    let bounds = match &a.bounds {
+        Some(f) => stirling_models::bounds::load_bounds(model.as_ref(), f)?,
+        None => Vec::new(),
+    };
     let opts = FitOptions {
         free: a.free.clone(),
+        bounds,
         multiple_shooting: a
             .multiple_shooting
             .map(|c| fit::multiple_shooting::MsOptions {

@@ -66,6 +66,8 @@ pub struct ParamAst {
     pub name: Ident,
     pub default: Expr,
     pub unit: String,
+    /// `in lo..hi`: the range a fit keeps it in.
+    pub bounds: Option<syn::ExprRange>,
 }
 
 impl Parse for ParamAst {
@@ -79,11 +81,25 @@ impl Parse for ParamAst {
         } else {
             "-".to_string()
         };
+        let bounds = if input.peek(Token![in]) {
+            let kw = input.parse::<Token![in]>()?;
+            match input.parse::<Expr>()? {
+                Expr::Range(r) if r.start.is_some() && r.end.is_some() => Some(r),
+                _ => {
+                    let msg =
+                        "expected the range a fit keeps the parameter in, e.g. `in 100.0..2000.0`";
+                    return Err(syn::Error::new(kw.span, msg));
+                }
+            }
+        } else {
+            None
+        };
         Ok(ParamAst {
             doc,
             name,
             default,
             unit,
+            bounds,
         })
     }
 }

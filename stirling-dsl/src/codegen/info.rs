@@ -11,7 +11,11 @@ use crate::topology::{BlockKind, Topology, Vessel};
 pub fn params(topo: &Topology, krate: &TokenStream) -> TokenStream {
     let items = topo.params.iter().map(|p| {
         let (name, default, unit, doc) = (&p.name, p.default, &p.unit, &p.doc);
-        quote! { #krate::ParamInfo { name: #name, default: #default, unit: #unit, doc: #doc } }
+        let bounds = match p.bounds {
+            Some((lo, hi)) => quote!(Some((#lo, #hi))),
+            None => quote!(None),
+        };
+        quote! { #krate::ParamInfo { name: #name, default: #default, unit: #unit, doc: #doc, bounds: #bounds } }
     });
     quote! { &[#(#items),*] }
 }

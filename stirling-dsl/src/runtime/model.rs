@@ -11,6 +11,9 @@ pub struct ParamInfo {
     pub default: f64,
     pub unit: &'static str,
     pub doc: &'static str,
+    /// The range a fit keeps it in, as declared (`kd: 650.0 "N/m" in 100.0..2000.0`); `None`:
+    /// the fit's default (a positive parameter stays above 2 % of its start).
+    pub bounds: Option<(f64, f64)>,
 }
 
 /// What a state is.

@@ -16,6 +16,8 @@ pub struct ParamDecl {
     pub default: f64,
     pub unit: String,
     pub doc: String,
+    /// The range a fit keeps it in (`kd: 650.0 "N/m" in 100.0..2000.0`).
+    pub bounds: Option<(f64, f64)>,
 }
 
 /// Gas properties shared by all control volumes.

@@ -24,13 +24,31 @@ impl Lower {
             states: &no_states,
             index: None,
         };
-        let default = match convert(&mut self.topo.arena, &scope, &p.default) {
+        let mut constant = |e: &syn::Expr| match convert(&mut self.topo.arena, &scope, e) {
             Ok(id) => self.topo.arena.eval_const(id).unwrap_or(f64::NAN),
             Err(e) => {
                 self.cx.errors.push(e);
                 0.0
             }
         };
+        let default = constant(&p.default);
+        let bounds = p.bounds.as_ref().map(|r| {
+            let lo = r.start.as_deref().map_or(f64::NAN, &mut constant);
+            let hi = r.end.as_deref().map_or(f64::NAN, &mut constant);
+            (lo, hi)
+        });
+        if let (Some((lo, hi)), Some(r)) = (bounds, &p.bounds) {
+            let name = &p.name;
+            let span = syn::spanned::Spanned::span(r);
+            if !(lo.is_finite() && hi.is_finite() && lo < hi) {
+                self.cx.error(span, format!("`{name}`: the bounds must be finite numbers, the lower below the upper (`in lo..hi`), got {lo}..{hi}"));
+            } else if !(lo..=hi).contains(&default) {
+                self.cx.error(
+                    span,
+                    format!("`{name}`: its default {default} is outside its bounds {lo}..{hi}"),
+                );
+            }
+        }
         let name = p.name.to_string();
         self.params
             .insert(name.clone(), self.topo.params.len() as u32);
@@ -39,6 +57,7 @@ impl Lower {
             default,
             unit: p.unit.clone(),
             doc: p.doc.clone(),
+            bounds,
         });
     }
 

@@ -203,6 +203,7 @@ fn declare(ast: &ModelAst, kind: &Kind, names: &[Ident], site: &str, added: &mut
             name: name.clone(),
             default: syn::parse_quote!(#default),
             unit: p.unit.to_string(),
+            bounds: None,
         });
     }
 }

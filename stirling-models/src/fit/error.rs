@@ -52,6 +52,15 @@ pub enum FitError {
     ShortTraining { from: f64, to: f64, samples: usize },
     #[error("{file}: {stage} needs the columns p, x and y")]
     MissingColumns { file: String, stage: &'static str },
+    #[error("parameter `{name}` = {value:.4e} is outside its bounds [{lo:.4e}, {hi:.4e}]")]
+    OutsideBounds {
+        name: String,
+        value: f64,
+        lo: f64,
+        hi: f64,
+    },
+    #[error("bounds of `{name}`: {why}")]
+    BadBounds { name: String, why: String },
     #[error("parameter `{name}` = {value:.4e} fell below {floor:.4e} (2 % of its start): the data push it out of the physical range")]
     ParamRange {
         name: String,

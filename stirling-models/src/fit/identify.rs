@@ -244,7 +244,10 @@ impl<'a> Run<'a, '_> {
         offsets: &mut free_run::SensorOffsets,
         notes: &mut Vec<String>,
     ) -> Option<multiple_shooting::MultipleShooting> {
-        let mo = self.opts.multiple_shooting.as_ref()?;
+        let mo = multiple_shooting::MsOptions {
+            bounds: self.opts.bounds.clone(),
+            ..self.opts.multiple_shooting.clone()?
+        };
         match multiple_shooting::multiple_shooting(
             self.model,
             p,
@@ -252,7 +255,7 @@ impl<'a> Run<'a, '_> {
             data,
             offsets,
             self.rec.train,
-            mo,
+            &mo,
         ) {
             Ok(r) => {
                 for (k, (_, v)) in r.params.iter().enumerate() {
@@ -288,6 +291,79 @@ impl<'a> Run<'a, '_> {
     }
 }
 
+/// A note for each free parameter that ended at one of its bounds (within 1e-3 of the
+/// range): the data push it further, and its interval, cut by the bound, says less than it
+/// seems.
+fn at_bounds(
+    model: &dyn Model,
+    p: &[f64],
+    free: &[usize],
+    given: &[(String, f64, f64)],
+) -> Vec<String> {
+    let mut notes = Vec::new();
+    for &j in free {
+        let info = &model.params()[j];
+        let given = given.iter().find(|b| b.0 == info.name).map(|b| (b.1, b.2));
+        let Some((lo, hi)) = given.or(info.bounds) else {
+            continue;
+        };
+        let near = 1e-3 * (hi - lo);
+        let side = if p[j] - lo <= near {
+            ("lower", lo)
+        } else if hi - p[j] <= near {
+            ("upper", hi)
+        } else {
+            continue;
+        };
+        notes.push(format!(
+            "`{}` = {:.5e} ended at its {} bound {:.5e}: the data push it further; widen the bound or look for what it absorbs",
+            info.name, p[j], side.0, side.1
+        ));
+    }
+    notes
+}
+
+/// The given bounds name parameters of the model, each a finite range, and every free
+/// parameter starts inside its bounds (given or declared).
+fn check_bounds(
+    model: &dyn Model,
+    p0: &[f64],
+    free: &[String],
+    given: &[(String, f64, f64)],
+) -> Result<(), FitError> {
+    let bad = |name: &str, why: String| FitError::BadBounds {
+        name: name.into(),
+        why,
+    };
+    for (name, lo, hi) in given {
+        if model.param_index(name).is_none() {
+            return Err(FitError::UnknownParameter {
+                name: name.clone(),
+                model: model.name().into(),
+            });
+        }
+        if !(lo.is_finite() && hi.is_finite() && lo < hi) {
+            return Err(bad(
+                name,
+                format!("expected finite numbers lo < hi, got [{lo}, {hi}]"),
+            ));
+        }
+    }
+    for name in free {
+        let Some(j) = model.param_index(name) else {
+            continue; // reported by the classification
+        };
+        let given = given.iter().find(|b| &b.0 == name).map(|b| (b.1, b.2));
+        if let Some((lo, hi)) = given.or(model.params()[j].bounds) {
+            if !(lo..=hi).contains(&p0[j]) {
+                let why = format!("its start {} is outside [{lo}, {hi}]", p0[j]);
+                return Err(bad(name, why));
+            }
+        }
+    }
+    Ok(())
+}
+
 /// [`identify`], also returning the fitted stages (stage 1, then stage 2, those that ran).
 pub fn identify_stages<'a>(
     model: &'a dyn Model,
@@ -300,6 +376,7 @@ pub fn identify_stages<'a>(
     let layout = StateLayout::working_gas(model);
     let rec = Record::new(model, &layout, p0, data, opts)?;
     let free = opts.free.clone().unwrap_or_else(|| default_free(model, p0));
+    check_bounds(model, p0, &free, &opts.bounds)?;
     let (mech, gas_free) = classify(model, p0, &free)?;
     let run = Run {
         model,
@@ -334,6 +411,7 @@ pub fn identify_stages<'a>(
     idx_free.extend(gas_free.iter().filter(|j| !mech.contains(j)));
     let ms = run.refine(data, &idx_free, &mut st.p, &mut offsets, &mut notes);
     let fr = run.validate(data, &st.p, &offsets, &mut notes);
+    notes.extend(at_bounds(model, &st.p, &idx_free, &opts.bounds));
     let id = Identification {
         model: model.name().into(),
         n: model.n(),

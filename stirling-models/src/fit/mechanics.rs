@@ -117,7 +117,7 @@ fn body_start(rec: &Record, x_off: [f64; 2]) -> Vec<f64> {
 /// The fit variables: free parameters, the four body initial states `z0`, the position offsets.
 fn variables(model: &dyn Model, inp: &MechInputs, z0: &[f64], opts: &FitOptions) -> Vec<Var> {
     let x_off = inp.x_off;
-    let mut vars = Var::params(model, inp.p, inp.free, opts.prior);
+    let mut vars = Var::params(model, inp.p, inp.free, opts.prior, &opts.bounds);
     for (k, nm) in ["x(0)", "v(0)", "y(0)", "w(0)"].iter().enumerate() {
         vars.push(Var::initial(
             nm,

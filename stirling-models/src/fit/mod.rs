@@ -96,6 +96,10 @@ pub struct FitOptions {
     /// Log-normal prior on the free model parameters around their starting values, as a log
     /// standard deviation (see [`prior`]; `None`: plain least squares).
     pub prior: Option<f64>,
+    /// Bounds `(name, lo, hi)` of free parameters, over those the model declares
+    /// (`kd: 650.0 "N/m" in 100.0..2000.0`): a trial step outside is rejected, so the fit
+    /// stays inside (and the start must be inside).
+    pub bounds: Vec<(String, f64, f64)>,
     /// Free-run validation after the stages (on the held-out block, else the training block).
     pub free_run: Option<free_run::FreeRunOptions>,
     /// Multiple-shooting refinement of the free parameters over the training block (off by
@@ -120,6 +124,7 @@ impl Default for FitOptions {
             drift_cut: 0.5,
             input_noise_draws: 40,
             prior: None,
+            bounds: Vec::new(),
             free_run: Some(free_run::FreeRunOptions::default()),
             multiple_shooting: None,
         }

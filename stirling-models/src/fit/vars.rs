@@ -18,18 +18,33 @@ pub struct Var {
     /// A log-normal prior centred on `initial`: `ln(value / initial) / prior` is one more
     /// residual (`None`, or `initial = 0`: no prior). See [`super::FitOptions::prior`].
     pub prior: Option<f64>,
+    /// The range the fit keeps it in (a trial step outside is rejected; see
+    /// [`super::FitOptions::bounds`]).
+    pub bounds: Option<(f64, f64)>,
 }
 
 impl Var {
-    /// The variables of the model parameters `free` (indices), scaled by their values.
-    pub fn params(model: &dyn Model, p: &[f64], free: &[usize], prior: Option<f64>) -> Vec<Var> {
+    /// The variables of the model parameters `free` (indices), scaled by their values, in
+    /// the bounds `bounds` gives (by name) or the model declares.
+    pub fn params(
+        model: &dyn Model,
+        p: &[f64],
+        free: &[usize],
+        prior: Option<f64>,
+        bounds: &[(String, f64, f64)],
+    ) -> Vec<Var> {
         free.iter()
-            .map(|&j| Var {
-                name: model.params()[j].name.into(),
-                initial: p[j],
-                scale: p[j].abs().max(1e-12),
-                kind: VarKind::Param(j),
-                prior,
+            .map(|&j| {
+                let info = &model.params()[j];
+                let given = bounds.iter().find(|b| b.0 == info.name);
+                Var {
+                    name: info.name.into(),
+                    initial: p[j],
+                    scale: p[j].abs().max(1e-12),
+                    kind: VarKind::Param(j),
+                    prior,
+                    bounds: given.map(|b| (b.1, b.2)).or(info.bounds),
+                }
             })
             .collect()
     }
@@ -42,6 +57,7 @@ impl Var {
             scale,
             kind: VarKind::Initial(pos),
             prior: None,
+            bounds: None,
         }
     }
 
@@ -53,6 +69,7 @@ impl Var {
             scale,
             kind: VarKind::Offset { out, du },
             prior: None,
+            bounds: None,
         }
     }
 }

@@ -11,6 +11,8 @@
 /// [`effects`] extends; a base is a `macro_rules!`, visible in textual order).
 #[macro_use]
 pub mod family;
+/// Bounds of parameters from a file, for the fit.
+pub mod bounds;
 /// Effects the nominal models leave out, as DSL-declared model augmentations.
 pub mod effects;
 /// Causes outside the effect library: truth models for the rig and the self-check only.

@@ -59,6 +59,7 @@ impl EffectVars {
                         scale,
                         kind,
                         prior: None,
+                        bounds: None,
                     };
                     v.adds.push((si, var));
                 }

@@ -36,7 +36,7 @@ use problem::Problem;
 use setup::{cut_segments, output_vars, param_vars, segment_vars};
 
 /// Options of the refinement.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Debug)]
 pub struct MsOptions {
     /// Cycles per segment.
     pub cycles: f64,
@@ -48,6 +48,9 @@ pub struct MsOptions {
     pub smooth: f64,
     pub lm: lm::LmOptions,
     pub sim: SimOptions,
+    /// Bounds `(name, lo, hi)` over those the model declares (as
+    /// [`FitOptions::bounds`](crate::fit::FitOptions::bounds)).
+    pub bounds: Vec<(String, f64, f64)>,
 }
 
 impl Default for MsOptions {
@@ -59,6 +62,7 @@ impl Default for MsOptions {
             smooth: 0.006,
             lm: lm::LmOptions::stage(),
             sim: SimOptions::default(),
+            bounds: Vec::new(),
         }
     }
 }
@@ -121,6 +125,14 @@ pub fn multiple_shooting(
         model,
         p: p0.to_vec(),
         free: free.to_vec(),
+        bounds: free
+            .iter()
+            .map(|&j| {
+                let info = &model.params()[j];
+                let given = opts.bounds.iter().find(|b| b.0 == info.name);
+                given.map(|b| (b.1, b.2)).or(info.bounds)
+            })
+            .collect(),
         outs: outputs.outs,
         off0: outputs.off0,
         segs,

@@ -21,6 +21,8 @@ pub(super) struct Problem<'a> {
     pub(super) model: &'a dyn Model,
     pub(super) p: Vec<f64>,
     pub(super) free: Vec<usize>,
+    /// The bounds of each free parameter.
+    pub(super) bounds: Vec<Option<(f64, f64)>>,
     /// `(name, state, data, sigma, offset variable)`.
     pub(super) outs: Vec<(String, usize, Vec<f64>, f64, Option<usize>)>,
     pub(super) off0: Vec<f64>,
@@ -88,6 +90,18 @@ impl Problem<'_> {
     pub(super) fn eval(&self, u: &[f64], sens: bool) -> Result<Eval, FitError> {
         let th = self.values(u);
         let n = self.model.n_states();
+        for (k, b) in self.bounds.iter().enumerate() {
+            if let Some((lo, hi)) = b.filter(|&(lo, hi)| !(lo..=hi).contains(&th[k])) {
+                let name = self.vars[k].name.clone();
+                let value = th[k];
+                return Err(FitError::OutsideBounds {
+                    name,
+                    value,
+                    lo,
+                    hi,
+                });
+            }
+        }
         let p = self.params_with(&th);
         let columns = if sens { self.columns() } else { Vec::new() };
         let rows: usize = self.segs.iter().map(|(a, b)| b - a).sum::<usize>() + 1;
