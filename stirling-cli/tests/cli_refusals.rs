@@ -1,6 +1,6 @@
 //! Records that cannot carry a result are refused with the reason and a non-zero exit, never
 //! answered: no motion (`fit` and `diagnose`), too few cycles (`fit`), too short to hold
-//! out (`diagnose`).
+//! out (`diagnose`); and bounds that cannot be used (`fit --bounds`).
 
 mod support;
 
@@ -56,5 +56,29 @@ fn a_record_too_short_to_hold_out_is_refused_by_diagnose() {
     fails_with(
         &["diagnose", "cv1", "--data", s(&f)],
         &["too short to diagnose"],
+    );
+}
+
+#[test]
+fn bounds_the_fit_cannot_use_are_refused_by_name() {
+    let f = write("bounded", 2000, true);
+    let dir = scratch("bounds_files");
+    for (name, text, says) in [
+        (
+            "unknown.toml",
+            "kq = [1.0, 2.0]\n",
+            "unknown parameter `kq`",
+        ),
+        ("reversed.toml", "kd = [700.0, 600.0]\n", "lo < hi"),
+        ("start.toml", "kd = [700.0, 800.0]\n", "outside [700, 800]"),
+    ] {
+        let b = dir.join(name);
+        std::fs::write(&b, text).unwrap();
+        fails_with(&["fit", "cv1", "--data", s(&f), "--bounds", s(&b)], &[says]);
+    }
+    let missing = dir.join("missing.toml");
+    fails_with(
+        &["fit", "cv1", "--data", s(&f), "--bounds", s(&missing)],
+        &["cannot read", "missing.toml"],
     );
 }
