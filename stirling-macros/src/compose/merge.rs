@@ -57,9 +57,11 @@ impl Merge<'_> {
         self.errors.push(syn::Error::new(span, msg));
     }
 
-    /// An added item: appended, unless the base already declares its name (links excepted).
+    /// An added item: appended, unless the base already declares its name (links and effects
+    /// excepted: a link may repeat, and an effect named twice is refused where effects are
+    /// applied, `crate::effects`).
     fn add_item(&mut self, c: Chunk) {
-        let links = matches!(c.key, Key::Link(..));
+        let links = matches!(c.key, Key::Link(..) | Key::Effect(..));
         if !links && c.key != Key::Name && find(&self.items, &c.key).is_some() {
             let base = self.base;
             let msg = format!(
