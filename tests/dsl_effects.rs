@@ -18,6 +18,7 @@ stirling_model! {
         effect coulomb on piston;
         effect end_stops on displacer;
         effect leak cold -> bounce;
+        effect orifice_leak cold -> bounce;
     }
 }
 
@@ -36,10 +37,15 @@ stirling_model! {
             xmax: 0.01 "m",
             /// seal-leak conductance cold -> bounce (0: no leak)
             Gleak_cold_bounce: 0.0 "kg/(s Pa)",
+            /// orifice seal-leak coefficient cold -> bounce (0: no leak)
+            Co_cold_bounce: 0.0 "kg/(s Pa^0.5)",
+            /// width of the orifice law's linear core
+            dP0: 50.0 "Pa",
         }
         modify body piston { force: -Fc_piston * tanh(w / v_eps) }
         modify body displacer { force: -kc_displacer * ((abs(x) - xmax) + abs(abs(x) - xmax)) / 2.0 * sign(x) }
         link cold -> bounce { conductance: Gleak_cold_bounce }
+        link cold -> bounce { orifice: Co_cold_bounce, dp0: dP0 }
     }
 }
 
@@ -68,6 +74,8 @@ fn the_effects_declare_their_parameters_at_their_null() {
             ("kc_displacer", 0.0, "N/m"),
             ("xmax", 0.01, "m"),
             ("Gleak_cold_bounce", 0.0, "kg/(s Pa)"),
+            ("Co_cold_bounce", 0.0, "kg/(s Pa^0.5)"),
+            ("dP0", 50.0, "Pa"),
         ]
     );
     assert_eq!(
@@ -88,6 +96,11 @@ fn the_effects_declare_their_parameters_at_their_null() {
                 at: "cold -> bounce",
                 params: &["Gleak_cold_bounce"]
             },
+            EffectSite {
+                effect: "orifice_leak",
+                at: "cold -> bounce",
+                params: &["Co_cold_bounce", "dP0"]
+            },
         ]
     );
 }
@@ -107,6 +120,7 @@ fn an_effect_named_where_it_acts_is_its_hand_written_term() {
                 ("Fc_piston", 0.8),
                 ("kc_displacer", 2e5),
                 ("Gleak_cold_bounce", 2e-8),
+                ("Co_cold_bounce", 1e-6),
             ] {
                 on[named.param_index(name).unwrap()] = v;
             }
@@ -162,7 +176,14 @@ fn the_diagnosis_takes_its_candidates_from_the_named_effects() {
     let names: Vec<&str> = pool.iter().map(|e| e.name).collect();
     assert_eq!(
         names,
-        ["coulomb", "end_stops", "leak", "sensor_lag", "sensor_gain"]
+        [
+            "coulomb",
+            "end_stops",
+            "leak",
+            "orifice_leak",
+            "sensor_lag",
+            "sensor_gain"
+        ]
     );
     let params = |e: &str| -> Vec<(&str, Option<f64>)> {
         let e = pool.iter().find(|x| x.name == e).unwrap();

@@ -3,12 +3,13 @@
 
 use syn::{Expr, Ident};
 
-/// Where an effect of a kind acts.
+/// Where an effect of a kind acts, and what it adds there.
 pub enum Where {
-    /// On a body (`on <body>`): a force term.
-    Body,
-    /// Between two volumes (`<from> -> <to>`): a mass-flow link.
-    Between,
+    /// On a body (`on <body>`): a force term from the parameter names and the body's position
+    /// and velocity, subtracted from the body's force.
+    Body(fn(&[Ident], &Ident, &Ident) -> Expr),
+    /// Between two volumes (`<from> -> <to>`): a mass-flow link with these fields.
+    Between(fn(&[Ident]) -> Vec<(&'static str, Expr)>),
 }
 
 /// A parameter: its default name (`{0}`: the body or first end, `{1}`: the body's position
@@ -26,10 +27,6 @@ pub struct Kind {
     pub name: &'static str,
     pub site: Where,
     pub params: &'static [ParamKind],
-    /// The term from the parameter names and the site's two names (a body's position and
-    /// velocity; a link's two ends): the force subtracted from the body's, or the link's
-    /// conductance.
-    pub term: fn(&[Ident], &Ident, &Ident) -> Expr,
 }
 
 const fn param(
@@ -58,16 +55,25 @@ fn end_stops(p: &[Ident], pos: &Ident, _vel: &Ident) -> Expr {
     syn::parse_quote!(#kc * ((abs(#pos) - #qmax) + abs(abs(#pos) - #qmax)) / 2.0 * sign(#pos))
 }
 
-/// A seal leak: the link's conductance.
-fn leak(p: &[Ident], _from: &Ident, _to: &Ident) -> Expr {
+/// A seal leak: a linear conductance.
+fn leak(p: &[Ident]) -> Vec<(&'static str, Expr)> {
     let g = &p[0];
-    syn::parse_quote!(#g)
+    vec![("conductance", syn::parse_quote!(#g))]
+}
+
+/// A seal leak through an orifice: the square-root law with its linear core `dP0`.
+fn orifice_leak(p: &[Ident]) -> Vec<(&'static str, Expr)> {
+    let (co, dp0) = (&p[0], &p[1]);
+    vec![
+        ("orifice", syn::parse_quote!(#co)),
+        ("dp0", syn::parse_quote!(#dp0)),
+    ]
 }
 
 pub const KINDS: &[Kind] = &[
     Kind {
         name: "coulomb",
-        site: Where::Body,
+        site: Where::Body(coulomb),
         params: &[
             param(
                 "Fc_{0}",
@@ -82,11 +88,10 @@ pub const KINDS: &[Kind] = &[
                 "velocity scale of the smoothed Coulomb friction",
             ),
         ],
-        term: coulomb,
     },
     Kind {
         name: "end_stops",
-        site: Where::Body,
+        site: Where::Body(end_stops),
         params: &[
             param(
                 "kc_{0}",
@@ -96,17 +101,28 @@ pub const KINDS: &[Kind] = &[
             ),
             param("{1}max", 0.01, "m", "travel of {site} to its end stops"),
         ],
-        term: end_stops,
     },
     Kind {
         name: "leak",
-        site: Where::Between,
+        site: Where::Between(leak),
         params: &[param(
             "Gleak_{0}_{1}",
             0.0,
             "kg/(s Pa)",
             "seal-leak conductance {site} (0: no leak)",
         )],
-        term: leak,
+    },
+    Kind {
+        name: "orifice_leak",
+        site: Where::Between(orifice_leak),
+        params: &[
+            param(
+                "Co_{0}_{1}",
+                0.0,
+                "kg/(s Pa^0.5)",
+                "orifice seal-leak coefficient {site} (0: no leak)",
+            ),
+            param("dP0", 50.0, "Pa", "width of the orifice law's linear core"),
+        ],
     },
 ];

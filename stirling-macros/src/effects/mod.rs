@@ -5,6 +5,7 @@
 //! effect coulomb on piston;              // force -Fc_piston tanh(w / v_eps) on the piston
 //! effect end_stops on displacer;         // -kc_displacer relu(|x| - xmax) sign(x)
 //! effect leak cold -> bounce;            // link cold -> bounce { conductance: Gleak_cold_bounce }
+//! effect orifice_leak cold -> bounce;    // link cold -> bounce { orifice: Co_cold_bounce, dp0: dP0 }
 //! effect coulomb on piston as Fcp;       // the strength named `Fcp` (then the shape, `as Fcp, v_eps`)
 //! ```
 //!
@@ -98,26 +99,29 @@ fn one(
         return Err(syn::Error::new(e.span, msg));
     }
     let names = match (&kind.site, &e.site) {
-        (Where::Body, Site::Body(b)) => on_body(ast, kind, e, b)?,
-        (Where::Between, Site::Between(from, to)) => {
+        (Where::Body(term), Site::Body(b)) => on_body(ast, kind, *term, e, b)?,
+        (Where::Between(fields), Site::Between(from, to)) => {
             let names = param_names(kind, e, &[&from.name.to_string(), &to.name.to_string()]);
             link(Item::Link(LinkAst {
                 span: e.span,
                 from: from.clone(),
                 to: to.clone(),
                 range: None,
-                fields: vec![Field {
-                    name: Ident::new("conductance", e.span),
-                    value: (kind.term)(&names, &from.name, &to.name),
-                }],
+                fields: fields(&names)
+                    .into_iter()
+                    .map(|(name, value)| Field {
+                        name: Ident::new(name, e.span),
+                        value,
+                    })
+                    .collect(),
             }));
             names
         }
-        (Where::Body, _) => {
+        (Where::Body(_), _) => {
             let msg = format!("effect `{name}` acts on a body: write `effect {name} on <body>;`");
             return Err(syn::Error::new(e.span, msg));
         }
-        (Where::Between, _) => {
+        (Where::Between(_), _) => {
             let msg = format!(
                 "effect `{name}` acts between two volumes: write `effect {name} <from> -> <to>;`"
             );
@@ -133,7 +137,13 @@ fn one(
 }
 
 /// The effect's term appended to the body's `force`.
-fn on_body(ast: &mut ModelAst, kind: &Kind, e: &EffectAst, b: &Ident) -> syn::Result<Vec<Ident>> {
+fn on_body(
+    ast: &mut ModelAst,
+    kind: &Kind,
+    term: fn(&[Ident], &Ident, &Ident) -> Expr,
+    e: &EffectAst,
+    b: &Ident,
+) -> syn::Result<Vec<Ident>> {
     let body = ast.items.iter_mut().find_map(|it| match it {
         Item::Body(x) if x.name == *b => Some(x),
         _ => None,
@@ -146,8 +156,7 @@ fn on_body(ast: &mut ModelAst, kind: &Kind, e: &EffectAst, b: &Ident) -> syn::Re
         return Err(syn::Error::new(b.span(), msg));
     };
     let names = param_names(kind, e, &[&b.to_string(), &body.pos.to_string()]);
-    let term = (kind.term)(&names, &body.pos, &body.vel);
-    add_force(body, term);
+    add_force(body, term(&names, &body.pos, &body.vel));
     Ok(names)
 }
 

@@ -127,6 +127,6 @@ stirling_macros::stirling_model! {
         link matrix[j] -> matrix[j + 1] for j in 0..n - 1 { conductance: Gm * n }
         link Th -> matrix[0] { conductance: 2.0 * Gm * n }
         link matrix[n - 1] -> Tk { conductance: 2.0 * Gm * n }
-        link cold -> bounce { orifice: Co, dp0: dP0 }
+        effect orifice_leak cold -> bounce as Co, dP0;
     }
 }
