@@ -19,6 +19,7 @@ stirling_model! {
         effect end_stops on displacer;
         effect leak cold -> bounce;
         effect orifice_leak cold -> bounce;
+        effect quadratic on link hot -> regen[0];
     }
 }
 
@@ -41,7 +42,10 @@ stirling_model! {
             Co_cold_bounce: 0.0 "kg/(s Pa^0.5)",
             /// width of the orifice law's linear core
             dP0: 50.0 "Pa",
+            /// quadratic flow resistance of link hot -> regen[0] (0: linear only)
+            Rq_hot_regen: 0.0 "Pa s^2/kg^2",
         }
+        modify link hot -> regen[0] { quadratic: Rq_hot_regen }
         modify body piston { force: -Fc_piston * tanh(w / v_eps) }
         modify body displacer { force: -kc_displacer * ((abs(x) - xmax) + abs(abs(x) - xmax)) / 2.0 * sign(x) }
         link cold -> bounce { conductance: Gleak_cold_bounce }
@@ -76,6 +80,7 @@ fn the_effects_declare_their_parameters_at_their_null() {
             ("Gleak_cold_bounce", 0.0, "kg/(s Pa)"),
             ("Co_cold_bounce", 0.0, "kg/(s Pa^0.5)"),
             ("dP0", 50.0, "Pa"),
+            ("Rq_hot_regen", 0.0, "Pa s^2/kg^2"),
         ]
     );
     assert_eq!(
@@ -101,6 +106,11 @@ fn the_effects_declare_their_parameters_at_their_null() {
                 at: "cold -> bounce",
                 params: &["Co_cold_bounce", "dP0"]
             },
+            EffectSite {
+                effect: "quadratic",
+                at: "link hot -> regen[0]",
+                params: &["Rq_hot_regen"]
+            },
         ]
     );
 }
@@ -121,6 +131,7 @@ fn an_effect_named_where_it_acts_is_its_hand_written_term() {
                 ("kc_displacer", 2e5),
                 ("Gleak_cold_bounce", 2e-8),
                 ("Co_cold_bounce", 1e-6),
+                ("Rq_hot_regen", 1e9),
             ] {
                 on[named.param_index(name).unwrap()] = v;
             }
@@ -181,6 +192,7 @@ fn the_diagnosis_takes_its_candidates_from_the_named_effects() {
             "end_stops",
             "leak",
             "orifice_leak",
+            "quadratic",
             "sensor_lag",
             "sensor_gain"
         ]
@@ -194,6 +206,15 @@ fn the_diagnosis_takes_its_candidates_from_the_named_effects() {
         [("Fc_piston", Some(0.0)), ("v_eps", None)]
     );
     assert_eq!(params("leak"), [("Gleak_cold_bounce", Some(0.0))]);
+    let typical = |e: &str| {
+        pool.iter()
+            .find(|x| x.name == e)
+            .unwrap()
+            .strength()
+            .typical
+    };
+    assert_eq!(typical("quadratic"), 1e9, "the library's regen_quadratic");
+    assert_eq!(typical("leak"), 2e-8);
     // the rig sets an effect by its name (its strength) or a parameter
     let set = effects::EffectSettings::parse_for(
         "named",

@@ -10,6 +10,8 @@ pub enum Where {
     Body(fn(&[Ident], &Ident, &Ident) -> Expr),
     /// Between two volumes (`<from> -> <to>`): a mass-flow link with these fields.
     Between(fn(&[Ident]) -> Vec<(&'static str, Expr)>),
+    /// On a declared link (`on link <from> -> <to>`): these fields added to it.
+    Link(fn(&[Ident]) -> Vec<(&'static str, Expr)>),
 }
 
 /// A parameter: its default name (`{0}`: the body or first end, `{1}`: the body's position
@@ -61,6 +63,12 @@ fn leak(p: &[Ident]) -> Vec<(&'static str, Expr)> {
     vec![("conductance", syn::parse_quote!(#g))]
 }
 
+/// Quadratic (turbulent) friction of a link: `dP = R mdot + Rq mdot |mdot|`.
+fn quadratic(p: &[Ident]) -> Vec<(&'static str, Expr)> {
+    let rq = &p[0];
+    vec![("quadratic", syn::parse_quote!(#rq))]
+}
+
 /// A seal leak through an orifice: the square-root law with its linear core `dP0`.
 fn orifice_leak(p: &[Ident]) -> Vec<(&'static str, Expr)> {
     let (co, dp0) = (&p[0], &p[1]);
@@ -110,6 +118,16 @@ pub const KINDS: &[Kind] = &[
             0.0,
             "kg/(s Pa)",
             "seal-leak conductance {site} (0: no leak)",
+        )],
+    },
+    Kind {
+        name: "quadratic",
+        site: Where::Link(quadratic),
+        params: &[param(
+            "Rq_{0}_{1}",
+            0.0,
+            "Pa s^2/kg^2",
+            "quadratic flow resistance of {site} (0: linear only)",
         )],
     },
     Kind {

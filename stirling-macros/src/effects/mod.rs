@@ -117,8 +117,15 @@ fn one(
             }));
             names
         }
+        (Where::Link(fields), Site::Link(from, to)) => on_link(ast, kind, *fields, e, (from, to))?,
         (Where::Body(_), _) => {
             let msg = format!("effect `{name}` acts on a body: write `effect {name} on <body>;`");
+            return Err(syn::Error::new(e.span, msg));
+        }
+        (Where::Link(_), _) => {
+            let msg = format!(
+                "effect `{name}` acts on a link: write `effect {name} on link <from> -> <to>;`"
+            );
             return Err(syn::Error::new(e.span, msg));
         }
         (Where::Between(_), _) => {
@@ -157,6 +164,41 @@ fn on_body(
     };
     let names = param_names(kind, e, &[&b.to_string(), &body.pos.to_string()]);
     add_force(body, term(&names, &body.pos, &body.vel));
+    Ok(names)
+}
+
+/// The effect's fields added to the declared link `from -> to` (its ends as written).
+fn on_link(
+    ast: &mut ModelAst,
+    kind: &Kind,
+    fields: fn(&[Ident]) -> Vec<(&'static str, Expr)>,
+    e: &EffectAst,
+    (from, to): (&crate::ast::EndAst, &crate::ast::EndAst),
+) -> syn::Result<Vec<Ident>> {
+    let end = crate::compose::end_str;
+    let link = ast.items.iter_mut().find_map(|it| match it {
+        Item::Link(l) if end(&l.from) == end(from) && end(&l.to) == end(to) => Some(l),
+        _ => None,
+    });
+    let site = format!("{} -> {}", end(from), end(to));
+    let Some(link) = link else {
+        let msg = format!("effect `{}` on link `{site}`: no link `{site}` (its ends as the link item writes them)", kind.name);
+        return Err(syn::Error::new(from.name.span(), msg));
+    };
+    let names = param_names(kind, e, &[&from.name.to_string(), &to.name.to_string()]);
+    for (name, value) in fields(&names) {
+        if link.fields.iter().any(|f| f.name == name) {
+            let msg = format!(
+                "effect `{}` on link `{site}`: the link has its `{name}` already",
+                kind.name
+            );
+            return Err(syn::Error::new(e.span, msg));
+        }
+        link.fields.push(Field {
+            name: Ident::new(name, e.span),
+            value,
+        });
+    }
     Ok(names)
 }
 

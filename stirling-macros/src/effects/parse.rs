@@ -13,6 +13,8 @@ pub enum Site {
     Body(Ident),
     /// `<from> -> <to>`: between two volumes (a leak).
     Between(EndAst, EndAst),
+    /// `on link <from> -> <to>`: on a declared link (its ends as written).
+    Link(EndAst, EndAst),
 }
 
 /// One `effect` item.
@@ -31,7 +33,14 @@ impl Parse for EffectAst {
         let span = kind.span();
         let site = if input.peek(Ident) && input.fork().parse::<Ident>()? == "on" {
             input.parse::<Ident>()?;
-            Site::Body(input.parse()?)
+            if input.peek(Ident) && input.peek2(Ident) && input.fork().parse::<Ident>()? == "link" {
+                input.parse::<Ident>()?;
+                let from: EndAst = input.parse()?;
+                input.parse::<Token![->]>()?;
+                Site::Link(from, input.parse()?)
+            } else {
+                Site::Body(input.parse()?)
+            }
         } else {
             let from: EndAst = input.parse()?;
             input.parse::<Token![->]>()?;
@@ -56,10 +65,15 @@ impl Parse for EffectAst {
 }
 
 impl Site {
-    /// As written: `piston`, `cold -> bounce`.
+    /// As written: `piston`, `cold -> bounce`, `link hot -> regen[0]`.
     pub fn describe(&self) -> String {
         match self {
             Site::Body(b) => b.to_string(),
+            Site::Link(a, b) => format!(
+                "link {} -> {}",
+                crate::compose::end_str(a),
+                crate::compose::end_str(b)
+            ),
             Site::Between(a, b) => format!(
                 "{} -> {}",
                 crate::compose::end_str(a),

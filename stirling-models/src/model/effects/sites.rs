@@ -47,7 +47,7 @@ fn build(model: &dyn Model) -> Vec<&'static EffectInfo> {
                 .map(|s| s.at)
                 .collect();
             let params = params_of(model, kind);
-            let lib = effect(kind);
+            let lib = library(kind);
             let what = lib.map_or(kind, |e| e.summary);
             let info = EffectInfo {
                 name: kind,
@@ -107,8 +107,17 @@ fn params_of(model: &dyn Model, kind: &str) -> Vec<EffectParam> {
 /// A clearly visible strength: the library's for a parameter of that name, else the
 /// library's for the effect (its strength parameter's).
 fn typical_strength(kind: &str, name: &str) -> f64 {
-    let lib = effect(kind);
+    let lib = library(kind);
     lib.and_then(|e| e.params.iter().find(|p| p.name == name))
         .or_else(|| lib.map(EffectInfo::strength))
         .map_or(1.0, |p| p.typical)
+}
+
+/// The library's effect of an `effect` kind (`quadratic` on a link is the library's
+/// `regen_quadratic` on the regenerator's links).
+fn library(kind: &str) -> Option<&'static EffectInfo> {
+    effect(match kind {
+        "quadratic" => "regen_quadratic",
+        k => k,
+    })
 }
