@@ -5,7 +5,7 @@
 use std::path::PathBuf;
 
 use clap::Args;
-use stirling_dsl::{Model, Style};
+use stirling_dsl::{EffectSite, Model, Style};
 
 use crate::common::{self, files, ModelArgs};
 
@@ -88,6 +88,16 @@ fn listing(model: &dyn Model, p: &[f64], style: Style) -> String {
         s.push_str("\nsensors (CSV columns a record may hold)\n");
         s.push_str(&table(&sensor_rows(model), &["column", "state", "unit"]));
     }
+    let (sites, member) = effect_sites(model);
+    if !sites.is_empty() {
+        let from = member.map_or(String::new(), |m| {
+            format!(", on its augmented member `{m}`")
+        });
+        s.push_str(&format!(
+            "\neffects at their null (what `stirling diagnose` may test{from})\n"
+        ));
+        s.push_str(&table(&effect_rows(sites), &["effect", "at", "parameters"]));
+    }
     s.push('\n');
     s.push_str(&model.equations(style));
     s
@@ -123,14 +133,39 @@ fn sensor_rows(model: &dyn Model) -> Vec<Vec<String>> {
         .collect()
 }
 
+/// The effects the model names with `effect` items, or those of the augmented member a
+/// registered model names for the diagnosis (with that member's name).
+fn effect_sites(model: &dyn Model) -> (&'static [EffectSite], Option<&'static str>) {
+    if !model.effect_sites().is_empty() {
+        return (model.effect_sites(), None);
+    }
+    let member = stirling_models::user_models::find(model.name())
+        .and_then(|u| u.augmented)
+        .and_then(|build| build(model.n(), model.closure()).ok());
+    match member {
+        Some(m) => (m.effect_sites(), Some(m.name())),
+        None => (&[], None),
+    }
+}
+
+fn effect_rows(sites: &[EffectSite]) -> Vec<Vec<String>> {
+    sites
+        .iter()
+        .map(|e| vec![e.effect.into(), e.at.into(), e.params.join(", ")])
+        .collect()
+}
+
 fn param_rows(model: &dyn Model, p: &[f64]) -> Vec<Vec<String>> {
     let rows = model.params().iter().zip(p);
     rows.map(|(info, &v)| {
-        let doc = if v == info.default {
+        let mut doc = if v == info.default {
             info.doc.to_string()
         } else {
             format!("{} (default {})", info.doc, fmt(info.default))
         };
+        if let Some((lo, hi)) = info.bounds {
+            doc.push_str(&format!(" [fit bounds {}..{}]", fmt(lo), fmt(hi)));
+        }
         vec![info.name.into(), fmt(v), info.unit.into(), doc]
     })
     .collect()
@@ -190,7 +225,12 @@ fn json(model: &dyn Model, p: &[f64], style: Style) -> serde_json::Value {
         .params()
         .iter()
         .zip(p)
-        .map(|(i, v)| serde_json::json!({ "name": i.name, "value": v, "default": i.default, "unit": i.unit, "doc": i.doc }))
+        .map(|(i, v)| serde_json::json!({ "name": i.name, "value": v, "default": i.default, "unit": i.unit, "doc": i.doc, "bounds": i.bounds.map(|(lo, hi)| [lo, hi]) }))
+        .collect();
+    let effects: Vec<_> = effect_sites(model)
+        .0
+        .iter()
+        .map(|e| serde_json::json!({ "effect": e.effect, "at": e.at, "params": e.params }))
         .collect();
     let sensors: Vec<_> = model
         .sensors()
@@ -207,7 +247,35 @@ fn json(model: &dyn Model, p: &[f64], style: Style) -> serde_json::Value {
         "states": states,
         "params": params,
         "sensors": sensors,
+        "effects": effects,
         "equations_style": if matches!(style, Style::Latex) { "latex" } else { "text" },
         "equations": model.equations(style),
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use stirling_dsl::Closure;
+    use stirling_models::effects::NSectionFx;
+
+    /// A model that names effects lists them (text and JSON), with their parameters; a
+    /// parameter without declared bounds has `bounds: null`.
+    #[test]
+    fn the_listing_names_the_effects() {
+        let m = NSectionFx::new(1, Closure::Full).unwrap();
+        let p = m.default_params();
+        let text = listing(&m, &p, Style::Text);
+        assert!(text.contains("effects at their null"), "{text}");
+        let row = text
+            .lines()
+            .find(|l| l.contains("end_stops") && l.contains("piston"));
+        assert!(row.is_some_and(|r| r.contains("kc, ymax")), "{text}");
+        let v = json(&m, &p, Style::Text);
+        let fx = v["effects"].as_array().unwrap();
+        let leak = fx.iter().find(|e| e["effect"] == "leak").unwrap();
+        assert_eq!(leak["at"], "cold -> bounce");
+        assert_eq!(leak["params"][0], "Gleak");
+        assert_eq!(v["params"][0]["bounds"], serde_json::Value::Null);
+    }
 }
