@@ -6,6 +6,7 @@
 //! effect end_stops on displacer;         // -kc_displacer relu(|x| - xmax) sign(x)
 //! effect leak cold -> bounce;            // link cold -> bounce { conductance: Gleak_cold_bounce }
 //! effect orifice_leak cold -> bounce;    // link cold -> bounce { orifice: Co_cold_bounce, dp0: dP0 }
+//! effect quadratic on link hot -> regen[0];  // that link gains quadratic: Rq_hot_regen
 //! effect coulomb on piston as Fcp;       // the strength named `Fcp` (then the shape, `as Fcp, v_eps`)
 //! ```
 //!
