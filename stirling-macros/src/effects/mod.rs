@@ -181,7 +181,7 @@ fn on_link(
         Item::Link(l) if end(&l.from) == end(from) && end(&l.to) == end(to) => Some(l),
         _ => None,
     });
-    let site = format!("{} -> {}", end(from), end(to));
+    let site = parse::ends(from, to);
     let Some(link) = link else {
         let msg = format!("effect `{}` on link `{site}`: no link `{site}` (its ends as the link item writes them)", kind.name);
         return Err(syn::Error::new(from.name.span(), msg));

@@ -69,16 +69,14 @@ impl Site {
     pub fn describe(&self) -> String {
         match self {
             Site::Body(b) => b.to_string(),
-            Site::Link(a, b) => format!(
-                "link {} -> {}",
-                crate::compose::end_str(a),
-                crate::compose::end_str(b)
-            ),
-            Site::Between(a, b) => format!(
-                "{} -> {}",
-                crate::compose::end_str(a),
-                crate::compose::end_str(b)
-            ),
+            Site::Link(a, b) => format!("link {}", ends(a, b)),
+            Site::Between(a, b) => ends(a, b),
         }
     }
+}
+
+/// `from -> to` with the ends as written.
+pub fn ends(from: &EndAst, to: &EndAst) -> String {
+    let end = crate::compose::end_str;
+    format!("{} -> {}", end(from), end(to))
 }

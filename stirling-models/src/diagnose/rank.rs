@@ -241,12 +241,6 @@ fn best_fit(
     best.ok_or(last_err)
 }
 
-/// Whether a fitted candidate moved a strength off its null (a fit that returns every
-/// strength to its null is the nominal model again and explains nothing).
-fn active(e: &RankEntry) -> bool {
-    e.moved
-}
-
 /// Whether the estimates of `e`'s parameters have a strength off its null.
 fn moved(e: &EffectInfo, params: &[EffectEstimate]) -> bool {
     params.iter().any(|q| {
@@ -262,7 +256,8 @@ fn moved(e: &EffectInfo, params: &[EffectEstimate]) -> bool {
 pub fn sort(entries: &mut [Assessed], level: f64) {
     let class = |e: &RankEntry| {
         let fitted = e.delta_bic.is_some();
-        match (e.p_value < level, fitted && active(e), fitted) {
+        // a fit back at every null is the nominal model again and explains nothing
+        match (e.p_value < level, fitted && e.moved, fitted) {
             (true, true, _) => 0,
             (false, true, _) => 1,
             (_, false, true) => 2,

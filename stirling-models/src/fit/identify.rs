@@ -18,7 +18,7 @@ use super::mechanics::{self, MechInputs};
 use super::record::Record;
 use super::sensitivity::Signal;
 use super::stage_fit::{fit_stage, stats, FittedStage, Solved};
-use super::vars::VarKind;
+use super::vars::{param_bounds, VarKind};
 use super::{free_run, multiple_shooting, unmeasured};
 use super::{FitError, FitOptions, Identification, StageFit};
 use crate::data::Measured;
@@ -303,8 +303,7 @@ fn at_bounds(
     let mut notes = Vec::new();
     for &j in free {
         let info = &model.params()[j];
-        let given = given.iter().find(|b| b.0 == info.name).map(|b| (b.1, b.2));
-        let Some((lo, hi)) = given.or(info.bounds) else {
+        let Some((lo, hi)) = param_bounds(model, j, given) else {
             continue;
         };
         let near = 1e-3 * (hi - lo);
@@ -353,8 +352,7 @@ fn check_bounds(
         let Some(j) = model.param_index(name) else {
             continue; // reported by the classification
         };
-        let given = given.iter().find(|b| &b.0 == name).map(|b| (b.1, b.2));
-        if let Some((lo, hi)) = given.or(model.params()[j].bounds) {
+        if let Some((lo, hi)) = param_bounds(model, j, given) {
             if !(lo..=hi).contains(&p0[j]) {
                 let why = format!("its start {} is outside [{lo}, {hi}]", p0[j]);
                 return Err(bad(name, why));

@@ -34,17 +34,13 @@ impl Var {
         bounds: &[(String, f64, f64)],
     ) -> Vec<Var> {
         free.iter()
-            .map(|&j| {
-                let info = &model.params()[j];
-                let given = bounds.iter().find(|b| b.0 == info.name);
-                Var {
-                    name: info.name.into(),
-                    initial: p[j],
-                    scale: p[j].abs().max(1e-12),
-                    kind: VarKind::Param(j),
-                    prior,
-                    bounds: given.map(|b| (b.1, b.2)).or(info.bounds),
-                }
+            .map(|&j| Var {
+                name: model.params()[j].name.into(),
+                initial: p[j],
+                scale: p[j].abs().max(1e-12),
+                kind: VarKind::Param(j),
+                prior,
+                bounds: param_bounds(model, j, bounds),
             })
             .collect()
     }
@@ -72,6 +68,17 @@ impl Var {
             bounds: None,
         }
     }
+}
+
+/// The bounds of parameter `j`: those `given` name it with, else those the model declares.
+pub fn param_bounds(
+    model: &dyn Model,
+    j: usize,
+    given: &[(String, f64, f64)],
+) -> Option<(f64, f64)> {
+    let name = model.params()[j].name;
+    let given = given.iter().find(|b| b.0 == name).map(|b| (b.1, b.2));
+    given.or(model.params()[j].bounds)
 }
 
 /// What a fit variable is.

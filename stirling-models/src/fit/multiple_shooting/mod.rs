@@ -31,6 +31,7 @@ use super::free_run::{channels, sample_range, SensorOffsets};
 use super::report::{self, ChannelFit, FitStats};
 use super::{lm, FitError};
 use crate::data::Measured;
+use crate::fit::vars::param_bounds;
 use crate::sim::{state_scale, SimOptions};
 use problem::Problem;
 use setup::{cut_segments, output_vars, param_vars, segment_vars};
@@ -127,11 +128,7 @@ pub fn multiple_shooting(
         free: free.to_vec(),
         bounds: free
             .iter()
-            .map(|&j| {
-                let info = &model.params()[j];
-                let given = opts.bounds.iter().find(|b| b.0 == info.name);
-                given.map(|b| (b.1, b.2)).or(info.bounds)
-            })
+            .map(|&j| param_bounds(model, j, &opts.bounds))
             .collect(),
         outs: outputs.outs,
         off0: outputs.off0,

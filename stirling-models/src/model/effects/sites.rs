@@ -70,16 +70,7 @@ fn params_of(model: &dyn Model, kind: &str) -> Vec<EffectParam> {
         .filter(|s| s.effect == kind)
         .collect();
     let mut out: Vec<EffectParam> = Vec::new();
-    let default = |name: &str| {
-        model
-            .param_index(name)
-            .map_or(0.0, |i| model.params()[i].default)
-    };
-    let unit = |name: &str| {
-        model
-            .param_index(name)
-            .map_or("", |i| model.params()[i].unit)
-    };
+    let info = |name: &str| model.param_index(name).map(|i| &model.params()[i]);
     for strength in [true, false] {
         for s in &sites {
             for (k, &name) in s.params.iter().enumerate() {
@@ -89,14 +80,14 @@ fn params_of(model: &dyn Model, kind: &str) -> Vec<EffectParam> {
                 let typical = if strength {
                     typical_strength(kind, name)
                 } else {
-                    default(name)
+                    info(name).map_or(0.0, |q| q.default)
                 };
                 let null = strength.then_some(0.0);
                 out.push(EffectParam {
                     name,
                     null,
                     typical,
-                    unit: unit(name),
+                    unit: info(name).map_or("", |q| q.unit),
                 });
             }
         }
