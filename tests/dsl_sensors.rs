@@ -26,6 +26,22 @@ stirling_model! {
     }
 }
 
+stirling_model! {
+    /// The nsection engine with expression sensors: the pressure drop across the regenerator,
+    /// an alternator-like voltage on the piston's velocity, and a nonlinear mix of states and
+    /// parameters that exercises every derivative rule the outputs use.
+    pub model Expressed extends stirling::models::nsection_engine {
+        name "expressed";
+        params {
+            /// velocity-to-voltage constant of a moving-magnet alternator
+            Kv: 12.0 "V s/m",
+        }
+        sensor dp: P_hot - P_cold "Pa";
+        sensor volt: Kv * w "V";
+        sensor mix: sqrt(P_regen[1] * P_cold) / Pmean + kd * x.powi(2) - exp(-v * v) + (y / x).tanh() "1";
+    }
+}
+
 fn names(m: &dyn Model) -> Vec<&'static str> {
     m.sensors().iter().map(|s| s.name).collect()
 }
@@ -60,6 +76,8 @@ fn a_derived_model_adds_replaces_and_removes_sensors() {
         SensorInfo {
             name: "p",
             state: "P_cold",
+            expr: "",
+            reads: &["P_cold"],
             unit: "kPa"
         }
     );
@@ -126,4 +144,113 @@ fn the_free_parameters_come_from_the_declaration() {
     let m = Probed::new(3, Closure::Full).unwrap();
     assert_eq!(m.declared_free(), ["kd", "hr"]);
     assert_eq!(default_free(&m, &m.default_params()), ["kd", "hr"]);
+}
+
+/// An expression sensor declares its output: printed over the states and parameters, with
+/// the states it reads; at run time its value is the expression at the state.
+#[test]
+fn an_expression_sensor_outputs_its_expression() {
+    use stirling::dsl::Observation;
+    let m = Expressed::new(3, Closure::Full).unwrap();
+    assert_eq!(names(&m), ["x", "y", "p", "p_hot", "dp", "volt", "mix"]);
+    let info = |n: &str| *m.sensors().iter().find(|s| s.name == n).unwrap();
+    let dp = info("dp");
+    assert_eq!((dp.state, dp.expr, dp.unit), ("", "P_hot - P_cold", "Pa"));
+    assert_eq!(dp.reads, ["P_hot", "P_cold"]);
+    assert_eq!(info("volt").definition(), "Kv * w");
+    assert_eq!(info("mix").reads, ["P_regen[1]", "P_cold", "x", "v", "y"]);
+    assert_eq!(
+        info("mix").expr,
+        "sqrt(P_regen[1] * P_cold) / Pmean + kd * x^2 - exp(-v * v) + tanh(y / x)"
+    );
+    assert_eq!(m.sensor_state("dp"), Some(None));
+    let p = m.default_params();
+    let mut x = vec![0.0; m.n_states()];
+    m.equilibrium_guess(&p, &mut x);
+    let st = m.state_names();
+    let at = |n: &str| st.iter().position(|s| s == n).unwrap();
+    x[at("P_hot")] += 1234.0;
+    x[at("w")] = 0.7;
+    let obs = |n: &str| Observation::sensor(&m, n).unwrap();
+    assert_eq!(
+        obs("dp").value(&m, &p, &x),
+        x[at("P_hot")] - x[at("P_cold")]
+    );
+    assert_eq!(obs("volt").value(&m, &p, &x), 12.0 * 0.7);
+    // a state sensor is its state
+    assert_eq!(obs("p").as_state(), Some(at("P_cold")));
+    assert_eq!(obs("dp").as_state(), None);
+}
+
+/// The generated gradient of every sensor output, in the states it reads and in the
+/// parameters, against central differences at a state away from equilibrium.
+#[test]
+fn expression_sensor_gradients_match_finite_differences() {
+    use stirling::dsl::Observation;
+    let m = Expressed::new(3, Closure::Full).unwrap();
+    let p = m.default_params();
+    let mut x = vec![0.0; m.n_states()];
+    m.equilibrium_guess(&p, &mut x);
+    let st = m.state_names();
+    for (name, v) in [("x", 2e-3), ("v", 0.3), ("y", -1.5e-3), ("w", 0.7)] {
+        x[st.iter().position(|s| s == name).unwrap()] = v;
+    }
+    for (i, s) in st.iter().enumerate() {
+        if s.starts_with("P_") {
+            x[i] *= 1.0 + 0.01 * i as f64;
+        }
+    }
+    for s in m.sensors() {
+        let o = Observation::sensor(&m, s.name).unwrap();
+        let (mut dv, mut dp) = (vec![0.0; o.reads().len()], vec![0.0; p.len()]);
+        let y = o.gradient(&m, &p, &x, &mut dv, &mut dp);
+        assert_eq!(y, o.value(&m, &p, &x));
+        for (r, &i) in o.reads().iter().enumerate() {
+            let h = 1e-6 * x[i].abs().max(1e-3);
+            let (mut a, mut b) = (x.clone(), x.clone());
+            a[i] += h;
+            b[i] -= h;
+            let fd = (o.value(&m, &p, &a) - o.value(&m, &p, &b)) / (2.0 * h);
+            assert!(
+                (dv[r] - fd).abs() <= 1e-6 * fd.abs().max(1e-6 * y.abs().max(1.0)),
+                "sensor {}: d/d{} = {} vs fd {fd}",
+                s.name,
+                st[i],
+                dv[r]
+            );
+        }
+        for j in 0..p.len() {
+            let h = 1e-6 * p[j].abs().max(1e-6);
+            let (mut a, mut b) = (p.clone(), p.clone());
+            a[j] += h;
+            b[j] -= h;
+            let fd = (o.value(&m, &a, &x) - o.value(&m, &b, &x)) / (2.0 * h);
+            assert!(
+                (dp[j] - fd).abs() <= 1e-6 * fd.abs().max(1e-9),
+                "sensor {}: d/d{} = {} vs fd {fd}",
+                s.name,
+                m.params()[j].name,
+                dp[j]
+            );
+        }
+    }
+}
+
+/// A record's channel cannot be observed where the model has no state for it: an element
+/// beyond `n` is refused by name, as is an undeclared sensor.
+#[test]
+fn an_observation_refuses_what_the_model_cannot_output() {
+    use stirling::dsl::{Observation, ObserveError};
+    let m = Expressed::new(1, Closure::Full).unwrap();
+    let err = Observation::sensor(&m, "mix").unwrap_err();
+    assert!(
+        matches!(&err, ObserveError::Absent { sensor, state, n: 1, .. } if sensor == "mix" && state == "P_regen[1]"),
+        "{err}"
+    );
+    let err = Observation::sensor(&m, "volts").unwrap_err();
+    assert!(
+        err.to_string().contains("declares no sensor `volts`"),
+        "{err}"
+    );
+    assert!(err.to_string().contains("volt"), "{err}");
 }

@@ -124,8 +124,8 @@ pub use closure::Closure;
 pub use expr::{Arena, Id, Style, Sym};
 pub use runtime::{
     to_dot, BodyInfo, ConductionInfo, EffectSite, FaceInfo, JacSink, JacValues, JacWrite, LinkInfo,
-    Model, ModelError, ParamInfo, PortInfo, PowerTerms, SensorInfo, StateInfo, StateKind,
-    TopologyInfo, VesselInfo, WallInfo,
+    Model, ModelError, Observation, ObserveError, ParamInfo, PortInfo, PowerTerms, SensorInfo,
+    StateInfo, StateKind, TopologyInfo, VesselInfo, WallInfo,
 };
 pub use topology::{assemble, Topology};
 

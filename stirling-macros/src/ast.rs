@@ -29,6 +29,7 @@
 //!     link matrix[j] -> shell for j in 0..n { conductance: Gms / n } // every section to one wall
 //!     sensor p: P_cold "Pa";       // a measured channel: a CSV column named `p` observes state `P_cold`
 //!     sensor T3: Tw_matrix[3] "K"; // an element of an array (checked against `n` at run time)
+//!     sensor dp: P_cold - P_bounce "Pa"; // an expression of states and parameters
 //!     free kd, kp, hh;             // the parameters a fit frees by default
 //! }
 //! ```
@@ -206,41 +207,28 @@ pub enum Item {
     Effect(crate::effects::EffectAst),
 }
 
-/// `sensor name: STATE "unit";` or `sensor name: STATE[k] "unit";` (unit optional: the
-/// state's own).
+/// `sensor name: STATE "unit";`, `sensor name: STATE[k] "unit";` (unit optional: the
+/// state's own) or `sensor name: EXPR "unit";` (an expression of states and parameters,
+/// unit required).
 pub struct SensorAst {
     pub name: Ident,
-    /// The observed state's name as [`Model::states`] lists it (`x`, `P_cold`, `Tw_head`),
-    /// without the index.
-    pub state: Ident,
-    /// The element of an array state.
-    pub index: Option<syn::LitInt>,
+    /// What the sensor reads: a state's name as [`Model::states`] lists it (`x`, `P_cold`,
+    /// `Tw_head`), an array element (`P_regen[2]`) or an expression of states and parameters.
+    pub expr: syn::Expr,
     pub unit: Option<LitStr>,
 }
 
 fn sensor(input: ParseStream) -> syn::Result<SensorAst> {
     let name = input.parse()?;
     input.parse::<Token![:]>()?;
-    let state = input.parse()?;
-    let index = if input.peek(syn::token::Bracket) {
-        let content;
-        bracketed!(content in input);
-        Some(content.parse()?)
-    } else {
-        None
-    };
+    let expr = syn::Expr::parse_without_eager_brace(input)?;
     let unit = if input.peek(LitStr) {
         Some(input.parse()?)
     } else {
         None
     };
     input.parse::<Token![;]>()?;
-    Ok(SensorAst {
-        name,
-        state,
-        index,
-        unit,
-    })
+    Ok(SensorAst { name, expr, unit })
 }
 
 pub struct ModelAst {

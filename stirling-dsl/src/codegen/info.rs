@@ -33,7 +33,15 @@ pub fn bodies(topo: &Topology, krate: &TokenStream) -> TokenStream {
 pub fn sensors(topo: &Topology, krate: &TokenStream) -> TokenStream {
     let items = topo.sensors.iter().map(|s| {
         let (name, state, unit) = (&s.name, &s.state, &s.unit);
-        quote! { #krate::SensorInfo { name: #name, state: #state, unit: #unit } }
+        let (expr, reads) = match &s.expr {
+            Some(e) => (super::sensors::text(topo, e), e.reads.clone()),
+            None => (String::new(), vec![s.state.clone()]),
+        };
+        quote! {
+            #krate::SensorInfo {
+                name: #name, state: #state, expr: #expr, reads: &[#(#reads),*], unit: #unit
+            }
+        }
     });
     quote! { &[#(#items),*] }
 }

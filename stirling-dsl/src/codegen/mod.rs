@@ -8,6 +8,7 @@ mod info;
 mod layout;
 mod rows;
 mod sections;
+mod sensors;
 mod sums;
 mod terms;
 
@@ -50,6 +51,7 @@ pub fn generate(mut topo: Topology, spec: &ModelSpec) -> TokenStream {
         ]);
         states.push(info::states(&lay, krate));
     }
+    let sensor_output = sensors::sensor_output(&mut arena, &topo, &private);
     topo.arena = arena;
     let lay = Layout {
         sys: &full,
@@ -59,6 +61,7 @@ pub fn generate(mut topo: Topology, spec: &ModelSpec) -> TokenStream {
         params: info::params(&topo, krate),
         bodies: info::bodies(&topo, krate),
         sensors: info::sensors(&topo, krate),
+        sensor_output,
         effect_sites: info::effect_sites(&topo, krate),
         topology: info::topology(&topo, &lay, krate),
         vessel_names: info::vessel_names(&topo),
@@ -73,6 +76,7 @@ struct Statics {
     params: TokenStream,
     bodies: TokenStream,
     sensors: TokenStream,
+    sensor_output: TokenStream,
     effect_sites: TokenStream,
     topology: TokenStream,
     vessel_names: TokenStream,
@@ -185,6 +189,7 @@ fn model_impl(topo: &Topology, spec: &ModelSpec, st: &Statics) -> TokenStream {
     let has_array = topo.has_array();
     let (sf, sz) = (&st.states[0], &st.states[1]);
     let vn = &st.vessel_names;
+    let sensor_output = &st.sensor_output;
     let free = &topo.free;
     let [ft, fl] = &st.texts[0];
     let [zt, zl] = &st.texts[1];
@@ -289,6 +294,7 @@ fn model_impl(topo: &Topology, spec: &ModelSpec, st: &Statics) -> TokenStream {
             }
             fn topology(&self) -> &'static #krate::TopologyInfo { &Self::TOPOLOGY }
             fn sensors(&self) -> &'static [#krate::SensorInfo] { Self::SENSORS }
+            #sensor_output
             fn effect_sites(&self) -> &'static [#krate::EffectSite] { Self::EFFECT_SITES }
             fn declared_free(&self) -> &'static [&'static str] { &[#(#free),*] }
         }

@@ -4,6 +4,7 @@ mod dot;
 mod error;
 mod jac_sink;
 mod model;
+mod observe;
 mod topology_info;
 
 pub use dot::to_dot;
@@ -12,6 +13,7 @@ pub use jac_sink::{JacSink, JacValues, JacWrite};
 pub use model::{
     BodyInfo, EffectSite, Model, ParamInfo, PowerTerms, SensorInfo, StateInfo, StateKind,
 };
+pub use observe::{Observation, ObserveError};
 pub use topology_info::{
     ConductionInfo, FaceInfo, LinkInfo, PortInfo, TopologyInfo, VesselInfo, WallInfo,
 };

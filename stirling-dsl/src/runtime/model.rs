@@ -40,13 +40,32 @@ pub struct StateInfo {
     pub meaning: String,
 }
 
-/// A measured channel declared with the model (`sensor p: P_cold "Pa";`): the CSV column
-/// `name` observes the state `state` (as [`Model::states`] names it), in `unit`.
+/// A measured channel declared with the model: the CSV column `name`, in `unit`, observes
+/// the state `state` (as [`Model::states`] names it; `sensor p: P_cold "Pa";`) or the
+/// expression `expr` of the states `reads` and the parameters (`sensor dp: P_cold - P_bounce
+/// "Pa";`, evaluated by [`Model::sensor_output`]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct SensorInfo {
     pub name: &'static str,
+    /// The observed state; empty for an expression sensor.
     pub state: &'static str,
+    /// The expression as printed; empty for a state sensor.
+    pub expr: &'static str,
+    /// The states the output reads, in the order [`Model::sensor_output`] takes their values
+    /// (a state sensor: its state).
+    pub reads: &'static [&'static str],
     pub unit: &'static str,
+}
+
+impl SensorInfo {
+    /// What the sensor reads, as declared: its state or its expression.
+    pub fn definition(&self) -> &'static str {
+        if self.expr.is_empty() {
+            self.state
+        } else {
+            self.expr
+        }
+    }
 }
 
 /// An effect applied to the model where it names it (`effect coulomb on piston;`), at its
@@ -178,6 +197,16 @@ pub trait Model: Send + Sync {
     fn sensors(&self) -> &'static [SensorInfo] {
         &[]
     }
+    /// The output of declared sensor `k` (index into [`Model::sensors`]) from the values `v`
+    /// of the states it reads ([`SensorInfo::reads`]): writes its derivative in each read to
+    /// `dv` and in each parameter it names to `dp` (the other entries untouched). The default
+    /// is a state sensor's: the one value read. Generated for a model with expression sensors;
+    /// [`crate::Observation`] resolves the reads at a model's `n` and closure.
+    fn sensor_output(&self, k: usize, p: &[f64], v: &[f64], dv: &mut [f64], dp: &mut [f64]) -> f64 {
+        let _ = (k, p, dp);
+        dv[0] = 1.0;
+        v[0]
+    }
     /// The effects applied by `effect` items (at their null), in declaration order; none by
     /// default.
     fn effect_sites(&self) -> &'static [EffectSite] {
@@ -205,9 +234,13 @@ pub trait Model: Send + Sync {
     }
     /// The state a declared sensor observes, at this model's `n` and closure: `None` when
     /// no sensor has that name, `Some(None)` when its state does not exist here (an array
-    /// element beyond `n`, a mass state of the frozen closure).
+    /// element beyond `n`, a mass state of the frozen closure) or the sensor is an expression
+    /// (see [`crate::Observation`]).
     fn sensor_state(&self, name: &str) -> Option<Option<usize>> {
         let s = self.sensors().iter().find(|s| s.name == name)?;
+        if s.state.is_empty() {
+            return Some(None);
+        }
         Some(self.states().iter().position(|st| st.name == s.state))
     }
     /// Names of the states.

@@ -211,14 +211,27 @@ pub struct EffectSiteDecl {
     pub params: Vec<String>,
 }
 
-/// A measured channel: a CSV column observing one state.
+/// A measured channel: a CSV column observing one state, or an expression of states and
+/// parameters.
 #[derive(Clone, Debug)]
 pub struct SensorDecl {
     /// The channel (the CSV column's name).
     pub name: String,
-    /// The observed state's name as `Model::states` lists it (`x`, `P_cold`, `Tw_matrix[3]`).
+    /// The observed state's name as `Model::states` lists it (`x`, `P_cold`, `Tw_matrix[3]`);
+    /// empty for an expression sensor.
     pub state: String,
     pub unit: String,
+    /// An expression sensor's output (`sensor dp: P_cold - P_bounce "Pa";`).
+    pub expr: Option<SensorExpr>,
+}
+
+/// The output of an expression sensor: `value` in the arena, whose leaves are
+/// `Sym::Input(i)` for the state `reads[i]` and `Sym::Param(k)`.
+#[derive(Clone, Debug)]
+pub struct SensorExpr {
+    pub value: Id,
+    /// The states read, as `Model::states` names them, in input order.
+    pub reads: Vec<String>,
 }
 
 /// A whole declared model.

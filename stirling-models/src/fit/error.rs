@@ -92,6 +92,12 @@ pub enum FitError {
         state: String,
         expected: String,
     },
+    #[error("{file}: column `{column}` cannot be compared with the model: {source}")]
+    Observe {
+        file: String,
+        column: String,
+        source: stirling_dsl::ObserveError,
+    },
     #[error("{stage} expects two bodies (displacer x, piston y); `{model}` has {found}")]
     Bodies {
         stage: &'static str,

@@ -30,6 +30,7 @@ use crate::signal::{crossing_frequency, fundamental, wrap};
 use crate::sim::{simulate, SimOptions, Trajectory};
 
 pub use super::measured_state::{channels, measured_state, Channel, SensorOffsets};
+use super::outputs::{outputs, predicted};
 
 /// Fundamental-harmonic features of a periodic motion.
 #[derive(Clone, Debug, Serialize)]
@@ -145,18 +146,6 @@ pub(super) fn sample_range(
     Ok((a, b))
 }
 
-/// The channels as the model outputs them along the trajectory `x` (offsets added).
-fn model_outputs(ch: &[Channel], x: &[Vec<f64>], off: &SensorOffsets) -> Vec<(String, Vec<f64>)> {
-    ch.iter()
-        .map(|c| {
-            (
-                c.name.clone(),
-                x.iter().map(|r| r[c.state] + off.get(&c.name)).collect(),
-            )
-        })
-        .collect()
-}
-
 /// Fits per channel over the first `len` samples of each block `(label, len)`.
 fn block_fits(
     meas: &[(String, Vec<f64>)],
@@ -228,7 +217,7 @@ pub fn free_run(
 ) -> Result<FreeRun, FitError> {
     let clock = Instant::now();
     let name = "free run";
-    let ch = channels(model, data)?;
+    let ch = outputs(model, data)?;
     let dt = data.dt();
     let (a, b) = sample_range(data, block, block.1, name, 11)?;
     let h = ((opts.smooth / dt).round() as usize).max(3);
@@ -238,7 +227,7 @@ pub fn free_run(
         .iter()
         .map(|c| (c.name.clone(), c.data[a..=b].to_vec()))
         .collect();
-    let sim = model_outputs(&ch, &traj.x, off);
+    let sim = predicted(model, p, &ch, &traj.x, off);
     let measured = cycle_features(&meas, dt);
     let simulated = cycle_features(&sim, dt);
     let f_meas = measured

@@ -34,6 +34,8 @@ pub mod measured_state;
 pub mod mechanics;
 /// Multiple-shooting refinement over short free-running segments.
 pub mod multiple_shooting;
+/// The record's channels as outputs of the model (states or declared sensor expressions).
+pub mod outputs;
 /// Log-normal priors on fitted model parameters.
 pub mod prior;
 /// The measured record as the stages see it.

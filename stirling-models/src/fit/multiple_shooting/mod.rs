@@ -27,7 +27,8 @@ use std::time::Instant;
 use serde::Serialize;
 use stirling_dsl::Model;
 
-use super::free_run::{channels, sample_range, SensorOffsets};
+use super::free_run::{sample_range, SensorOffsets};
+use super::outputs::outputs;
 use super::report::{self, ChannelFit, FitStats};
 use super::{lm, FitError};
 use crate::data::Measured;
@@ -112,7 +113,7 @@ pub fn multiple_shooting(
     opts: &MsOptions,
 ) -> Result<MultipleShooting, FitError> {
     let clock = Instant::now();
-    let ch = channels(model, data)?;
+    let ch = outputs(model, data)?;
     let dt = data.dt();
     let end = block.1.min(block.0 + opts.span);
     let (a, b) = sample_range(data, block, end, "multiple shooting", 21)?;

@@ -8,6 +8,7 @@ use super::super::free_run::SensorOffsets;
 use super::super::report::{self, ChannelFit, FitStats};
 use super::super::sensitivity::{Column, Driven};
 use super::super::{lm, FitError};
+use super::setup::Out;
 use super::Segment;
 use crate::sim::{integrate, Hooks, SimOptions};
 
@@ -23,8 +24,7 @@ pub(super) struct Problem<'a> {
     pub(super) free: Vec<usize>,
     /// The bounds of each free parameter.
     pub(super) bounds: Vec<Option<(f64, f64)>>,
-    /// `(name, state, data, sigma, offset variable)`.
-    pub(super) outs: Vec<(String, usize, Vec<f64>, f64, Option<usize>)>,
+    pub(super) outs: Vec<Out>,
     pub(super) off0: Vec<f64>,
     /// Sample ranges `[a, b]` (b is the next segment's a).
     pub(super) segs: Vec<(usize, usize)>,
@@ -170,24 +170,39 @@ impl Problem<'_> {
         let (np, no, n) = (self.free.len(), self.n_off, self.model.n_states());
         let base = np + no + at.s * n;
         let total = ev.r.len() / self.outs.len();
-        for (o, (_, st, data, sig, ov)) in self.outs.iter().enumerate() {
-            let off = ov.map(|k| th[np + k]).unwrap_or(self.off0[o]);
+        let p = self.params_with(th);
+        let mut dp = vec![0.0; p.len()];
+        for (o, out) in self.outs.iter().enumerate() {
+            let (reads, sig) = (out.obs.reads(), out.sigma);
+            let mut dv = vec![0.0; reads.len()];
+            let off = out.offset.map(|k| th[np + k]).unwrap_or(self.off0[o]);
             for k in 0..at.used {
                 let row = o * total + at.row0 + k;
                 let xr = &x[k];
-                let y = xr[*st] + off;
+                dp.iter_mut().for_each(|d| *d = 0.0);
+                let y = out.obs.gradient(self.model, &p, xr, &mut dv, &mut dp) + off;
                 ev.yhat[o].push(y);
-                ev.r[row] = (y - data[at.a + k]) / sig;
-                if sens {
-                    for c in 0..n {
-                        ev.j[(row, base + c)] = xr[n + c * n + st] / sig;
-                    }
-                    for c in 0..np {
-                        ev.j[(row, c)] = xr[n + (n + c) * n + st] / sig;
-                    }
-                    if let Some(kv) = ov {
-                        ev.j[(row, np + kv)] = self.vars[np + kv].scale / sig;
-                    }
+                ev.r[row] = (y - out.data[at.a + k]) / sig;
+                if !sens {
+                    continue;
+                }
+                // d y / d column = sum over the reads of d y / d x_i times x_i's sensitivity
+                let through = |col: usize| -> f64 {
+                    reads
+                        .iter()
+                        .zip(&dv)
+                        .map(|(&i, d)| d * xr[n + col * n + i])
+                        .sum()
+                };
+                for c in 0..n {
+                    ev.j[(row, base + c)] = through(c) / sig;
+                }
+                for (c, &j) in self.free.iter().enumerate() {
+                    let direct = dp[j] * self.vars[c].scale;
+                    ev.j[(row, c)] = (through(n + c) + direct) / sig;
+                }
+                if let Some(kv) = out.offset {
+                    ev.j[(row, np + kv)] = self.vars[np + kv].scale / sig;
                 }
             }
         }
@@ -202,8 +217,8 @@ impl Problem<'_> {
         let np = self.free.len();
         let mut offsets = given.clone();
         for (o, out) in self.outs.iter().enumerate() {
-            let v = out.4.map(|k| th[np + k]).unwrap_or(self.off0[o]);
-            match out.0.as_str() {
+            let v = out.offset.map(|k| th[np + k]).unwrap_or(self.off0[o]);
+            match out.name.as_str() {
                 "x" => offsets.x = v,
                 "y" => offsets.y = v,
                 "p" => offsets.p = v,
@@ -246,8 +261,8 @@ impl Problem<'_> {
         self.outs
             .iter()
             .zip(&fin.yhat)
-            .map(|((name, _, d, _, _), yh)| {
-                ChannelFit::plain(name, "segments", &d[a..a + yh.len()], yh)
+            .map(|(out, yh)| {
+                ChannelFit::plain(&out.name, "segments", &out.data[a..a + yh.len()], yh)
             })
             .collect()
     }

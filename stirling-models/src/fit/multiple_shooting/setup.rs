@@ -1,9 +1,10 @@
 //! The multiple-shooting problem's setup: the segments of the training block and the
 //! variables (free parameters, sensor offsets, every segment's initial state).
 
-use stirling_dsl::{Model, StateKind};
+use stirling_dsl::{Model, Observation, StateKind};
 
-use super::super::free_run::{measured_state, Channel, SensorOffsets};
+use super::super::free_run::{measured_state, SensorOffsets};
+use super::super::outputs::Output;
 use super::super::FitError;
 use super::problem::Var;
 use crate::data::Measured;
@@ -11,7 +12,7 @@ use crate::signal::noise_sigma;
 
 /// Cut `[a, b]` into segments of about `opts.cycles` cycles of the measured frequency.
 pub(super) fn cut_segments(
-    ch: &[Channel],
+    ch: &[Output],
     (a, b): (usize, usize),
     dt: f64,
     block: (f64, f64),
@@ -42,16 +43,47 @@ pub(super) fn param_vars(model: &dyn Model, p0: &[f64], free: &[usize]) -> Vec<V
         .collect()
 }
 
+/// One measured output of the problem: its channel, noise level and offset variable.
+pub(super) struct Out {
+    pub(super) name: String,
+    pub(super) obs: Observation,
+    pub(super) data: Vec<f64>,
+    /// Noise standard deviation (the residuals' weight).
+    pub(super) sigma: f64,
+    /// The offset's variable (among the offsets), when fitted.
+    pub(super) offset: Option<usize>,
+}
+
 /// What [`output_vars`] builds: the outputs, their given offsets, how many offsets are fitted.
 pub(super) struct Outputs {
-    pub(super) outs: Vec<(String, usize, Vec<f64>, f64, Option<usize>)>,
+    pub(super) outs: Vec<Out>,
     pub(super) off0: Vec<f64>,
     pub(super) n_off: usize,
 }
 
+/// The noise level's floor and the offset's scale of an output: a pressure state's from the
+/// state's scale, a position's fixed, an expression's from the spread of its record.
+fn output_scales(o: &Output, sscale: &[f64]) -> (f64, f64) {
+    let is_p = o.name.starts_with('p');
+    match o.obs.as_state() {
+        Some(s) if is_p => (1e-6 * sscale[s], 100.0),
+        Some(_) => (1e-9, 1e-3),
+        None => {
+            let (lo, hi) = o
+                .data
+                .iter()
+                .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| {
+                    (a.min(v), b.max(v))
+                });
+            let spread = (hi - lo).max(f64::MIN_POSITIVE);
+            (1e-6 * spread, 1e-2 * spread)
+        }
+    }
+}
+
 /// The measured outputs with their noise levels; with `fit_offsets`, one offset variable each.
 pub(super) fn output_vars(
-    ch: &[Channel],
+    outputs: &[Output],
     off: &SensorOffsets,
     sscale: &[f64],
     fit_offsets: bool,
@@ -60,23 +92,26 @@ pub(super) fn output_vars(
     let mut outs = Vec::new();
     let mut off0 = Vec::new();
     let mut n_off = 0;
-    for c in ch {
-        let o = off.get(&c.name);
-        let is_p = c.name.starts_with('p');
-        let sig = noise_sigma(&c.data).max(if is_p { 1e-6 * sscale[c.state] } else { 1e-9 });
-        let ov = if fit_offsets {
+    for o in outputs {
+        let given = off.get(&o.name);
+        let (floor, scale) = output_scales(o, sscale);
+        let offset = fit_offsets.then(|| {
             vars.push(Var {
-                name: format!("{}_offset", c.name),
-                initial: o,
-                scale: if is_p { 100.0 } else { 1e-3 },
+                name: format!("{}_offset", o.name),
+                initial: given,
+                scale,
             });
             n_off += 1;
-            Some(n_off - 1)
-        } else {
-            None
-        };
-        outs.push((c.name.clone(), c.state, c.data.clone(), sig, ov));
-        off0.push(o);
+            n_off - 1
+        });
+        outs.push(Out {
+            name: o.name.clone(),
+            obs: o.obs.clone(),
+            data: o.data.clone(),
+            sigma: noise_sigma(&o.data).max(floor),
+            offset,
+        });
+        off0.push(given);
     }
     Outputs { outs, off0, n_off }
 }
