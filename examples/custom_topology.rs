@@ -62,6 +62,8 @@ stirling_model! {
         }
         // a transducer in the bounce space, besides the family's `p`, `p_hot`, `x`, `y`
         sensor p_bounce: P_bounce "Pa";
+        // a differential transducer across the piston: an expression of two states
+        sensor dp: P_cold - P_bounce "Pa";
     }
 }
 

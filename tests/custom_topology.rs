@@ -382,6 +382,101 @@ fn the_engine_is_fitted_from_its_own_sensors() {
     common::fit::assert_free_run_amplitudes(&id, &["x", "y", "p", "p_bounce"], 0.05);
 }
 
+/// The engine's differential transducer across the piston (`sensor dp: P_cold - P_bounce
+/// "Pa";`, an expression of two states) is a fitted output like the states: multiple
+/// shooting over the record with it recovers the parameters with intervals that cover the
+/// truth, and the refined model reproduces the channel.
+#[test]
+fn the_differential_pressure_sensor_is_a_fitted_output() {
+    use stirling::models::fit::multiple_shooting::{multiple_shooting, MsOptions};
+    use stirling::models::fit::{self, FitOptions};
+    let (m, truth, rec) = bounce_record(&["p", "x", "y", "p_bounce", "dp"]);
+    // the rig reads the expression: the difference of the two pressure channels up to the
+    // absolute transducers' offsets and the noise
+    let (pc, pb, dp) = (
+        rec.channel("p").unwrap(),
+        rec.channel("p_bounce").unwrap(),
+        rec.channel("dp").unwrap(),
+    );
+    let worst = (0..dp.len())
+        .map(|k| (dp[k] - (pc[k] - pb[k])).abs())
+        .fold(0.0, f64::max);
+    let sd = stirling::models::rig::RigConfig::default().noise_p;
+    assert!(
+        worst < 6.0 * 3f64.sqrt() * sd,
+        "dp against p - p_bounce: {worst} Pa"
+    );
+    let free = ["kd", "kp", "bd", "bp", "hh", "hk", "Rf"];
+    let id = fit::identify(
+        &m,
+        &truth,
+        &rec,
+        &FitOptions {
+            free: Some(free.map(String::from).to_vec()),
+            ..Default::default()
+        },
+    )
+    .expect("fitted");
+    let mut p0 = truth.clone();
+    for (k, f) in [("kd", 1.02), ("bp", 1.1), ("hh", 0.9), ("Rf", 1.2)] {
+        p0[m.param_index(k).unwrap()] *= f;
+    }
+    let idx: Vec<usize> = free.iter().map(|k| m.param_index(k).unwrap()).collect();
+    let clock = std::time::Instant::now();
+    let ms = multiple_shooting(
+        &m,
+        &p0,
+        &idx,
+        &rec,
+        &id.offsets,
+        id.train,
+        &MsOptions::default(),
+    )
+    .expect("refined");
+    eprintln!(
+        "multiple shooting {:.1} s, {} it",
+        clock.elapsed().as_secs_f64(),
+        ms.iterations
+    );
+    for e in ms
+        .stats
+        .estimates
+        .iter()
+        .filter(|e| !e.name.starts_with("seg"))
+    {
+        eprintln!(
+            "  {:<12} {:.5e} [{:.5e}, {:.5e}]",
+            e.name, e.value, e.ci_low, e.ci_high
+        );
+    }
+    for f in &ms.fits {
+        eprintln!(
+            "  fit {} {:.2} %, rms {:.3e}",
+            f.channel, f.fit_percent, f.rms
+        );
+    }
+    for k in free {
+        let e = ms.estimate(k).unwrap();
+        assert!(e.covers(value(&m, &truth, k)), "{k}: {e:?}");
+    }
+    let dp_fit = ms
+        .fits
+        .iter()
+        .find(|f| f.channel == "dp")
+        .expect("dp fitted");
+    // down to the transducer's noise
+    assert!(
+        dp_fit.rms < 1.2 * sd,
+        "dp: rms {} Pa against noise {sd} Pa",
+        dp_fit.rms
+    );
+    let fr = id.free_run.as_ref().expect("free run");
+    let short = fr
+        .fit_percent("dp", "free_run_short")
+        .expect("dp in the free run");
+    assert!(short > 85.0, "free run of dp: {short:.2} %");
+}
+
 /// Without its bounce-space sensor the record cannot carry the fit: refused by name.
 #[test]
 fn identification_refuses_the_engine_without_its_bounce_sensor() {

@@ -86,7 +86,7 @@ fn listing(model: &dyn Model, p: &[f64], style: Style) -> String {
     ));
     if !model.sensors().is_empty() {
         s.push_str("\nsensors (CSV columns a record may hold)\n");
-        s.push_str(&table(&sensor_rows(model), &["column", "state", "unit"]));
+        s.push_str(&table(&sensor_rows(model), &["column", "reads", "unit"]));
     }
     let (sites, member) = effect_sites(model);
     if !sites.is_empty() {
@@ -124,11 +124,11 @@ fn sensor_rows(model: &dyn Model) -> Vec<Vec<String>> {
         .sensors()
         .iter()
         .map(|s| {
-            let state = match model.sensor_state(s.name) {
-                Some(Some(_)) => s.state.to_string(),
-                _ => format!("{} (absent at this n and closure)", s.state),
+            let reads = match stirling_dsl::Observation::sensor(model, s.name) {
+                Ok(_) => s.definition().to_string(),
+                Err(_) => format!("{} (absent at this n and closure)", s.definition()),
             };
-            vec![s.name.into(), state, s.unit.into()]
+            vec![s.name.into(), reads, s.unit.into()]
         })
         .collect()
 }
@@ -235,7 +235,7 @@ fn json(model: &dyn Model, p: &[f64], style: Style) -> serde_json::Value {
     let sensors: Vec<_> = model
         .sensors()
         .iter()
-        .map(|s| serde_json::json!({ "column": s.name, "state": s.state, "unit": s.unit, "present": matches!(model.sensor_state(s.name), Some(Some(_))) }))
+        .map(|s| serde_json::json!({ "column": s.name, "state": s.state, "expr": s.expr, "reads": s.reads, "unit": s.unit, "present": stirling_dsl::Observation::sensor(model, s.name).is_ok() }))
         .collect();
     serde_json::json!({
         "model": model.name(),

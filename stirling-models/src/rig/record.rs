@@ -2,7 +2,7 @@
 //! asked channels read of it (the seed's four where the family has them, any other declared
 //! sensor of the model).
 
-use stirling_dsl::Model;
+use stirling_dsl::{Model, Observation};
 
 use super::sensors::{self, read_sensors};
 use super::{RigConfig, RigError};
@@ -78,7 +78,7 @@ pub(super) fn record(
     let count = (cfg.t_end * cfg.rate).round() as usize;
     let dt = 1.0 / cfg.rate;
     let rows = clean_run(model, p, cfg, count)?;
-    let read = read_sensors(&rows, &chans, cfg)?;
+    let read = read_sensors((model, p), &rows, &chans, cfg)?;
     let mut data = Measured {
         source: format!("rig:{}", model.name()),
         t: (0..=count).map(|k| k as f64 * dt).collect(),
@@ -119,20 +119,16 @@ fn declared_channel(
             known: format!("{} (the sensors `{}` declares)", known(), model.name()),
         });
     };
-    let Some(Some(state)) = model.sensor_state(name) else {
-        return Err(RigError::UnknownChannel {
-            channel: name.into(),
-            known: format!(
-                "{}; `{}` observes {}, absent at n = {}",
-                known(),
-                name,
-                sensor.state,
-                model.n()
-            ),
-        });
-    };
+    let obs = Observation::sensor(model, name).map_err(|e| RigError::UnknownChannel {
+        channel: name.into(),
+        known: format!("{}; {e}", known()),
+    })?;
+    // an absolute pressure carries the transducer's offset and must stay positive; a
+    // difference or another expression is read zeroed at rest
+    let state = obs.as_state().is_some();
     let (offset, sd, pressure) = match sensor.unit {
-        "Pa" => (cfg.offset_p, cfg.noise_p, true),
+        "Pa" if state => (cfg.offset_p, cfg.noise_p, true),
+        "Pa" => (0.0, cfg.noise_p, false),
         "m" => (0.0, cfg.noise_x, false),
         unit => {
             return Err(RigError::SensorUnit {
@@ -143,7 +139,7 @@ fn declared_channel(
     };
     Ok(sensors::Channel {
         name: name.into(),
-        state,
+        obs,
         tau: 0.0,
         gain: 0.0,
         offset,

@@ -1,6 +1,7 @@
 //! The sensors of the rig: pressure lag, position gain errors, offsets and seeded noise.
 
 use rand::{rngs::StdRng, Rng, SeedableRng};
+use stirling_dsl::{Model, Observation};
 
 use super::{RigConfig, RigError};
 use crate::effects::EffectSettings;
@@ -31,10 +32,11 @@ fn check_pressure(p: &[f64], cfg: &RigConfig) -> Result<(), RigError> {
     Ok(())
 }
 
-/// One channel the rig writes: the state it reads and what its sensor does to it.
+/// One channel the rig writes: the model output it reads (a state, or a declared sensor's
+/// expression) and what its sensor does to it.
 pub(super) struct Channel {
     pub name: String,
-    pub state: usize,
+    pub obs: Observation,
     /// First-order lag (s) and relative gain error.
     pub tau: f64,
     pub gain: f64,
@@ -58,7 +60,7 @@ pub(super) fn seed_channels(
     let tau = fx.sensor_value("tau_p");
     let pressure = |name: &str, state| Channel {
         name: name.into(),
-        state,
+        obs: Observation::state(state),
         tau,
         gain: 0.0,
         offset: cfg.offset_p,
@@ -67,7 +69,7 @@ pub(super) fn seed_channels(
     };
     let position = |name: &str, state, gain, offset| Channel {
         name: name.into(),
-        state,
+        obs: Observation::state(state),
         tau: 0.0,
         gain,
         offset,
@@ -93,19 +95,19 @@ pub(super) fn seed_channels(
     out
 }
 
-/// What the sensors read from the clean `rows`: per channel, lag, gain, offset and seeded
-/// noise (one generator, drawn channel after channel).
+/// What the sensors read from the clean `rows` of `model` at `p`: per channel, lag, gain,
+/// offset and seeded noise (one generator, drawn channel after channel).
 pub(super) fn read_sensors(
+    (model, p): (&dyn Model, &[f64]),
     rows: &[Vec<f64>],
     chans: &[Channel],
     cfg: &RigConfig,
 ) -> Result<Vec<Vec<f64>>, RigError> {
     let dt = 1.0 / cfg.rate;
-    let col = |i: usize| rows.iter().map(|r| r[i]).collect::<Vec<f64>>();
     let mut g = Gauss(StdRng::seed_from_u64(cfg.seed));
     let mut out = Vec::with_capacity(chans.len());
     for c in chans {
-        let clean = col(c.state);
+        let clean: Vec<f64> = rows.iter().map(|r| c.obs.value(model, p, r)).collect();
         if c.pressure {
             check_pressure(&clean, cfg)?;
         }
