@@ -39,6 +39,8 @@ stirling_model! {
             Tb: 300.0 "K",
             /// alternator load: force -c_alt w on the piston, electric power c_alt w^2
             c_alt: 6.0 "N s/m",
+            /// alternator's motor constant: its voltage is Kv w (c_alt = Kv^2 / R_load)
+            Kv: 25.0 "V s/m",
             /// bounce-space wall area
             Awb: 0.06 "m^2",
             /// bounce-space heat-transfer coefficient
@@ -62,8 +64,10 @@ stirling_model! {
         }
         // a transducer in the bounce space, besides the family's `p`, `p_hot`, `x`, `y`
         sensor p_bounce: P_bounce "Pa";
-        // a differential transducer across the piston: an expression of two states
+        // expressions of states and parameters: a differential transducer across the
+        // piston, and the alternator's voltage
         sensor dp: P_cold - P_bounce "Pa";
+        sensor emf: Kv * w "V";
     }
 }
 

@@ -382,17 +382,32 @@ fn the_engine_is_fitted_from_its_own_sensors() {
     common::fit::assert_free_run_amplitudes(&id, &["x", "y", "p", "p_bounce"], 0.05);
 }
 
-/// The engine's differential transducer across the piston (`sensor dp: P_cold - P_bounce
-/// "Pa";`, an expression of two states) is a fitted output like the states: multiple
-/// shooting over the record with it recovers the parameters with intervals that cover the
-/// truth, and the refined model reproduces the channel.
+/// The engine's expression sensors are fitted outputs like its states: the differential
+/// transducer across the piston (`sensor dp: P_cold - P_bounce "Pa";`) and the alternator's
+/// voltage (`sensor emf: Kv * w "V";`, with its constant `Kv` free). Multiple shooting over
+/// a record with both recovers the parameters, `Kv` among them, with intervals that cover
+/// the truth, reproduces the channels down to their noise, and so does the free run.
 #[test]
-fn the_differential_pressure_sensor_is_a_fitted_output() {
+fn expression_sensors_are_fitted_outputs() {
     use stirling::models::fit::multiple_shooting::{multiple_shooting, MsOptions};
     use stirling::models::fit::{self, FitOptions};
-    let (m, truth, rec) = bounce_record(&["p", "x", "y", "p_bounce", "dp"]);
-    // the rig reads the expression: the difference of the two pressure channels up to the
-    // absolute transducers' offsets and the noise
+    use stirling::models::rig::{measure, RigConfig};
+    let m = model(2);
+    let truth = m.default_params();
+    let cfg = RigConfig {
+        t_end: 3.0,
+        x0: 5e-4,
+        offset_p: 50.0,
+        seed: 2,
+        channels: ["p", "x", "y", "p_bounce", "dp", "emf"]
+            .map(String::from)
+            .to_vec(),
+        noise: vec![("emf".into(), 0.02)],
+        ..Default::default()
+    };
+    let rec = measure(&m, &truth, &cfg).expect("measured");
+    // the rig reads the expression: the difference of the two absolute transducers (their
+    // offsets cancel) up to the noise
     let (pc, pb, dp) = (
         rec.channel("p").unwrap(),
         rec.channel("p_bounce").unwrap(),
@@ -401,28 +416,32 @@ fn the_differential_pressure_sensor_is_a_fitted_output() {
     let worst = (0..dp.len())
         .map(|k| (dp[k] - (pc[k] - pb[k])).abs())
         .fold(0.0, f64::max);
-    let sd = stirling::models::rig::RigConfig::default().noise_p;
     assert!(
-        worst < 6.0 * 3f64.sqrt() * sd,
+        worst < 6.0 * 3f64.sqrt() * cfg.noise_p,
         "dp against p - p_bounce: {worst} Pa"
     );
-    let free = ["kd", "kp", "bd", "bp", "hh", "hk", "Rf"];
+    let free = ["kd", "kp", "bd", "bp", "hh", "hk", "Rf", "Kv"];
     let id = fit::identify(
         &m,
         &truth,
         &rec,
         &FitOptions {
-            free: Some(free.map(String::from).to_vec()),
+            free: Some(free[..7].iter().map(|k| k.to_string()).collect()),
             ..Default::default()
         },
     )
     .expect("fitted");
     let mut p0 = truth.clone();
-    for (k, f) in [("kd", 1.02), ("bp", 1.1), ("hh", 0.9), ("Rf", 1.2)] {
+    for (k, f) in [
+        ("kd", 1.02),
+        ("bp", 1.1),
+        ("hh", 0.9),
+        ("Rf", 1.2),
+        ("Kv", 0.9),
+    ] {
         p0[m.param_index(k).unwrap()] *= f;
     }
     let idx: Vec<usize> = free.iter().map(|k| m.param_index(k).unwrap()).collect();
-    let clock = std::time::Instant::now();
     let ms = multiple_shooting(
         &m,
         &p0,
@@ -433,48 +452,25 @@ fn the_differential_pressure_sensor_is_a_fitted_output() {
         &MsOptions::default(),
     )
     .expect("refined");
-    eprintln!(
-        "multiple shooting {:.1} s, {} it",
-        clock.elapsed().as_secs_f64(),
-        ms.iterations
-    );
-    for e in ms
-        .stats
-        .estimates
-        .iter()
-        .filter(|e| !e.name.starts_with("seg"))
-    {
-        eprintln!(
-            "  {:<12} {:.5e} [{:.5e}, {:.5e}]",
-            e.name, e.value, e.ci_low, e.ci_high
-        );
-    }
-    for f in &ms.fits {
-        eprintln!(
-            "  fit {} {:.2} %, rms {:.3e}",
-            f.channel, f.fit_percent, f.rms
-        );
-    }
     for k in free {
         let e = ms.estimate(k).unwrap();
+        eprintln!("{k}: {:.5e} [{:.5e}, {:.5e}]", e.value, e.ci_low, e.ci_high);
         assert!(e.covers(value(&m, &truth, k)), "{k}: {e:?}");
     }
-    let dp_fit = ms
-        .fits
-        .iter()
-        .find(|f| f.channel == "dp")
-        .expect("dp fitted");
-    // down to the transducer's noise
-    assert!(
-        dp_fit.rms < 1.2 * sd,
-        "dp: rms {} Pa against noise {sd} Pa",
-        dp_fit.rms
-    );
+    let kv = ms.estimate("Kv").unwrap();
+    assert!(kv.ci_high - kv.ci_low < 0.02 * 25.0, "Kv interval {kv:?}");
+    for (ch, sd) in [("dp", cfg.noise_p), ("emf", 0.02)] {
+        let f = ms.fits.iter().find(|f| f.channel == ch).expect("fitted");
+        eprintln!("{ch}: {:.2} %, rms {:.3e}", f.fit_percent, f.rms);
+        assert!(f.rms < 1.2 * sd, "{ch}: rms {} against noise {sd}", f.rms);
+    }
     let fr = id.free_run.as_ref().expect("free run");
-    let short = fr
-        .fit_percent("dp", "free_run_short")
-        .expect("dp in the free run");
-    assert!(short > 85.0, "free run of dp: {short:.2} %");
+    for ch in ["dp", "emf"] {
+        let short = fr
+            .fit_percent(ch, "free_run_short")
+            .expect("in the free run");
+        assert!(short > 85.0, "free run of {ch}: {short:.2} %");
+    }
 }
 
 /// Without its bounce-space sensor the record cannot carry the fit: refused by name.

@@ -41,6 +41,10 @@ pub struct RigArgs {
     /// Position noise standard deviation (m)
     #[arg(long, default_value_t = 20e-6, allow_negative_numbers = true, value_parser = ranges::finite)]
     pub noise_x: f64,
+    /// Noise standard deviation of one channel, in its unit: overrides --noise-p/--noise-x, and
+    /// gives the level of a declared sensor in another unit, e.g. --noise emf=0.05 (repeatable)
+    #[arg(long, value_name = "CHANNEL=SD", value_parser = ranges::channel_noise)]
+    pub noise: Vec<(String, f64)>,
     /// Pressure sensor offset (Pa), on p and p_hot
     #[arg(long, default_value_t = 0.0, allow_negative_numbers = true, value_parser = ranges::finite)]
     pub offset_p: f64,
@@ -83,6 +87,7 @@ pub fn run(a: &RigArgs) -> anyhow::Result<()> {
         rate: a.rate,
         noise_p: a.noise_p,
         noise_x: a.noise_x,
+        noise: a.noise.clone(),
         offset_p: a.offset_p,
         offset_x: a.offset_x,
         offset_y: a.offset_y,

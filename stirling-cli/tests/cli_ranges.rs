@@ -187,5 +187,12 @@ fn rig_negative_values_reach_the_range_check() {
     run(&["--noise-p", "-1"], &["--noise-p", "-1"]);
     run(&["--n", "-1"], &["'--n <N>': must be at least 1"]);
     run(&["--offset-p", "nan"], &["--offset-p", "finite"]);
+    run(&["--noise", "x=-1"], &["--noise", ">= 0"]);
+    run(&["--noise", "x"], &["--noise", "CHANNEL=SD"]);
+    // a channel's noise for a channel not written is a typo, not silently ignored
+    run(
+        &["--noise", "p_hot=10"],
+        &["--noise names `p_hot`", "--channels p,x,y"],
+    );
     assert!(!out.exists());
 }

@@ -114,6 +114,24 @@ pub fn split_counts(s: &str) -> Parsed<(usize, usize)> {
     Ok((count(a)?, count(b)?))
 }
 
+/// A channel's noise level `NAME=SD` (SD a finite number >= 0), as `--noise emf=0.01`.
+pub fn channel_noise(s: &str) -> Parsed<(String, f64)> {
+    let (name, v) = s.split_once('=').ok_or(RangeError::Outside(
+        "expected CHANNEL=SD, such as emf=0.01 (the standard deviation in the channel's unit)",
+    ))?;
+    let name = name.trim();
+    if name.is_empty() {
+        return Err(RangeError::Outside(
+            "the channel's name is empty: expected CHANNEL=SD",
+        ));
+    }
+    let v = number(v)?;
+    if v < 0.0 {
+        return Err(RangeError::Outside("the noise level must be >= 0"));
+    }
+    Ok((name.to_string(), v))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -128,6 +146,10 @@ mod tests {
         assert_eq!(at_least_one("3"), Ok(3));
         assert!(at_least_one("0").is_err() && at_least_one("-1").is_err());
         assert!(positive("-1").is_err() && positive("inf").is_err());
+        assert_eq!(channel_noise("emf=0.01"), Ok(("emf".into(), 0.01)));
+        for bad in ["emf", "=1", "emf=-1", "emf=x", "emf=inf"] {
+            assert!(channel_noise(bad).is_err(), "{bad}");
+        }
         assert!(cycles("0.5").is_err() && cycles("2").is_ok());
     }
 }

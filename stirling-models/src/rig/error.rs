@@ -21,8 +21,10 @@ pub enum RigError {
     TooManySamples { t_end: f64, rate: f64 },
     #[error("unknown channel `{channel}` in --channels: expected some of {known}")]
     UnknownChannel { channel: String, known: String },
-    #[error("sensor `{channel}` is in {unit}: the rig measures pressures (Pa, with --offset-p and --noise-p) and positions (m, with --noise-x)")]
+    #[error("sensor `{channel}` is in {unit}: the rig knows the noise of pressures (Pa, --noise-p) and positions (m, --noise-x); give this one's with --noise {channel}=SD (in {unit})")]
     SensorUnit { channel: String, unit: String },
+    #[error("--noise names `{channel}`, which is not among the channels written (--channels {channels})")]
+    NoiseChannel { channel: String, channels: String },
     #[error("--channels is empty: name at least one of p, p_hot, x, y")]
     NoChannels,
     #[error("the measured pressure would go negative: its minimum {min:.0} Pa plus --offset-p {offset} minus 5 x --noise-p {noise} is not positive")]

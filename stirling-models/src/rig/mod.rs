@@ -45,6 +45,10 @@ pub struct RigConfig {
     pub noise_p: f64,
     /// Position noise standard deviation (m).
     pub noise_x: f64,
+    /// Noise standard deviation of named channels, in each channel's unit: overrides
+    /// `noise_p`/`noise_x`, and gives the level of a declared sensor in another unit (an
+    /// alternator's voltage in V).
+    pub noise: Vec<(String, f64)>,
     /// Sensor offsets added to `p` and `p_hot` (Pa), `x`, `y` (m).
     pub offset_p: f64,
     pub offset_x: f64,
@@ -74,6 +78,7 @@ impl Default for RigConfig {
             rate: 2000.0,
             noise_p: 50.0,
             noise_x: 20e-6,
+            noise: Vec::new(),
             offset_p: 0.0,
             offset_x: 0.0,
             offset_y: 0.0,
@@ -157,6 +162,21 @@ fn validate(cfg: &RigConfig) -> Result<(), RigError> {
     }
     if cfg.channels.is_empty() {
         return Err(RigError::NoChannels);
+    }
+    for (name, v) in &cfg.noise {
+        if !cfg.channels.contains(name) {
+            return Err(RigError::NoiseChannel {
+                channel: name.clone(),
+                channels: cfg.channels.join(","),
+            });
+        }
+        if !(*v >= 0.0 && v.is_finite()) {
+            return bad(
+                "--noise",
+                *v,
+                &format!("a non-negative noise level for `{name}`"),
+            );
+        }
     }
     Ok(())
 }

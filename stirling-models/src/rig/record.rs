@@ -78,6 +78,11 @@ pub(super) fn record(
     let count = (cfg.t_end * cfg.rate).round() as usize;
     let dt = 1.0 / cfg.rate;
     let rows = clean_run(model, p, cfg, count)?;
+    for c in &mut chans {
+        if let Some(&(_, sd)) = cfg.noise.iter().find(|(n, _)| *n == c.name) {
+            c.sd = sd;
+        }
+    }
     let read = read_sensors((model, p), &rows, &chans, cfg)?;
     let mut data = Measured {
         source: format!("rig:{}", model.name()),
@@ -126,11 +131,13 @@ fn declared_channel(
     // an absolute pressure carries the transducer's offset and must stay positive; a
     // difference or another expression is read zeroed at rest
     let state = obs.as_state().is_some();
-    let (offset, sd, pressure) = match sensor.unit {
-        "Pa" if state => (cfg.offset_p, cfg.noise_p, true),
-        "Pa" => (0.0, cfg.noise_p, false),
-        "m" => (0.0, cfg.noise_x, false),
-        unit => {
+    let given = cfg.noise.iter().find(|(c, _)| c == name).map(|&(_, sd)| sd);
+    let (offset, sd, pressure) = match (sensor.unit, given) {
+        ("Pa", _) if state => (cfg.offset_p, cfg.noise_p, true),
+        ("Pa", _) => (0.0, cfg.noise_p, false),
+        ("m", _) => (0.0, cfg.noise_x, false),
+        (_, Some(sd)) => (0.0, sd, false),
+        (unit, None) => {
             return Err(RigError::SensorUnit {
                 channel: name.into(),
                 unit: unit.into(),
