@@ -12,6 +12,8 @@ pub enum Where {
     Between(fn(&[Ident]) -> Vec<(&'static str, Expr)>),
     /// On a declared link (`on link <from> -> <to>`): these fields added to it.
     Link(fn(&[Ident]) -> Vec<(&'static str, Expr)>),
+    /// On a CV's heat port (`on port <cv>.<port>`): its fixed wall temperature becomes a wall.
+    Port(super::ports::PortShape),
 }
 
 /// A parameter: its default name (`{0}`: the body or first end, `{1}`: the body's position
@@ -141,6 +143,42 @@ pub const KINDS: &[Kind] = &[
                 "orifice seal-leak coefficient {site} (0: no leak)",
             ),
             param("dP0", 50.0, "Pa", "width of the orifice law's linear core"),
+        ],
+    },
+    Kind {
+        name: "heater_input",
+        site: Where::Port(super::ports::PortShape::Head),
+        params: &[
+            param(
+                "kh_{0}_{1}",
+                0.0,
+                "K/J",
+                "inverse heat capacity of the wall behind {site} (0: infinite, the fixed wall)",
+            ),
+            param(
+                "Gh_{0}_{1}",
+                0.5,
+                "W/K",
+                "conductance from the fixed source to the wall behind {site} (its finite input)",
+            ),
+        ],
+    },
+    Kind {
+        name: "matrix_capacity",
+        site: Where::Port(super::ports::PortShape::Matrix),
+        params: &[
+            param(
+                "km_{0}_{1}",
+                0.0,
+                "K/J",
+                "inverse heat capacity of the whole matrix behind {site} (0: infinite, the fixed wall)",
+            ),
+            param(
+                "Gm_{0}_{1}",
+                0.03,
+                "W/K",
+                "axial conductance of the whole matrix behind {site}",
+            ),
         ],
     },
 ];

@@ -7,6 +7,9 @@
 //! effect leak cold -> bounce;            // link cold -> bounce { conductance: Gleak_cold_bounce }
 //! effect orifice_leak cold -> bounce;    // link cold -> bounce { orifice: Co_cold_bounce, dp0: dP0 }
 //! effect quadratic on link hot -> regen[0];  // that link gains quadratic: Rq_hot_regen
+//! effect heater_input on port hot.hot;   // the port's fixed wall becomes wall `hot_hot`:
+//!                                        // capacity 1/kh_hot_hot, fed through Gh_hot_hot
+//! effect matrix_capacity on port regen.wall; // walls regen_wall[n], capacity 1/km_regen_wall
 //! effect coulomb on piston as Fcp;       // the strength named `Fcp` (then the shape, `as Fcp, v_eps`)
 //! ```
 //!
@@ -17,6 +20,7 @@
 
 mod kinds;
 mod parse;
+mod ports;
 
 pub use parse::{EffectAst, Site};
 
@@ -75,7 +79,7 @@ fn push(errors: &mut Option<syn::Error>, e: syn::Error) {
 }
 
 /// Apply one effect: its parameters (those the model lacks into `added`) and its term (a
-/// force term in place, a link given to `link`).
+/// force term in place; a link, or a port's wall with its items, given to `link`).
 fn one(
     ast: &mut ModelAst,
     e: &EffectAst,
@@ -119,6 +123,20 @@ fn one(
             names
         }
         (Where::Link(fields), Site::Link(from, to)) => on_link(ast, kind, *fields, e, (from, to))?,
+        (Where::Port(shape), Site::Port(cv, port)) => {
+            let names = param_names(kind, e, &[&cv.to_string(), &port.to_string()]);
+            let pair = (&names[0], &names[1]);
+            for item in ports::on_port(ast, kind.name, *shape, (cv, port), pair)? {
+                link(item);
+            }
+            names
+        }
+        (Where::Port(_), _) => {
+            let msg = format!(
+                "effect `{name}` acts on a CV's heat port: write `effect {name} on port <cv>.<port>;`"
+            );
+            return Err(syn::Error::new(e.span, msg));
+        }
         (Where::Body(_), _) => {
             let msg = format!("effect `{name}` acts on a body: write `effect {name} on <body>;`");
             return Err(syn::Error::new(e.span, msg));

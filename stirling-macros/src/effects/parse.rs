@@ -1,4 +1,5 @@
-//! `effect <kind> on <body> [as <names>];` and `effect <kind> <end> -> <end> [as <names>];`.
+//! `effect <kind> on <body> [as <names>];`, `effect <kind> <end> -> <end> [as <names>];`,
+//! `effect <kind> on link <end> -> <end> ..;` and `effect <kind> on port <cv>.<port> ..;`.
 
 use proc_macro2::Span;
 use syn::parse::{Parse, ParseStream};
@@ -15,6 +16,8 @@ pub enum Site {
     Between(EndAst, EndAst),
     /// `on link <from> -> <to>`: on a declared link (its ends as written).
     Link(EndAst, EndAst),
+    /// `on port <cv>.<port>`: on a CV's heat port.
+    Port(Ident, Ident),
 }
 
 /// One `effect` item.
@@ -33,11 +36,17 @@ impl Parse for EffectAst {
         let span = kind.span();
         let site = if input.peek(Ident) && input.fork().parse::<Ident>()? == "on" {
             input.parse::<Ident>()?;
-            if input.peek(Ident) && input.peek2(Ident) && input.fork().parse::<Ident>()? == "link" {
+            let next = || input.fork().parse::<Ident>().map(|i| i.to_string());
+            if input.peek(Ident) && input.peek2(Ident) && next()? == "link" {
                 input.parse::<Ident>()?;
                 let from: EndAst = input.parse()?;
                 input.parse::<Token![->]>()?;
                 Site::Link(from, input.parse()?)
+            } else if input.peek(Ident) && input.peek2(Ident) && next()? == "port" {
+                input.parse::<Ident>()?;
+                let cv: Ident = input.parse()?;
+                input.parse::<Token![.]>()?;
+                Site::Port(cv, input.parse()?)
             } else {
                 Site::Body(input.parse()?)
             }
@@ -71,6 +80,7 @@ impl Site {
             Site::Body(b) => b.to_string(),
             Site::Link(a, b) => format!("link {}", ends(a, b)),
             Site::Between(a, b) => ends(a, b),
+            Site::Port(cv, port) => format!("port {cv}.{port}"),
         }
     }
 }
