@@ -232,3 +232,68 @@ fn the_diagnosis_takes_its_candidates_from_the_named_effects() {
     let p = effects::nominal_params(&m);
     assert_eq!(p, m.default_params());
 }
+
+stirling_model! {
+    /// `nsection` with a lag on its hot-side transducer and a gain error on the displacer's
+    /// position sensor, named on the sensors.
+    pub model Sensed extends stirling::models::nsection_engine {
+        name "sensed";
+        effect lag on sensor p_hot;
+        effect gain on sensor x;
+    }
+}
+
+/// A lag or gain named on a sensor is listed with its parameter (named after the sensor, not
+/// a model parameter: the equations are the nominal ones), carried as a sensor effect, and
+/// applied by the rig to that channel alone.
+#[test]
+fn a_sensor_effect_acts_on_its_sensor_alone() {
+    use stirling::models::effects::{EffectSettings, EffectTarget};
+    use stirling::models::rig::{measure_with, RigConfig};
+    let m = Sensed::new(2, Closure::Full).unwrap();
+    assert_eq!(
+        m.effect_sites(),
+        [
+            EffectSite {
+                effect: "lag",
+                at: "sensor p_hot",
+                params: &["tau_p_hot"]
+            },
+            EffectSite {
+                effect: "gain",
+                at: "sensor x",
+                params: &["gain_x"]
+            },
+        ]
+    );
+    let plain = stirling::models::family::NSection::new(2, Closure::Full).unwrap();
+    assert_eq!(m.params().len(), plain.params().len());
+    let pool = effects::carried("sensed", Some(&m));
+    let lag = pool.iter().find(|e| e.name == "lag").unwrap();
+    assert_eq!(lag.target, EffectTarget::Sensor);
+    assert_eq!((lag.params[0].name, lag.params[0].unit), ("tau_p_hot", "s"));
+    assert_eq!(lag.strength().typical, 2e-3, "the library's sensor_lag");
+    let set = EffectSettings::parse_for("sensed", Some(&m), &["tau_p_hot=0.004".into()]).unwrap();
+    assert_eq!(set.sensor, [("tau_p_hot".to_string(), 0.004)]);
+    let err = EffectSettings::parse_for("sensed", Some(&m), &["gain_x=0.7".into()]).unwrap_err();
+    assert!(err.to_string().contains("between -0.5 and 0.5"), "{err}");
+    let cfg = RigConfig {
+        t_end: 0.3,
+        channels: ["p", "p_hot", "x", "y"].map(String::from).to_vec(),
+        ..Default::default()
+    };
+    let p = m.default_params();
+    let clean = measure_with(&m, &p, &EffectSettings::default(), &cfg).unwrap();
+    let lagged = measure_with(&m, &p, &set, &cfg).unwrap();
+    assert_eq!(clean.channel("p"), lagged.channel("p"), "p is not lagged");
+    let (a, b) = (
+        clean.channel("p_hot").unwrap(),
+        lagged.channel("p_hot").unwrap(),
+    );
+    let worst = a
+        .iter()
+        .zip(b)
+        .map(|(u, v)| (u - v).abs())
+        .fold(0.0, f64::max);
+    assert!(worst > 100.0, "p_hot lagged by 4 ms moves by {worst} Pa");
+}

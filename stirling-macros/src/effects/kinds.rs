@@ -14,6 +14,10 @@ pub enum Where {
     Link(fn(&[Ident]) -> Vec<(&'static str, Expr)>),
     /// On a CV's heat port (`on port <cv>.<port>`): its fixed wall temperature becomes a wall.
     Port(super::ports::PortShape),
+    /// On a declared sensor (`on sensor <name>`): a distortion of its reading, applied by the
+    /// rig and fitted by the diagnosis; the model's equations are unchanged and its one
+    /// parameter (`tau_<sensor>`, `gain_<sensor>`) is not a model parameter.
+    Sensor,
 }
 
 /// A parameter: its default name (`{0}`: the body or first end, `{1}`: the body's position
@@ -144,6 +148,26 @@ pub const KINDS: &[Kind] = &[
             ),
             param("dP0", 50.0, "Pa", "width of the orifice law's linear core"),
         ],
+    },
+    Kind {
+        name: "lag",
+        site: Where::Sensor,
+        params: &[param(
+            "tau_{0}",
+            0.0,
+            "s",
+            "first-order lag of {site} (0: none)",
+        )],
+    },
+    Kind {
+        name: "gain",
+        site: Where::Sensor,
+        params: &[param(
+            "gain_{0}",
+            0.0,
+            "-",
+            "relative gain error of {site}: read (1 + gain) times the value",
+        )],
     },
     Kind {
         name: "heater_input",

@@ -10,6 +10,8 @@
 //! effect heater_input on port hot.hot;   // the port's fixed wall becomes wall `hot_hot`:
 //!                                        // capacity 1/kh_hot_hot, fed through Gh_hot_hot
 //! effect matrix_capacity on port regen.wall; // walls regen_wall[n], capacity 1/km_regen_wall
+//! effect lag on sensor p_bounce;        // its reading lagged, time constant tau_p_bounce
+//! effect gain on sensor x;               // its reading (1 + gain_x) times the position
 //! effect coulomb on piston as Fcp;       // the strength named `Fcp` (then the shape, `as Fcp, v_eps`)
 //! ```
 //!
@@ -130,6 +132,33 @@ fn one(
                 link(item);
             }
             names
+        }
+        (Where::Sensor, Site::Sensor(sensor)) => {
+            let declared = ast
+                .items
+                .iter()
+                .any(|it| matches!(it, Item::Sensor(s) if s.name == *sensor));
+            if !declared {
+                let msg = format!("effect `{name}` on sensor `{sensor}`: no sensor `{sensor}`; it acts on a declared sensor");
+                return Err(syn::Error::new(sensor.span(), msg));
+            }
+            if !e.names.is_empty() {
+                let msg = format!("effect `{name}` on a sensor takes no `as`: its parameter is named after the sensor (`{}`)", fill(kind.params[0].name, &[&sensor.to_string()]));
+                return Err(syn::Error::new(e.span, msg));
+            }
+            let names = param_names(kind, e, &[&sensor.to_string()]);
+            // a sensor's parameter is the rig's and the diagnosis's, not the model's
+            return Ok(EffectSiteDecl {
+                effect: name,
+                at: e.site.describe(),
+                params: names.iter().map(Ident::to_string).collect(),
+            });
+        }
+        (Where::Sensor, _) => {
+            let msg = format!(
+                "effect `{name}` acts on a sensor's reading: write `effect {name} on sensor <name>;`"
+            );
+            return Err(syn::Error::new(e.span, msg));
         }
         (Where::Port(_), _) => {
             let msg = format!(

@@ -1,5 +1,6 @@
 //! `effect <kind> on <body> [as <names>];`, `effect <kind> <end> -> <end> [as <names>];`,
-//! `effect <kind> on link <end> -> <end> ..;` and `effect <kind> on port <cv>.<port> ..;`.
+//! `effect <kind> on link <end> -> <end> ..;`, `effect <kind> on port <cv>.<port> ..;` and
+//! `effect <kind> on sensor <name>;`.
 
 use proc_macro2::Span;
 use syn::parse::{Parse, ParseStream};
@@ -18,6 +19,8 @@ pub enum Site {
     Link(EndAst, EndAst),
     /// `on port <cv>.<port>`: on a CV's heat port.
     Port(Ident, Ident),
+    /// `on sensor <name>`: on a declared sensor's reading.
+    Sensor(Ident),
 }
 
 /// One `effect` item.
@@ -42,6 +45,9 @@ impl Parse for EffectAst {
                 let from: EndAst = input.parse()?;
                 input.parse::<Token![->]>()?;
                 Site::Link(from, input.parse()?)
+            } else if input.peek(Ident) && input.peek2(Ident) && next()? == "sensor" {
+                input.parse::<Ident>()?;
+                Site::Sensor(input.parse()?)
             } else if input.peek(Ident) && input.peek2(Ident) && next()? == "port" {
                 input.parse::<Ident>()?;
                 let cv: Ident = input.parse()?;
@@ -81,6 +87,7 @@ impl Site {
             Site::Link(a, b) => format!("link {}", ends(a, b)),
             Site::Between(a, b) => ends(a, b),
             Site::Port(cv, port) => format!("port {cv}.{port}"),
+            Site::Sensor(name) => format!("sensor {name}"),
         }
     }
 }

@@ -281,8 +281,20 @@ pub fn run(cfg: &RigConfig) -> Result<RigOutput, RigError> {
 /// `p` (no effects: the truth is the model itself). A pressure sensor (unit `Pa`) gets
 /// `offset_p` and `noise_p`, a position (`m`) no offset and `noise_x`.
 pub fn measure(model: &dyn Model, p: &[f64], cfg: &RigConfig) -> Result<Measured, RigError> {
+    measure_with(model, p, &EffectSettings::default(), cfg)
+}
+
+/// [`measure`] with the sensor effects of `fx` on the readings (a lag or gain named on a
+/// sensor, `tau_<sensor>`, `gain_<sensor>`; the library's `tau_p`, `gain_x`, `gain_y`); its
+/// model settings are not applied (set them in `p`).
+pub fn measure_with(
+    model: &dyn Model,
+    p: &[f64],
+    fx: &EffectSettings,
+    cfg: &RigConfig,
+) -> Result<Measured, RigError> {
     validate(cfg)?;
-    record(model, p, &EffectSettings::default(), cfg)
+    record(model, p, fx, cfg)
 }
 
 /// `--channels` of the family's rig: the seed's four.

@@ -72,7 +72,7 @@ pub(super) fn record(
     };
     for c in &cfg.channels {
         if !chans.iter().any(|k| &k.name == c) {
-            chans.push(declared_channel(model, c, cfg)?);
+            chans.push(declared_channel(model, c, fx, cfg)?);
         }
     }
     let count = (cfg.t_end * cfg.rate).round() as usize;
@@ -108,6 +108,7 @@ pub(super) fn record(
 fn declared_channel(
     model: &dyn Model,
     name: &str,
+    fx: &EffectSettings,
     cfg: &RigConfig,
 ) -> Result<sensors::Channel, RigError> {
     let known = || {
@@ -144,11 +145,22 @@ fn declared_channel(
             })
         }
     };
+    // its own distortions (`effect lag on sensor ..;`), else the library's lag of every
+    // absolute pressure transducer
+    let own = |prefix: &str| {
+        let key = format!("{prefix}_{name}");
+        fx.sensor.iter().find(|(n, _)| *n == key).map(|&(_, v)| v)
+    };
+    let tau = own("tau").unwrap_or(if pressure {
+        fx.sensor_value("tau_p")
+    } else {
+        0.0
+    });
     Ok(sensors::Channel {
         name: name.into(),
         obs,
-        tau: 0.0,
-        gain: 0.0,
+        tau,
+        gain: own("gain").unwrap_or(0.0),
         offset,
         sd,
         pressure,

@@ -57,11 +57,15 @@ pub(super) fn seed_channels(
     fx: &EffectSettings,
     cfg: &RigConfig,
 ) -> Vec<Channel> {
-    let tau = fx.sensor_value("tau_p");
+    // `tau_p` lags both transducers; `tau_p_hot` (a lag named on that sensor) the hot one
+    let tau = |name: &str| match fx.sensor.iter().find(|(n, _)| *n == format!("tau_{name}")) {
+        Some(&(_, v)) => v,
+        None => fx.sensor_value("tau_p"),
+    };
     let pressure = |name: &str, state| Channel {
         name: name.into(),
         obs: Observation::state(state),
-        tau,
+        tau: tau(name),
         gain: 0.0,
         offset: cfg.offset_p,
         sd: cfg.noise_p,

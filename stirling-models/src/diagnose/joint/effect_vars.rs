@@ -180,6 +180,17 @@ fn kind_in(
 ) -> Result<Option<VarKind>, DiagnoseError> {
     match e.target {
         EffectTarget::Model => model_kind(model, st, e, name),
+        // named on one sensor (`effect lag on sensor p_bounce;`)
+        EffectTarget::Sensor if matches!(e.name, "lag" | "gain") => {
+            let s = one_sensor(st, name)
+                .ok_or_else(|| DiagnoseError::SensorParam { name: name.into() })?;
+            // a stage that neither reads nor outputs the sensor does not see it
+            let acts = match &s {
+                Sensor::Lag { signals, outputs } => !signals.is_empty() || !outputs.is_empty(),
+                Sensor::Gain { given, outputs } => !given.is_empty() || !outputs.is_empty(),
+            };
+            Ok(acts.then_some(VarKind::Sensor(s)))
+        }
         EffectTarget::Sensor => sensor_kind(st, name).map(Some),
     }
 }
@@ -282,4 +293,41 @@ fn sensor_kind(st: &FittedStage, name: &str) -> Result<VarKind, DiagnoseError> {
         other => return Err(DiagnoseError::SensorParam { name: other.into() }),
     };
     Ok(VarKind::Sensor(sensor))
+}
+
+/// A distortion named on one sensor (`effect lag on sensor p_bounce;` gives `tau_p_bounce`,
+/// `effect gain on sensor x;` `gain_x`): in a stage that prescribes the sensor's state, on
+/// what prescribes it (a lag un-lags its measured signals, a gain divides it); in a stage
+/// that outputs the channel, on that output.
+fn one_sensor(st: &FittedStage, name: &str) -> Option<Sensor> {
+    let (lag, channel) = match (name.strip_prefix("tau_"), name.strip_prefix("gain_")) {
+        (Some(ch), _) => (true, ch),
+        (_, Some(ch)) => (false, ch),
+        _ => return None,
+    };
+    let stage = &st.stage;
+    stage.model.sensors().iter().find(|s| s.name == channel)?;
+    let state = stage.model.sensor_state(channel).flatten();
+    // the measured signals that prescribe the sensor's state
+    let mut signals: Vec<usize> = stage
+        .given
+        .iter()
+        .filter(|g| Some(g.state) == state)
+        .flat_map(|g| g.terms.iter().map(|t| t.0))
+        .filter(|s| !stage.derived.contains(s))
+        .collect();
+    signals.sort_unstable();
+    signals.dedup();
+    let outputs: Vec<usize> = (0..stage.outputs.len())
+        .filter(|&o| stage.outputs[o].channel == channel)
+        .collect();
+    Some(if lag {
+        Sensor::Lag { signals, outputs }
+    } else {
+        // every prescribed state read from those signals (a position and its velocity)
+        let given = (0..stage.given.len())
+            .filter(|&g| stage.given[g].terms.iter().any(|t| signals.contains(&t.0)))
+            .collect();
+        Sensor::Gain { given, outputs }
+    })
 }

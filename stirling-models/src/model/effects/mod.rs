@@ -292,7 +292,8 @@ pub fn augmented(
 pub fn check_range(name: &str, v: f64) -> Result<(), EffectError> {
     let (ok, range) = match name {
         "v_eps" | "xmax" | "ymax" | "Gm" | "Gloss" | "dP0" => (v > 0.0, "> 0"),
-        "gain_x" | "gain_y" => (v > -0.5 && v < 0.5, "between -0.5 and 0.5"),
+        n if n.starts_with("Gh_") || n.starts_with("Gm_") => (v > 0.0, "> 0"),
+        n if n.starts_with("gain_") => (v > -0.5 && v < 0.5, "between -0.5 and 0.5"),
         _ => (v >= 0.0, ">= 0"),
     };
     if ok {

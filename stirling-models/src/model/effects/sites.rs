@@ -52,7 +52,7 @@ fn build(model: &dyn Model) -> Vec<&'static EffectInfo> {
             let info = EffectInfo {
                 name: kind,
                 summary: Box::leak(format!("{what} (at {})", at.join(", ")).into_boxed_str()),
-                target: EffectTarget::Model,
+                target: target(kind),
                 params: Box::leak(params.into_boxed_slice()),
                 applies_to: Box::leak(vec![base].into_boxed_slice()),
             };
@@ -87,7 +87,7 @@ fn params_of(model: &dyn Model, kind: &str) -> Vec<EffectParam> {
                     name,
                     null,
                     typical,
-                    unit: info(name).map_or("", |q| q.unit),
+                    unit: info(name).map_or(sensor_unit(kind), |q| q.unit),
                 });
             }
         }
@@ -105,10 +105,30 @@ fn typical_strength(kind: &str, name: &str) -> f64 {
 }
 
 /// The library's effect of an `effect` kind (`quadratic` on a link is the library's
-/// `regen_quadratic` on the regenerator's links).
+/// `regen_quadratic` on the regenerator's links; `lag` and `gain` on a sensor are the
+/// library's `sensor_lag` and `sensor_gain` on that sensor alone).
 fn library(kind: &str) -> Option<&'static EffectInfo> {
     effect(match kind {
         "quadratic" => "regen_quadratic",
+        "lag" => "sensor_lag",
+        "gain" => "sensor_gain",
         k => k,
     })
+}
+
+/// What an `effect` kind acts on: the sensors' readings (`lag`, `gain`: the rig applies
+/// them, the diagnosis fits them) or the model.
+fn target(kind: &str) -> EffectTarget {
+    match kind {
+        "lag" | "gain" => EffectTarget::Sensor,
+        _ => EffectTarget::Model,
+    }
+}
+
+/// The unit of a sensor effect's parameter (not a model parameter, so not declared).
+fn sensor_unit(kind: &str) -> &'static str {
+    match kind {
+        "lag" => "s",
+        _ => "-",
+    }
 }

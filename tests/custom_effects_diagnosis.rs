@@ -1,0 +1,173 @@
+//! The diagnosis on a declared engine (`examples/custom_topology.rs`) whose augmented members
+//! name a heater head as a port effect (`effect heater_input on port hot.hot;`) and a lag on
+//! one sensor (`effect lag on sensor p_bounce;`): the library's wall-state and sensor effects
+//! are effects of any engine, named where they act.
+
+#[path = "../examples/custom_topology.rs"]
+#[allow(dead_code)]
+#[macro_use]
+mod ex;
+
+use stirling::dsl::{Closure, Model};
+use stirling::stirling_model;
+
+stirling_model! {
+    /// The alternator engine with a heater head of finite capacity and Coulomb friction on
+    /// the piston, at their null.
+    pub model HeatedFx extends alternator_engine {
+        name "alternator_engine_heated_fx";
+        effect heater_input on port hot.hot;
+        effect coulomb on piston;
+    }
+}
+
+stirling_model! {
+    /// The alternator engine with a lag on its bounce-space transducer and Coulomb friction
+    /// on the piston, at their null.
+    pub model LaggedFx extends alternator_engine {
+        name "alternator_engine_lagged_fx";
+        effect lag on sensor p_bounce;
+        effect coulomb on piston;
+    }
+}
+
+/// A 2 s start-up record of `m` with the model settings `set` (parameters by name) and the
+/// sensor settings `sensor` withheld, and a start perturbed from the nominal parameters.
+fn record_of<M: Model + Clone>(
+    m: M,
+    set: &[(&str, f64)],
+    sensor: &[(&str, f64)],
+) -> (M, Vec<f64>, stirling::models::data::Measured) {
+    use stirling::models::effects::EffectSettings;
+    use stirling::models::rig::{measure_with, RigConfig};
+    let nominal = stirling::models::effects::nominal_params(&m);
+    let mut truth = nominal.clone();
+    for &(k, v) in set {
+        truth[m.param_index(k).unwrap()] = v;
+    }
+    let cfg = RigConfig {
+        t_end: 2.0,
+        rate: 1000.0,
+        seed: 5,
+        channels: ["p", "x", "y", "p_bounce"].map(String::from).to_vec(),
+        ..Default::default()
+    };
+    let fx = EffectSettings {
+        sensor: sensor.iter().map(|&(k, v)| (k.to_string(), v)).collect(),
+        ..Default::default()
+    };
+    let rec = measure_with(&m, &truth, &fx, &cfg).expect("measured");
+    let mut p0 = nominal;
+    for (name, f) in [
+        ("kd", 1.08),
+        ("kp", 0.93),
+        ("bd", 1.07),
+        ("bp", 0.94),
+        ("hh", 1.06),
+        ("hk", 0.95),
+    ] {
+        p0[m.param_index(name).unwrap()] *= f;
+    }
+    (m, p0, rec)
+}
+
+fn record(kh: f64, _seed: u64) -> (HeatedFx, Vec<f64>, stirling::models::data::Measured) {
+    let m = HeatedFx::new(2, Closure::Full).unwrap();
+    record_of(m, &[("kh_hot_hot", kh)], &[])
+}
+
+/// A heater head of finite capacity withheld from the record (`kh_hot_hot` = 0.4 K/J: a
+/// 2.5 J/K head fed through 0.5 W/K, which sags by several kelvin a second under the heat
+/// the gas draws) is named by the diagnosis, its strength recovered; a clean record gives
+/// `no_significant_gap`. At the library's typical 0.04 K/J (the family's head, time constant
+/// 50 s) a 2 s record does not show it (p = 4.3e-3 against the threshold 3.3e-3: no
+/// significant gap), at 0.2 it is significant (p = 2e-17) but closes the gap by less than
+/// half with confidence (`unexplained`, naming it first): the head's temperature at the
+/// held-out block's start is not measured, so the free run starts it at its rest.
+#[test]
+fn the_diagnosis_names_a_withheld_heater_head() {
+    use stirling::models::diagnose::{diagnose, DiagnoseOptions};
+    let opts = DiagnoseOptions {
+        effects: Some(
+            ["heater_input", "coulomb", "sensor_lag"]
+                .map(String::from)
+                .to_vec(),
+        ),
+        bootstrap: 200,
+        fit_all: true,
+        ..Default::default()
+    };
+    let (m, p0, rec) = record(0.4, 5);
+    let d = diagnose(&m, &p0, &rec, &opts).expect("diagnosed");
+    eprintln!(
+        "heater: {} {:?} ({})",
+        d.verdict.verdict, d.verdict.effect, d.verdict.reason
+    );
+    assert_eq!(d.verdict.verdict, "effect", "{}", d.verdict.reason);
+    assert_eq!(d.verdict.effect.as_deref(), Some("heater_input"));
+    let entry = d
+        .ranking
+        .iter()
+        .find(|e| e.effect == "heater_input")
+        .unwrap();
+    let kh = entry
+        .params
+        .iter()
+        .find(|q| q.name == "kh_hot_hot")
+        .unwrap()
+        .value;
+    assert!((0.3..0.6).contains(&kh), "kh_hot_hot {kh} (truth 0.4)");
+    let (m, p0, rec) = record(0.0, 5);
+    let d = diagnose(&m, &p0, &rec, &opts).expect("diagnosed");
+    eprintln!(
+        "clean: {} {:?} ({})",
+        d.verdict.verdict, d.verdict.effect, d.verdict.reason
+    );
+    assert_eq!(
+        d.verdict.verdict, "no_significant_gap",
+        "{}",
+        d.verdict.reason
+    );
+}
+
+/// A lag of 3 ms on the bounce-space transducer alone (`effect lag on sensor p_bounce;`,
+/// parameter `tau_p_bounce`), withheld: the diagnosis names `lag`, not the library's
+/// `sensor_lag` (which lags every pressure transducer), and recovers its time constant.
+#[test]
+fn the_diagnosis_names_a_lag_on_one_sensor() {
+    use stirling::models::diagnose::{diagnose, DiagnoseOptions};
+    let opts = DiagnoseOptions {
+        effects: Some(["lag", "sensor_lag", "coulomb"].map(String::from).to_vec()),
+        bootstrap: 200,
+        fit_all: true,
+        ..Default::default()
+    };
+    let m = LaggedFx::new(2, Closure::Full).unwrap();
+    let (m, p0, rec) = record_of(m, &[], &[("tau_p_bounce", 3e-3)]);
+    let d = diagnose(&m, &p0, &rec, &opts).expect("diagnosed");
+    eprintln!(
+        "lag: {} {:?} ({})",
+        d.verdict.verdict, d.verdict.effect, d.verdict.reason
+    );
+    assert_eq!(d.verdict.verdict, "effect", "{}", d.verdict.reason);
+    assert_eq!(d.verdict.effect.as_deref(), Some("lag"));
+    let entry = d.ranking.iter().find(|e| e.effect == "lag").unwrap();
+    let tau = entry
+        .params
+        .iter()
+        .find(|q| q.name == "tau_p_bounce")
+        .unwrap()
+        .value;
+    assert!(
+        (2e-3..4e-3).contains(&tau),
+        "tau_p_bounce {tau} (truth 3e-3)"
+    );
+    let m = LaggedFx::new(2, Closure::Full).unwrap();
+    let (m, p0, rec) = record_of(m, &[], &[]);
+    let d = diagnose(&m, &p0, &rec, &opts).expect("diagnosed");
+    assert_eq!(
+        d.verdict.verdict, "no_significant_gap",
+        "{}",
+        d.verdict.reason
+    );
+}
