@@ -31,6 +31,19 @@ stirling_model! {
     }
 }
 
+stirling_model! {
+    /// The alternator engine with Coulomb friction on the piston whose strength the model
+    /// bounds (`in 0.0..0.3`): the diagnosis's joint fit stays inside.
+    pub model BoundedFx extends alternator_engine {
+        name "alternator_engine_bounded_fx";
+        params {
+            /// Coulomb friction force on the piston, at most 0.3 N
+            Fc_piston: 0.0 "N" in 0.0..0.3,
+        }
+        effect coulomb on piston;
+    }
+}
+
 /// A 2 s start-up record of `m` with the model settings `set` (parameters by name) and the
 /// sensor settings `sensor` withheld, and a start perturbed from the nominal parameters.
 fn record_of<M: Model + Clone>(
@@ -170,4 +183,34 @@ fn the_diagnosis_names_a_lag_on_one_sensor() {
         "{}",
         d.verdict.reason
     );
+}
+
+/// A range the model declares for an effect's strength holds in the diagnosis's joint fit:
+/// with 0.5 N of piston friction withheld and `Fc_piston` declared in `0.0..0.3`, the fitted
+/// strength ends inside (at the bound), where unbounded it reaches 0.39 N.
+#[test]
+fn the_joint_fit_stays_inside_declared_bounds() {
+    use stirling::models::diagnose::{diagnose, DiagnoseOptions};
+    let opts = DiagnoseOptions {
+        effects: Some(["coulomb"].map(String::from).to_vec()),
+        bootstrap: 100,
+        fit_all: true,
+        ..Default::default()
+    };
+    let m = BoundedFx::new(2, Closure::Full).unwrap();
+    let (m, p0, rec) = record_of(m, &[("Fc_piston", 0.5)], &[]);
+    let d = diagnose(&m, &p0, &rec, &opts).expect("diagnosed");
+    let entry = d.ranking.iter().find(|e| e.effect == "coulomb").unwrap();
+    let fc = entry
+        .params
+        .iter()
+        .find(|q| q.name == "Fc_piston")
+        .unwrap()
+        .value;
+    eprintln!(
+        "bounded: {} ({}), Fc_piston {fc}",
+        d.verdict.verdict, d.verdict.reason
+    );
+    assert!(fc <= 0.3, "Fc_piston {fc} outside 0.0..0.3");
+    assert!(fc > 0.25, "Fc_piston {fc}: pushed to the bound by the data");
 }

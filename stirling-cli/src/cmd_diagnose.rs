@@ -29,6 +29,10 @@ pub struct DiagnoseArgs {
     /// Candidate effects: all, or a comma-separated list
     #[arg(long, default_value = "all")]
     pub effects: String,
+    /// Bounds of the nominal parameters (TOML `kd = [100.0, 2000.0]` or JSON), over those the
+    /// model declares; the calibration stays inside them
+    #[arg(long, value_name = "FILE")]
+    pub bounds: Option<PathBuf>,
     /// Training block a:b in seconds (default: first 60 %)
     #[arg(long, allow_hyphen_values = true)]
     pub train: Option<String>,
@@ -137,7 +141,15 @@ pub fn run(a: &DiagnoseArgs) -> anyhow::Result<()> {
     let (train, holdout) = common::blocks(a.train.as_deref(), a.holdout.as_deref(), &data, 0.6)?;
     let (model, mut p0) = diagnose::nominal_model(model_name, a.with.n)?;
     a.with.apply(model.as_ref(), &mut p0)?;
+    let bounds = match &a.bounds {
+        Some(f) => stirling_models::bounds::load_bounds(model.as_ref(), f)?,
+        None => Vec::new(),
+    };
     let opts = DiagnoseOptions {
+        fit: stirling_models::fit::FitOptions {
+            bounds,
+            ..Default::default()
+        },
         effects: effects_arg(&a.effects),
         prior: prior_arg(a.prior)?,
         train,

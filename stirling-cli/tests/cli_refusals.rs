@@ -75,6 +75,11 @@ fn bounds_the_fit_cannot_use_are_refused_by_name() {
         let b = dir.join(name);
         std::fs::write(&b, text).unwrap();
         fails_with(&["fit", "cv1", "--data", s(&f), "--bounds", s(&b)], &[says]);
+        // the diagnosis's calibration takes the same file
+        fails_with(
+            &["diagnose", "cv1", "--data", s(&f), "--bounds", s(&b)],
+            &[says],
+        );
     }
     let missing = dir.join("missing.toml");
     fails_with(

@@ -45,11 +45,11 @@ pub fn fit(
     let strengths: Vec<&EffectVar> = joint.effect.iter().filter(|v| !v.shape).collect();
     for (v, &s) in strengths.iter().zip(&score.step) {
         // a strength the screen dropped still gets a small push to explore its side
-        u0[v.index] = if v.bounded {
+        u0[v.index] = v.inside(if v.bounded {
             s.clamp(0.05, 2.0)
         } else {
             s.clamp(-2.0, 2.0)
-        };
+        });
     }
     fit_from(joint, u0, Vec::new(), opts, Some(null))
 }

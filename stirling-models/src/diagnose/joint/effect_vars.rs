@@ -42,7 +42,12 @@ impl EffectVars {
                 (None, Some(val)) if free_shapes => (val, 0.1 * val.abs().max(1e-9)),
                 _ => continue,
             };
+            // a range the model declares for the parameter (`in lo..hi`)
+            let range = model
+                .param_index(q.name)
+                .and_then(|j| crate::fit::vars::param_bounds(model, j, &[]));
             v.effect.push(EffectVar {
+                range,
                 name: q.name.into(),
                 index: n_nom + v.effect.len(),
                 null: initial,
@@ -59,7 +64,7 @@ impl EffectVars {
                         scale,
                         kind,
                         prior: None,
-                        bounds: None,
+                        bounds: range,
                     };
                     v.adds.push((si, var));
                 }

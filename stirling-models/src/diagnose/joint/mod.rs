@@ -42,6 +42,22 @@ pub struct EffectVar {
     /// A shape parameter (end-stop travel): not a strength; not tested, only fitted.
     pub shape: bool,
     pub unit: String,
+    /// The range the model declares for it (`in lo..hi`): the joint fit starts and stays
+    /// inside.
+    pub range: Option<(f64, f64)>,
+}
+
+impl EffectVar {
+    /// The scaled start `u` moved inside the declared range (a hundredth of it away from
+    /// the ends).
+    pub fn inside(&self, u: f64) -> f64 {
+        let Some((lo, hi)) = self.range else {
+            return u;
+        };
+        let margin = 0.01 * (hi - lo);
+        let v = (self.null + self.scale * u).clamp(lo + margin, hi - margin);
+        (v - self.null) / self.scale
+    }
 }
 
 /// The stacked problem.
