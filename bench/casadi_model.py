@@ -35,6 +35,17 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 BUILD = os.path.join(HERE, ".build")
 
 
+def _num(v):
+    """A topology constant: a literal (folded into the generated C) or, in the like-for-like
+    variant (`casadi_params.py`), an expression of the parameters."""
+    return v if isinstance(v, ca.SX) else float(v)
+
+
+def _nz(v):
+    """Whether a topology coefficient is structurally nonzero."""
+    return isinstance(v, ca.SX) or v != 0
+
+
 def build_graph(topo: Topology):
     p = topo.p
     ncv, nx = topo.ncv, topo.nx
@@ -45,25 +56,25 @@ def build_graph(topo: Topology):
     g, R, cp, eps = p["gamma"], p["R"], topo.cp, p["mdot_eps"]
     V, Vd, T = [], [], []
     for i in range(ncv):
-        Vi = float(topo.V0[i])
-        if topo.ax[i] != 0:
-            Vi = Vi + float(topo.ax[i]) * x
-        if topo.ay[i] != 0:
-            Vi = Vi + float(topo.ay[i]) * y
+        Vi = _num(topo.V0[i])
+        if _nz(topo.ax[i]):
+            Vi = Vi + _num(topo.ax[i]) * x
+        if _nz(topo.ay[i]):
+            Vi = Vi + _num(topo.ay[i]) * y
         V.append(Vi)
-        Vd.append(float(topo.ax[i]) * v + float(topo.ay[i]) * w)
+        Vd.append(_num(topo.ax[i]) * v + _num(topo.ay[i]) * w)
         T.append(P[i] * Vi / (m[i] * R))
     E = []
     for i in range(ncv):
-        Aw = float(topo.Aw0[i])
-        if topo.dAx[i] != 0:
-            Aw = Aw + float(topo.dAx[i]) * x
-        if topo.dAy[i] != 0:
-            Aw = Aw + float(topo.dAy[i]) * y
-        E.append(float(topo.h[i]) * Aw * (float(topo.Tw[i]) - T[i]))
+        Aw = _num(topo.Aw0[i])
+        if _nz(topo.dAx[i]):
+            Aw = Aw + _num(topo.dAx[i]) * x
+        if _nz(topo.dAy[i]):
+            Aw = Aw + _num(topo.dAy[i]) * y
+        E.append(_num(topo.h[i]) * Aw * (_num(topo.Tw[i]) - T[i]))
     Mn = [0] * ncv
     for l in range(ncv - 1):
-        mdot = (P[l] - P[l + 1]) / float(topo.Rl[l])
+        mdot = (P[l] - P[l + 1]) / _num(topo.Rl[l])
         s = 0.5 * (1 + ca.tanh(mdot / eps))
         H = cp * mdot * (s * T[l] + (1 - s) * T[l + 1])
         E[l] = E[l] - H
@@ -71,8 +82,8 @@ def build_graph(topo: Topology):
         Mn[l] = Mn[l] - mdot
         Mn[l + 1] = Mn[l + 1] + mdot
     Pd = [((g - 1) * E[i] - g * P[i] * Vd[i]) / V[i] for i in range(ncv)]
-    Fx = topo.Fx0 + sum(float(topo.ax[i]) * P[i] for i in range(ncv) if topo.ax[i] != 0)
-    Fy = topo.Fy0 + sum(float(topo.ay[i]) * P[i] for i in range(ncv) if topo.ay[i] != 0)
+    Fx = topo.Fx0 + sum(_num(topo.ax[i]) * P[i] for i in range(ncv) if _nz(topo.ax[i]))
+    Fy = topo.Fy0 + sum(_num(topo.ay[i]) * P[i] for i in range(ncv) if _nz(topo.ay[i]))
     vd = (Fx - p["kd"] * x - p["bd"] * v - p["b"] * (v - w) - p["bqd"] * v * ca.fabs(v)) / p["md"]
     wd = (Fy - p["kp"] * y - p["bp"] * w - p["b"] * (w - v) - p["bqp"] * w * ca.fabs(w)) / p["mp"]
     f = ca.vertcat(v, vd, w, wd, *Pd, *Mn)

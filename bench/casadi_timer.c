@@ -3,7 +3,8 @@
  * about 2 s per function), no Python and no allocation in the loop. Outputs go to buffers
  * sized from the functions' own sparsity (the nonzeros, CasADi's sparse format).
  *
- * usage: casadi_timer LIB.so NX NAME... < state   (NX numbers on stdin)
+ * usage: casadi_timer LIB.so NX [--np=NP] NAME... < state [params]   (NX numbers on stdin, then
+ *        NP parameter values when the functions take the parameters as their second input)
  * prints one JSON object {"NAME": seconds per call, ...}
  */
 #include <dlfcn.h>
@@ -40,7 +41,7 @@ static void *sym(void *lib, const char *name, const char *suffix) {
     return s;
 }
 
-static double time_function(void *lib, const char *name, const double *z) {
+static double time_function(void *lib, const char *name, const double *z, const double *pv) {
     eval_t eval = (eval_t)sym(lib, name, "");
     work_t work = (work_t)sym(lib, name, "_work");
     sparsity_t sp_out = (sparsity_t)sym(lib, name, "_sparsity_out");
@@ -52,6 +53,7 @@ static double time_function(void *lib, const char *name, const double *z) {
     casadi_int *iw = calloc(sz_iw + 1, sizeof *iw);
     double *w = calloc(sz_w + 1, sizeof *w);
     arg[0] = z;
+    if (pv) arg[1] = pv; /* the parameters, when the functions take them as an input */
     for (casadi_int i = 0; i < n_out(); i++) {
         const casadi_int *sp = sp_out(i);
         /* compressed form: {nrow, ncol, 1} is dense; else {nrow, ncol, colind (from 0), row} */
@@ -99,6 +101,12 @@ int main(int argc, char **argv) {
         return 2;
     }
     int nx = atoi(argv[2]);
+    /* `--np=NP` before the names: the functions' second input, NP numbers after the state */
+    int first = 3, np = 0;
+    if (strncmp(argv[3], "--np=", 5) == 0) {
+        np = atoi(argv[3] + 5);
+        first = 4;
+    }
     double *z = malloc((nx + 1) * sizeof *z);
     for (int i = 0; i < nx; i++) {
         if (scanf("%lf", &z[i]) != 1) {
@@ -106,9 +114,19 @@ int main(int argc, char **argv) {
             return 2;
         }
     }
+    double *pv = NULL;
+    if (np > 0) {
+        pv = malloc((np + 1) * sizeof *pv);
+        for (int i = 0; i < np; i++) {
+            if (scanf("%lf", &pv[i]) != 1) {
+                fprintf(stderr, "casadi_timer: expected %d parameter values after the state\n", np);
+                return 2;
+            }
+        }
+    }
     printf("{");
-    for (int a = 3; a < argc; a++) {
-        printf("%s\"%s\": %.6e", a > 3 ? ", " : "", argv[a], time_function(lib, argv[a], z));
+    for (int a = first; a < argc; a++) {
+        printf("%s\"%s\": %.6e", a > first ? ", " : "", argv[a], time_function(lib, argv[a], z, pv));
         fflush(stdout);
     }
     printf("}\n");

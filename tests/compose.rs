@@ -289,6 +289,8 @@ stirling_model! {
             bp: 1.9083 "N s/m",
             /// alternator load: force -c_alt w on the piston, electric power c_alt w^2
             c_alt: 6.0 "N s/m",
+            /// alternator's motor constant: its voltage is Kv w (c_alt = Kv^2 / R_load)
+            Kv: 25.0 "V s/m",
             /// displacer-piston coupling damping
             b: 0.1 "N s/m",
             /// displacer quadratic damping

@@ -8,7 +8,11 @@
 #[macro_use]
 mod ex;
 
+mod common;
+
+use common::verdict::{assert_verdict, fitted};
 use stirling::dsl::{Closure, Model};
+use stirling::models::diagnose::{diagnose, DiagnoseOptions};
 use stirling::stirling_model;
 
 stirling_model! {
@@ -84,7 +88,7 @@ fn record_of<M: Model + Clone>(
     (m, p0, rec)
 }
 
-fn record(kh: f64, _seed: u64) -> (HeatedFx, Vec<f64>, stirling::models::data::Measured) {
+fn record(kh: f64) -> (HeatedFx, Vec<f64>, stirling::models::data::Measured) {
     let m = HeatedFx::new(2, Closure::Full).unwrap();
     record_of(m, &[("kh_hot_hot", kh)], &[])
 }
@@ -99,48 +103,15 @@ fn record(kh: f64, _seed: u64) -> (HeatedFx, Vec<f64>, stirling::models::data::M
 /// held-out block's start is not measured, so the free run starts it at its rest.
 #[test]
 fn the_diagnosis_names_a_withheld_heater_head() {
-    use stirling::models::diagnose::{diagnose, DiagnoseOptions};
-    let opts = DiagnoseOptions {
-        effects: Some(
-            ["heater_input", "coulomb", "sensor_lag"]
-                .map(String::from)
-                .to_vec(),
-        ),
-        bootstrap: 200,
-        fit_all: true,
-        ..Default::default()
-    };
-    let (m, p0, rec) = record(0.4, 5);
+    let opts = options(&["heater_input", "coulomb", "sensor_lag"], 200);
+    let (m, p0, rec) = record(0.4);
     let d = diagnose(&m, &p0, &rec, &opts).expect("diagnosed");
-    eprintln!(
-        "heater: {} {:?} ({})",
-        d.verdict.verdict, d.verdict.effect, d.verdict.reason
-    );
-    assert_eq!(d.verdict.verdict, "effect", "{}", d.verdict.reason);
-    assert_eq!(d.verdict.effect.as_deref(), Some("heater_input"));
-    let entry = d
-        .ranking
-        .iter()
-        .find(|e| e.effect == "heater_input")
-        .unwrap();
-    let kh = entry
-        .params
-        .iter()
-        .find(|q| q.name == "kh_hot_hot")
-        .unwrap()
-        .value;
+    assert_verdict(&d, "heater", "effect", Some("heater_input"));
+    let kh = fitted(&d, "heater_input", "kh_hot_hot");
     assert!((0.3..0.6).contains(&kh), "kh_hot_hot {kh} (truth 0.4)");
-    let (m, p0, rec) = record(0.0, 5);
+    let (m, p0, rec) = record(0.0);
     let d = diagnose(&m, &p0, &rec, &opts).expect("diagnosed");
-    eprintln!(
-        "clean: {} {:?} ({})",
-        d.verdict.verdict, d.verdict.effect, d.verdict.reason
-    );
-    assert_eq!(
-        d.verdict.verdict, "no_significant_gap",
-        "{}",
-        d.verdict.reason
-    );
+    assert_verdict(&d, "clean", "no_significant_gap", None);
 }
 
 /// A lag of 3 ms on the bounce-space transducer alone (`effect lag on sensor p_bounce;`,
@@ -148,41 +119,19 @@ fn the_diagnosis_names_a_withheld_heater_head() {
 /// `sensor_lag` (which lags every pressure transducer), and recovers its time constant.
 #[test]
 fn the_diagnosis_names_a_lag_on_one_sensor() {
-    use stirling::models::diagnose::{diagnose, DiagnoseOptions};
-    let opts = DiagnoseOptions {
-        effects: Some(["lag", "sensor_lag", "coulomb"].map(String::from).to_vec()),
-        bootstrap: 200,
-        fit_all: true,
-        ..Default::default()
-    };
+    let opts = options(&["lag", "sensor_lag", "coulomb"], 200);
     let m = LaggedFx::new(2, Closure::Full).unwrap();
     let (m, p0, rec) = record_of(m, &[], &[("tau_p_bounce", 3e-3)]);
     let d = diagnose(&m, &p0, &rec, &opts).expect("diagnosed");
-    eprintln!(
-        "lag: {} {:?} ({})",
-        d.verdict.verdict, d.verdict.effect, d.verdict.reason
-    );
-    assert_eq!(d.verdict.verdict, "effect", "{}", d.verdict.reason);
-    assert_eq!(d.verdict.effect.as_deref(), Some("lag"));
-    let entry = d.ranking.iter().find(|e| e.effect == "lag").unwrap();
-    let tau = entry
-        .params
-        .iter()
-        .find(|q| q.name == "tau_p_bounce")
-        .unwrap()
-        .value;
+    assert_verdict(&d, "lag", "effect", Some("lag"));
+    let tau = fitted(&d, "lag", "tau_p_bounce");
     assert!(
         (2e-3..4e-3).contains(&tau),
         "tau_p_bounce {tau} (truth 3e-3)"
     );
-    let m = LaggedFx::new(2, Closure::Full).unwrap();
     let (m, p0, rec) = record_of(m, &[], &[]);
     let d = diagnose(&m, &p0, &rec, &opts).expect("diagnosed");
-    assert_eq!(
-        d.verdict.verdict, "no_significant_gap",
-        "{}",
-        d.verdict.reason
-    );
+    assert_verdict(&d, "clean", "no_significant_gap", None);
 }
 
 /// A range the model declares for an effect's strength holds in the diagnosis's joint fit:
@@ -190,27 +139,20 @@ fn the_diagnosis_names_a_lag_on_one_sensor() {
 /// strength ends inside (at the bound), where unbounded it reaches 0.39 N.
 #[test]
 fn the_joint_fit_stays_inside_declared_bounds() {
-    use stirling::models::diagnose::{diagnose, DiagnoseOptions};
-    let opts = DiagnoseOptions {
-        effects: Some(["coulomb"].map(String::from).to_vec()),
-        bootstrap: 100,
-        fit_all: true,
-        ..Default::default()
-    };
     let m = BoundedFx::new(2, Closure::Full).unwrap();
     let (m, p0, rec) = record_of(m, &[("Fc_piston", 0.5)], &[]);
-    let d = diagnose(&m, &p0, &rec, &opts).expect("diagnosed");
-    let entry = d.ranking.iter().find(|e| e.effect == "coulomb").unwrap();
-    let fc = entry
-        .params
-        .iter()
-        .find(|q| q.name == "Fc_piston")
-        .unwrap()
-        .value;
-    eprintln!(
-        "bounded: {} ({}), Fc_piston {fc}",
-        d.verdict.verdict, d.verdict.reason
-    );
+    let d = diagnose(&m, &p0, &rec, &options(&["coulomb"], 100)).expect("diagnosed");
+    let fc = fitted(&d, "coulomb", "Fc_piston");
     assert!(fc <= 0.3, "Fc_piston {fc} outside 0.0..0.3");
     assert!(fc > 0.25, "Fc_piston {fc}: pushed to the bound by the data");
+}
+
+/// The diagnosis of `effects`, every candidate fitted.
+fn options(effects: &[&str], bootstrap: usize) -> DiagnoseOptions {
+    DiagnoseOptions {
+        effects: Some(effects.iter().map(|e| e.to_string()).collect()),
+        bootstrap,
+        fit_all: true,
+        ..Default::default()
+    }
 }

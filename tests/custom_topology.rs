@@ -337,6 +337,14 @@ fn the_command_line_is_checked() {
 fn bounce_record(
     channels: &[&str],
 ) -> (AlternatorEngine, Vec<f64>, stirling::models::data::Measured) {
+    bounce_record_with(channels, Vec::new())
+}
+
+/// [`bounce_record`] with the noise levels of named channels (`RigConfig::noise`).
+fn bounce_record_with(
+    channels: &[&str],
+    noise: Vec<(String, f64)>,
+) -> (AlternatorEngine, Vec<f64>, stirling::models::data::Measured) {
     use stirling::models::rig::{measure, RigConfig};
     let m = model(2);
     let truth = m.default_params();
@@ -346,6 +354,7 @@ fn bounce_record(
         offset_p: 50.0,
         seed: 2,
         channels: channels.iter().map(|c| c.to_string()).collect(),
+        noise,
         ..Default::default()
     };
     let rec = measure(&m, &truth, &cfg).expect("measured");
@@ -391,21 +400,11 @@ fn the_engine_is_fitted_from_its_own_sensors() {
 fn expression_sensors_are_fitted_outputs() {
     use stirling::models::fit::multiple_shooting::{multiple_shooting, MsOptions};
     use stirling::models::fit::{self, FitOptions};
-    use stirling::models::rig::{measure, RigConfig};
-    let m = model(2);
-    let truth = m.default_params();
-    let cfg = RigConfig {
-        t_end: 3.0,
-        x0: 5e-4,
-        offset_p: 50.0,
-        seed: 2,
-        channels: ["p", "x", "y", "p_bounce", "dp", "emf"]
-            .map(String::from)
-            .to_vec(),
-        noise: vec![("emf".into(), 0.02)],
-        ..Default::default()
-    };
-    let rec = measure(&m, &truth, &cfg).expect("measured");
+    let (m, truth, rec) = bounce_record_with(
+        &["p", "x", "y", "p_bounce", "dp", "emf"],
+        vec![("emf".into(), 0.02)],
+    );
+    let sd = stirling::models::rig::RigConfig::default().noise_p;
     // the rig reads the expression: the difference of the two absolute transducers (their
     // offsets cancel) up to the noise
     let (pc, pb, dp) = (
@@ -417,7 +416,7 @@ fn expression_sensors_are_fitted_outputs() {
         .map(|k| (dp[k] - (pc[k] - pb[k])).abs())
         .fold(0.0, f64::max);
     assert!(
-        worst < 6.0 * 3f64.sqrt() * cfg.noise_p,
+        worst < 6.0 * 3f64.sqrt() * sd,
         "dp against p - p_bounce: {worst} Pa"
     );
     let free = ["kd", "kp", "bd", "bp", "hh", "hk", "Rf", "Kv"];
@@ -459,7 +458,7 @@ fn expression_sensors_are_fitted_outputs() {
     }
     let kv = ms.estimate("Kv").unwrap();
     assert!(kv.ci_high - kv.ci_low < 0.02 * 25.0, "Kv interval {kv:?}");
-    for (ch, sd) in [("dp", cfg.noise_p), ("emf", 0.02)] {
+    for (ch, sd) in [("dp", sd), ("emf", 0.02)] {
         let f = ms.fits.iter().find(|f| f.channel == ch).expect("fitted");
         eprintln!("{ch}: {:.2} %, rms {:.3e}", f.fit_percent, f.rms);
         assert!(f.rms < 1.2 * sd, "{ch}: rms {} against noise {sd}", f.rms);
@@ -639,15 +638,7 @@ fn the_diagnosis_names_withheld_piston_friction_and_passes_a_clean_record() {
     );
     let (m, p0, rec) = fx_record(0.0);
     let d = diagnose(&m, &p0, &rec, &diagnose_options()).expect("diagnosed");
-    eprintln!(
-        "clean: {} {:?} ({})",
-        d.verdict.verdict, d.verdict.effect, d.verdict.reason
-    );
-    assert_eq!(
-        d.verdict.verdict, "no_significant_gap",
-        "{}",
-        d.verdict.reason
-    );
+    common::verdict::assert_verdict(&d, "clean", "no_significant_gap", None);
 }
 
 /// The command line serves the engine once a binary registers it (as a user's crate would:

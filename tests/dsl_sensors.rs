@@ -254,3 +254,31 @@ fn an_observation_refuses_what_the_model_cannot_output() {
     );
     assert!(err.to_string().contains("volt"), "{err}");
 }
+
+stirling_model! {
+    /// A sensor whose expression leaves its domain: the square root of the displacer's
+    /// position, which swings negative.
+    pub model Rooted extends stirling::models::nsection_engine {
+        name "rooted";
+        sensor root: sqrt(x) "m";
+    }
+}
+
+/// The rig refuses a channel whose expression is not a number along the run, naming the
+/// channel and the time, instead of writing NaN into the record.
+#[test]
+fn the_rig_refuses_a_sensor_that_is_not_a_number() {
+    use stirling::models::rig::{measure, RigConfig, RigError};
+    let m = Rooted::new(2, Closure::Full).unwrap();
+    let cfg = RigConfig {
+        t_end: 0.2,
+        channels: ["p", "x", "root"].map(String::from).to_vec(),
+        ..Default::default()
+    };
+    let err = measure(&m, &m.default_params(), &cfg).unwrap_err();
+    assert!(
+        matches!(&err, RigError::NonFinite { channel, .. } if channel == "root"),
+        "{err}"
+    );
+    assert!(err.to_string().contains("not a number at t ="), "{err}");
+}

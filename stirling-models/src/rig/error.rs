@@ -33,6 +33,8 @@ pub enum RigError {
     NoGas { model: String },
     #[error("channel p_hot asked for, but `{model}` has a single gas volume")]
     NoHotSide { model: String },
+    #[error("sensor `{channel}` reads a value that is not a number at t = {t} s (its expression leaves its domain there, e.g. the square root of a negative number)")]
+    NonFinite { channel: String, t: f64 },
     #[error(transparent)]
     Outside(#[from] crate::outside::OutsideError),
     #[error("--truth {truth} takes no --effect (got {effects}): its strength is a parameter, e.g. --set {param}=VALUE")]

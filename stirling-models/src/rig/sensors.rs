@@ -112,6 +112,12 @@ pub(super) fn read_sensors(
     let mut out = Vec::with_capacity(chans.len());
     for c in chans {
         let clean: Vec<f64> = rows.iter().map(|r| c.obs.value(model, p, r)).collect();
+        if let Some(k) = clean.iter().position(|v| !v.is_finite()) {
+            return Err(RigError::NonFinite {
+                channel: c.name.clone(),
+                t: k as f64 * dt,
+            });
+        }
         if c.pressure {
             check_pressure(&clean, cfg)?;
         }
