@@ -1,9 +1,10 @@
 //! The record's channels as outputs of the model, for the fits that simulate the whole state
 //! (the free run, multiple shooting): the seed's channels and the measured CVs outside the
-//! working gas ([`channels`]), then every other sensor the model declares whose column the
-//! record has - a state elsewhere in the gas (`P_regen[2]`), a wall temperature, or an
-//! expression of states and parameters (`P_cold - P_bounce`) - each compared through the
-//! model's generated output and its gradient ([`Observation`]).
+//! working gas ([`channels`](crate::fit::measured_state::channels)), then every other sensor
+//! the model declares whose column the record has - a state elsewhere in the gas
+//! (`P_regen[2]`), a wall temperature, or an expression of states and parameters
+//! (`P_cold - P_bounce`) - each compared through the model's generated output and its
+//! gradient ([`Observation`](stirling_dsl::Observation)).
 
 use stirling_dsl::{Model, Observation};
 
