@@ -42,6 +42,14 @@ stirling_model! {
     }
 }
 
+stirling_model! {
+    /// The nsection engine with its `p` channel declared as a pressure difference.
+    pub model DiffP extends stirling::models::nsection_engine {
+        name "diff_p";
+        replace sensor p: P_cold - P_hot "Pa";
+    }
+}
+
 fn names(m: &dyn Model) -> Vec<&'static str> {
     m.sensors().iter().map(|s| s.name).collect()
 }
@@ -119,6 +127,16 @@ fn identification_refuses_a_seed_channel_declared_elsewhere() {
         "{err}"
     );
     assert!(err.to_string().contains("`p` on P_hot"), "{err}");
+    // an expression under a seed channel's name is refused the same way, by its expression
+    let m = DiffP::new(2, Closure::Full).unwrap();
+    let err = fit::identify(
+        &m,
+        &m.default_params(),
+        &Measured::default(),
+        &Default::default(),
+    )
+    .expect_err("p declared as an expression");
+    assert!(err.to_string().contains("`p` on P_cold - P_hot;"), "{err}");
     assert!(check_sensors(&Probed::new(3, Closure::Full).unwrap()).is_ok());
     for entry in stirling::models::model::registry::FAMILY {
         for closure in [Closure::Full, Closure::Frozen] {

@@ -38,15 +38,13 @@ pub fn check_sensors(model: &dyn Model) -> Result<(), FitError> {
         };
         if declared != assumed || declared.is_none() {
             let at = |s: Option<usize>| s.map_or("no state".to_string(), |k| names[k].clone());
-            let state = model
-                .sensors()
-                .iter()
-                .find(|s| s.name == channel)
-                .map_or(String::new(), |s| s.state.to_string());
+            let info = model.sensors().iter().find(|s| s.name == channel);
+            let state = info.map_or(String::new(), |s| s.definition().to_string());
+            let expression = info.is_some_and(|s| !s.expr.is_empty());
             return Err(FitError::SensorPlace {
                 model: model.name().into(),
                 channel,
-                state: if declared.is_some() {
+                state: if declared.is_some() || expression {
                     state
                 } else {
                     format!("{state} (absent at this n and closure)")
