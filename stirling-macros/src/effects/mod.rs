@@ -29,7 +29,7 @@ pub use parse::{EffectAst, Site};
 use stirling_dsl::topology::EffectSiteDecl;
 use syn::{Expr, Ident};
 
-use crate::ast::{BodyAst, Field, Item, LinkAst, ModelAst, ParamAst};
+use crate::ast::{BodyAst, EndAst, Field, Item, LinkAst, ModelAst, ParamAst};
 use kinds::{Kind, Where, KINDS};
 
 /// Apply every `effect` item of `ast` and return the sites. A link an effect adds takes the
@@ -109,19 +109,7 @@ fn one(
         (Where::Body(term), Site::Body(b)) => on_body(ast, kind, *term, e, b)?,
         (Where::Between(fields), Site::Between(from, to)) => {
             let names = param_names(kind, e, &[&from.name.to_string(), &to.name.to_string()]);
-            link(Item::Link(LinkAst {
-                span: e.span,
-                from: from.clone(),
-                to: to.clone(),
-                range: None,
-                fields: fields(&names)
-                    .into_iter()
-                    .map(|(name, value)| Field {
-                        name: Ident::new(name, e.span),
-                        value,
-                    })
-                    .collect(),
-            }));
+            link(between(e, (from, to), fields(&names)));
             names
         }
         (Where::Link(fields), Site::Link(from, to)) => on_link(ast, kind, *fields, e, (from, to))?,
@@ -134,61 +122,88 @@ fn one(
             names
         }
         (Where::Sensor, Site::Sensor(sensor)) => {
-            let declared = ast
-                .items
-                .iter()
-                .any(|it| matches!(it, Item::Sensor(s) if s.name == *sensor));
-            if !declared {
-                let msg = format!("effect `{name}` on sensor `{sensor}`: no sensor `{sensor}`; it acts on a declared sensor");
-                return Err(syn::Error::new(sensor.span(), msg));
-            }
-            if !e.names.is_empty() {
-                let msg = format!("effect `{name}` on a sensor takes no `as`: its parameter is named after the sensor (`{}`)", fill(kind.params[0].name, &[&sensor.to_string()]));
-                return Err(syn::Error::new(e.span, msg));
-            }
-            let names = param_names(kind, e, &[&sensor.to_string()]);
-            // a sensor's parameter is the rig's and the diagnosis's, not the model's
-            return Ok(EffectSiteDecl {
-                effect: name,
-                at: e.site.describe(),
-                params: names.iter().map(Ident::to_string).collect(),
-            });
+            // a sensor's parameter is the rig's and the diagnosis's, not the model's: none
+            // is declared
+            let names = on_sensor(ast, kind, e, sensor)?;
+            return Ok(site_decl(e, names));
         }
-        (Where::Sensor, _) => {
-            let msg = format!(
-                "effect `{name}` acts on a sensor's reading: write `effect {name} on sensor <name>;`"
-            );
-            return Err(syn::Error::new(e.span, msg));
-        }
-        (Where::Port(_), _) => {
-            let msg = format!(
-                "effect `{name}` acts on a CV's heat port: write `effect {name} on port <cv>.<port>;`"
-            );
-            return Err(syn::Error::new(e.span, msg));
-        }
-        (Where::Body(_), _) => {
-            let msg = format!("effect `{name}` acts on a body: write `effect {name} on <body>;`");
-            return Err(syn::Error::new(e.span, msg));
-        }
-        (Where::Link(_), _) => {
-            let msg = format!(
-                "effect `{name}` acts on a link: write `effect {name} on link <from> -> <to>;`"
-            );
-            return Err(syn::Error::new(e.span, msg));
-        }
-        (Where::Between(_), _) => {
-            let msg = format!(
-                "effect `{name}` acts between two volumes: write `effect {name} <from> -> <to>;`"
-            );
-            return Err(syn::Error::new(e.span, msg));
-        }
+        (site, _) => return Err(wrong_site(&name, site, e.span)),
     };
     declare(ast, kind, &names, &e.site.describe(), added);
-    Ok(EffectSiteDecl {
-        effect: name,
+    Ok(site_decl(e, names))
+}
+
+fn site_decl(e: &EffectAst, names: Vec<Ident>) -> EffectSiteDecl {
+    EffectSiteDecl {
+        effect: e.kind.to_string(),
         at: e.site.describe(),
         params: names.iter().map(Ident::to_string).collect(),
+    }
+}
+
+/// An effect named at a place of the wrong kind: how to name it.
+fn wrong_site(name: &str, site: &Where, span: proc_macro2::Span) -> syn::Error {
+    let (what, how) = match site {
+        Where::Body(_) => ("on a body", format!("effect {name} on <body>;")),
+        Where::Between(_) => (
+            "between two volumes",
+            format!("effect {name} <from> -> <to>;"),
+        ),
+        Where::Link(_) => (
+            "on a link",
+            format!("effect {name} on link <from> -> <to>;"),
+        ),
+        Where::Port(_) => (
+            "on a CV's heat port",
+            format!("effect {name} on port <cv>.<port>;"),
+        ),
+        Where::Sensor => (
+            "on a sensor's reading",
+            format!("effect {name} on sensor <name>;"),
+        ),
+    };
+    syn::Error::new(span, format!("effect `{name}` acts {what}: write `{how}`"))
+}
+
+/// The link a leak adds between two volumes, with its fields.
+fn between(e: &EffectAst, (from, to): (&EndAst, &EndAst), fields: Vec<(&str, Expr)>) -> Item {
+    Item::Link(LinkAst {
+        span: e.span,
+        from: from.clone(),
+        to: to.clone(),
+        range: None,
+        fields: fields
+            .into_iter()
+            .map(|(name, value)| Field {
+                name: Ident::new(name, e.span),
+                value,
+            })
+            .collect(),
     })
+}
+
+/// A distortion of a declared sensor's reading: its parameter named after the sensor.
+fn on_sensor(
+    ast: &ModelAst,
+    kind: &Kind,
+    e: &EffectAst,
+    sensor: &Ident,
+) -> syn::Result<Vec<Ident>> {
+    let name = kind.name;
+    let declared = ast
+        .items
+        .iter()
+        .any(|it| matches!(it, Item::Sensor(s) if s.name == *sensor));
+    if !declared {
+        let msg = format!("effect `{name}` on sensor `{sensor}`: no sensor `{sensor}`; it acts on a declared sensor");
+        return Err(syn::Error::new(sensor.span(), msg));
+    }
+    if !e.names.is_empty() {
+        let own = fill(kind.params[0].name, &[&sensor.to_string()]);
+        let msg = format!("effect `{name}` on a sensor takes no `as`: its parameter is named after the sensor (`{own}`)");
+        return Err(syn::Error::new(e.span, msg));
+    }
+    Ok(param_names(kind, e, &[&sensor.to_string()]))
 }
 
 /// The effect's term appended to the body's `force`.
