@@ -42,7 +42,7 @@ impl GasStage<'_> {
 /// The pressure offsets a record starts from, channels as [`GasStage::shift`].
 pub fn first_offsets(rec: &Record) -> Vec<f64> {
     let mut v = vec![rec.p_off0, rec.ph_off0];
-    v.extend(rec.outside.iter().map(|o| o.off0));
+    v.extend(rec.outside.iter().chain(&rec.inside).map(|o| o.off0));
     v
 }
 
@@ -168,6 +168,20 @@ fn pressure_outputs(
         let at = layout.gas_pos(o.state).expect("gas state");
         outputs.push(Output::new(&o.name, at, &o.raw, 1e-6 * pmean));
     }
+    // a sensor inside the working gas: an output only (the bodies are not driven by it, so
+    // its offset shifts no position)
+    for o in &rec.inside {
+        let name = format!("{}_offset", o.name);
+        vars.push(Var::offset(
+            &name,
+            o.off0,
+            100.0,
+            outputs.len(),
+            vec![0.0; 4],
+        ));
+        let at = layout.gas_pos(o.state).expect("gas state");
+        outputs.push(Output::new(&o.name, at, &o.raw, 1e-6 * pmean));
+    }
     outputs
 }
 
@@ -202,7 +216,7 @@ fn initial_state(
         let wc = cold_weight(i, ncv, rec.have_hot);
         x[s] = wc * (sp.val[ta] - rec.p_off0) + (1.0 - wc) * hot;
     }
-    for o in &rec.outside {
+    for o in rec.outside.iter().chain(&rec.inside) {
         x[o.state] = o.sig.val[ta] - o.off0;
     }
     super::measured_state::mass_states(model, p, layout, eq, &mut x);

@@ -146,6 +146,7 @@ impl Progress<'_> {
             others: rec
                 .outside
                 .iter()
+                .chain(&rec.inside)
                 .zip(&self.offs[2..])
                 .map(|(o, v)| (o.name.clone(), *v))
                 .collect(),
@@ -184,7 +185,8 @@ impl<'a> Run<'a, '_> {
             Vec::new()
         };
         let (gs, solved) = self.gas(&st.p, &free2, st.x_off)?;
-        // outputs: p, p_hot when measured, then the CVs outside the working gas
+        // outputs: p, p_hot when measured, the CVs outside the working gas, then the sensors
+        // inside it
         let hot = usize::from(self.rec.have_hot);
         for (out, v) in apply(&gs.stage, &solved.values, &mut st.p) {
             let ch = if out == 0 { 0 } else { out + 1 - hot };

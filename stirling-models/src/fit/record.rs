@@ -37,6 +37,10 @@ pub struct Record<'a> {
     pub ph_off0: f64,
     /// The measured CVs outside the working gas (a closed bounce space), in layout order.
     pub outside: Vec<Outside>,
+    /// Declared pressure sensors inside the working gas besides `p` and `p_hot` (a
+    /// regenerator section) whose columns the record has: outputs of stage 2, each with its
+    /// offset, and their CVs' pressures at the window start.
+    pub inside: Vec<Outside>,
 }
 
 /// A measured CV outside the working gas: its channel, smoothed like `p`, and the first
@@ -96,7 +100,18 @@ impl<'a> Record<'a> {
                 raw: c.data,
             })
             .collect();
+        let inside = inside_channels(model, layout, data)
+            .into_iter()
+            .map(|(name, state, raw)| Outside {
+                sig: smooth(&raw),
+                off0: cycle_mean(&raw) - eq[state],
+                name,
+                state,
+                raw,
+            })
+            .collect();
         Ok(Self {
+            inside,
             data,
             t0,
             dt,
@@ -122,6 +137,28 @@ impl<'a> Record<'a> {
             outside,
         })
     }
+}
+
+/// The declared sensors on the working gas's pressures other than the ones `p` and `p_hot`
+/// are read from, whose columns the record has: `(name, state, samples)`.
+fn inside_channels(
+    model: &dyn Model,
+    layout: &StateLayout,
+    data: &Measured,
+) -> Vec<(String, usize, Vec<f64>)> {
+    let ps = &layout.pressures;
+    let read = [ps.first(), ps.last()];
+    model
+        .sensors()
+        .iter()
+        .filter(|s| !matches!(s.name, "p" | "p_hot" | "x" | "y"))
+        .filter_map(|s| {
+            let state = model.sensor_state(s.name).flatten()?;
+            let inside = ps.contains(&state) && !read.contains(&Some(&state));
+            let v = data.channel(s.name).filter(|_| inside)?;
+            Some((s.name.to_string(), state, v.to_vec()))
+        })
+        .collect()
 }
 
 /// The start time and the interval of a uniformly sampled record.
