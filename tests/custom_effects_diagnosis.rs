@@ -10,8 +10,9 @@ mod ex;
 
 mod common;
 
+use common::startup::start_up_record;
 use common::verdict::{assert_verdict, fitted};
-use stirling::dsl::{Closure, Model};
+use stirling::dsl::Closure;
 use stirling::models::diagnose::{diagnose, DiagnoseOptions};
 use stirling::stirling_model;
 
@@ -48,49 +49,9 @@ stirling_model! {
     }
 }
 
-/// A 2 s start-up record of `m` with the model settings `set` (parameters by name) and the
-/// sensor settings `sensor` withheld, and a start perturbed from the nominal parameters.
-fn record_of<M: Model + Clone>(
-    m: M,
-    set: &[(&str, f64)],
-    sensor: &[(&str, f64)],
-) -> (M, Vec<f64>, stirling::models::data::Measured) {
-    use stirling::models::effects::EffectSettings;
-    use stirling::models::rig::{measure_with, RigConfig};
-    let nominal = stirling::models::effects::nominal_params(&m);
-    let mut truth = nominal.clone();
-    for &(k, v) in set {
-        truth[m.param_index(k).unwrap()] = v;
-    }
-    let cfg = RigConfig {
-        t_end: 2.0,
-        rate: 1000.0,
-        seed: 5,
-        channels: ["p", "x", "y", "p_bounce"].map(String::from).to_vec(),
-        ..Default::default()
-    };
-    let fx = EffectSettings {
-        sensor: sensor.iter().map(|&(k, v)| (k.to_string(), v)).collect(),
-        ..Default::default()
-    };
-    let rec = measure_with(&m, &truth, &fx, &cfg).expect("measured");
-    let mut p0 = nominal;
-    for (name, f) in [
-        ("kd", 1.08),
-        ("kp", 0.93),
-        ("bd", 1.07),
-        ("bp", 0.94),
-        ("hh", 1.06),
-        ("hk", 0.95),
-    ] {
-        p0[m.param_index(name).unwrap()] *= f;
-    }
-    (m, p0, rec)
-}
-
 fn record(kh: f64) -> (HeatedFx, Vec<f64>, stirling::models::data::Measured) {
     let m = HeatedFx::new(2, Closure::Full).unwrap();
-    record_of(m, &[("kh_hot_hot", kh)], &[])
+    start_up_record(m, &[("kh_hot_hot", kh)], &[])
 }
 
 /// A heater head of finite capacity withheld from the record (`kh_hot_hot` = 0.4 K/J: a
@@ -121,7 +82,7 @@ fn the_diagnosis_names_a_withheld_heater_head() {
 fn the_diagnosis_names_a_lag_on_one_sensor() {
     let opts = options(&["lag", "sensor_lag", "coulomb"], 200);
     let m = LaggedFx::new(2, Closure::Full).unwrap();
-    let (m, p0, rec) = record_of(m, &[], &[("tau_p_bounce", 3e-3)]);
+    let (m, p0, rec) = start_up_record(m, &[], &[("tau_p_bounce", 3e-3)]);
     let d = diagnose(&m, &p0, &rec, &opts).expect("diagnosed");
     assert_verdict(&d, "lag", "effect", Some("lag"));
     let tau = fitted(&d, "lag", "tau_p_bounce");
@@ -129,7 +90,7 @@ fn the_diagnosis_names_a_lag_on_one_sensor() {
         (2e-3..4e-3).contains(&tau),
         "tau_p_bounce {tau} (truth 3e-3)"
     );
-    let (m, p0, rec) = record_of(m, &[], &[]);
+    let (m, p0, rec) = start_up_record(m, &[], &[]);
     let d = diagnose(&m, &p0, &rec, &opts).expect("diagnosed");
     assert_verdict(&d, "clean", "no_significant_gap", None);
 }
@@ -140,7 +101,7 @@ fn the_diagnosis_names_a_lag_on_one_sensor() {
 #[test]
 fn the_joint_fit_stays_inside_declared_bounds() {
     let m = BoundedFx::new(2, Closure::Full).unwrap();
-    let (m, p0, rec) = record_of(m, &[("Fc_piston", 0.5)], &[]);
+    let (m, p0, rec) = start_up_record(m, &[("Fc_piston", 0.5)], &[]);
     let d = diagnose(&m, &p0, &rec, &options(&["coulomb"], 100)).expect("diagnosed");
     let fc = fitted(&d, "coulomb", "Fc_piston");
     assert!(fc <= 0.3, "Fc_piston {fc} outside 0.0..0.3");

@@ -562,31 +562,8 @@ fn the_rig_measures_the_declared_bounce_sensor() {
 /// `fcp` (N; 0: the clean engine), measured with the engine's own sensors, and a start
 /// perturbed from the nominal parameters as a user's first guess would be.
 fn fx_record(fcp: f64) -> (ex::AlternatorFx, Vec<f64>, stirling::models::data::Measured) {
-    use stirling::models::rig::{measure, RigConfig};
     let m = ex::AlternatorFx::new(2, Closure::Full).unwrap();
-    let nominal = stirling::models::effects::nominal_params(&m);
-    let mut truth = nominal.clone();
-    truth[m.param_index("Fc_piston").unwrap()] = fcp;
-    let cfg = RigConfig {
-        t_end: 2.0,
-        rate: 1000.0,
-        seed: 5,
-        channels: ["p", "x", "y", "p_bounce"].map(String::from).to_vec(),
-        ..Default::default()
-    };
-    let rec = measure(&m, &truth, &cfg).expect("measured");
-    let mut p0 = nominal;
-    for (name, f) in [
-        ("kd", 1.08),
-        ("kp", 0.93),
-        ("bd", 1.07),
-        ("bp", 0.94),
-        ("hh", 1.06),
-        ("hk", 0.95),
-    ] {
-        p0[m.param_index(name).unwrap()] *= f;
-    }
-    (m, p0, rec)
+    common::startup::start_up_record(m, &[("Fc_piston", fcp)], &[])
 }
 
 fn diagnose_options() -> stirling::models::diagnose::DiagnoseOptions {

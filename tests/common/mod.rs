@@ -5,6 +5,7 @@
 pub mod fit;
 pub mod models;
 pub mod same;
+pub mod startup;
 pub mod verdict;
 
 use rand::rngs::StdRng;
