@@ -141,10 +141,7 @@ pub fn run(a: &DiagnoseArgs) -> anyhow::Result<()> {
     let (train, holdout) = common::blocks(a.train.as_deref(), a.holdout.as_deref(), &data, 0.6)?;
     let (model, mut p0) = diagnose::nominal_model(model_name, a.with.n)?;
     a.with.apply(model.as_ref(), &mut p0)?;
-    let bounds = match &a.bounds {
-        Some(f) => stirling_models::bounds::load_bounds(model.as_ref(), f)?,
-        None => Vec::new(),
-    };
+    let bounds = common::bounds_file(model.as_ref(), a.bounds.as_deref())?;
     let opts = DiagnoseOptions {
         fit: stirling_models::fit::FitOptions {
             bounds,

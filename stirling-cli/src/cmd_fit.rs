@@ -67,10 +67,7 @@ pub fn run(a: &FitArgs) -> anyhow::Result<()> {
     let (train, holdout) = common::blocks(a.train.as_deref(), a.holdout.as_deref(), &data, 0.7)?;
     let model = stirling_models::build(&a.model, a.with.n, Closure::Full)?;
     let p0 = a.with.load(model.as_ref())?;
-    let bounds = match &a.bounds {
-        Some(f) => stirling_models::bounds::load_bounds(model.as_ref(), f)?,
-        None => Vec::new(),
-    };
+    let bounds = common::bounds_file(model.as_ref(), a.bounds.as_deref())?;
     let opts = FitOptions {
         free: a.free.clone(),
         bounds,

@@ -20,6 +20,17 @@ use anyhow::Context;
 use clap::Args;
 use stirling_dsl::{Closure, Model};
 
+/// The bounds of `--bounds FILE` (none without the option).
+pub fn bounds_file(
+    model: &dyn Model,
+    file: Option<&std::path::Path>,
+) -> anyhow::Result<Vec<(String, f64, f64)>> {
+    Ok(match file {
+        Some(f) => stirling_models::bounds::load_bounds(model, f)?,
+        None => Vec::new(),
+    })
+}
+
 /// The regenerator sections and the parameter sources of a model: every command that builds
 /// one takes them (declared once here).
 #[derive(Args, Debug, Clone)]

@@ -38,7 +38,7 @@ pub fn on_port(
     let err = |span: proc_macro2::Span, msg: String| syn::Error::new(span, msg);
     let wall = format_ident!("{}_{}", cv, port, span = port.span());
     let walls = wall_names(ast);
-    if walls.iter().any(|w| *w == wall) {
+    if walls.contains(&wall) {
         let msg = format!("effect `{kind}` on {site}: a wall `{wall}` exists already");
         return Err(err(port.span(), msg));
     }

@@ -81,14 +81,7 @@ impl Prepared {
 /// (checked on optimizer steps only: they are the runs with sensitivities); and a trial
 /// outside the parameter's bounds (the optimizer then takes a shorter step).
 fn check_floor(v: &Var, val: f64) -> Result<(), FitError> {
-    if let Some((lo, hi)) = v.bounds.filter(|&(lo, hi)| !(lo..=hi).contains(&val)) {
-        return Err(FitError::OutsideBounds {
-            name: v.name.clone(),
-            value: val,
-            lo,
-            hi,
-        });
-    }
+    super::vars::check_within(&v.name, val, v.bounds)?;
     if v.initial > 0.0 && val < MIN_RATIO * v.initial {
         return Err(FitError::ParamRange {
             name: v.name.clone(),

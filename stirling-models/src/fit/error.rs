@@ -96,7 +96,7 @@ pub enum FitError {
     Observe {
         file: String,
         column: String,
-        source: stirling_dsl::ObserveError,
+        source: Box<stirling_dsl::ObserveError>,
     },
     #[error("{stage} expects two bodies (displacer x, piston y); `{model}` has {found}")]
     Bodies {

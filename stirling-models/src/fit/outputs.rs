@@ -42,7 +42,7 @@ pub fn outputs(model: &dyn Model, data: &Measured) -> Result<Vec<Output>, FitErr
         let obs = Observation::sensor(model, s.name).map_err(|source| FitError::Observe {
             file: data.source.clone(),
             column: s.name.into(),
-            source,
+            source: Box::new(source),
         })?;
         out.push(Output {
             name: s.name.into(),

@@ -3,6 +3,8 @@
 
 use stirling_dsl::Model;
 
+use super::FitError;
+
 use crate::signal::noise_sigma;
 
 /// Lowest ratio of a positive model parameter to its starting value that a stage simulates.
@@ -67,6 +69,20 @@ impl Var {
             prior: None,
             bounds: None,
         }
+    }
+}
+
+/// Refuse `value` of parameter `name` outside `bounds` (a trial step the optimizer then
+/// shortens).
+pub fn check_within(name: &str, value: f64, bounds: Option<(f64, f64)>) -> Result<(), FitError> {
+    match bounds.filter(|&(lo, hi)| !(lo..=hi).contains(&value)) {
+        Some((lo, hi)) => Err(FitError::OutsideBounds {
+            name: name.into(),
+            value,
+            lo,
+            hi,
+        }),
+        None => Ok(()),
     }
 }
 

@@ -65,6 +65,16 @@ pub struct RigConfig {
     pub truth: Option<String>,
 }
 
+impl RigConfig {
+    /// The noise level given for `channel` (`noise`), if any.
+    pub fn noise_of(&self, channel: &str) -> Option<f64> {
+        self.noise
+            .iter()
+            .find(|(n, _)| n == channel)
+            .map(|&(_, sd)| sd)
+    }
+}
+
 impl Default for RigConfig {
     fn default() -> Self {
         Self {

@@ -79,7 +79,7 @@ pub(super) fn record(
     let dt = 1.0 / cfg.rate;
     let rows = clean_run(model, p, cfg, count)?;
     for c in &mut chans {
-        if let Some(&(_, sd)) = cfg.noise.iter().find(|(n, _)| *n == c.name) {
+        if let Some(sd) = cfg.noise_of(&c.name) {
             c.sd = sd;
         }
     }
@@ -132,8 +132,7 @@ fn declared_channel(
     // an absolute pressure carries the transducer's offset and must stay positive; a
     // difference or another expression is read zeroed at rest
     let state = obs.as_state().is_some();
-    let given = cfg.noise.iter().find(|(c, _)| c == name).map(|&(_, sd)| sd);
-    let (offset, sd, pressure) = match (sensor.unit, given) {
+    let (offset, sd, pressure) = match (sensor.unit, cfg.noise_of(name)) {
         ("Pa", _) if state => (cfg.offset_p, cfg.noise_p, true),
         ("Pa", _) => (0.0, cfg.noise_p, false),
         ("m", _) => (0.0, cfg.noise_x, false),
@@ -147,10 +146,7 @@ fn declared_channel(
     };
     // its own distortions (`effect lag on sensor ..;`), else the library's lag of every
     // absolute pressure transducer
-    let own = |prefix: &str| {
-        let key = format!("{prefix}_{name}");
-        fx.sensor.iter().find(|(n, _)| *n == key).map(|&(_, v)| v)
-    };
+    let own = |prefix: &str| fx.sensor_set(&format!("{prefix}_{name}"));
     let tau = own("tau").unwrap_or(if pressure {
         fx.sensor_value("tau_p")
     } else {

@@ -58,9 +58,9 @@ pub(super) fn seed_channels(
     cfg: &RigConfig,
 ) -> Vec<Channel> {
     // `tau_p` lags both transducers; `tau_p_hot` (a lag named on that sensor) the hot one
-    let tau = |name: &str| match fx.sensor.iter().find(|(n, _)| *n == format!("tau_{name}")) {
-        Some(&(_, v)) => v,
-        None => fx.sensor_value("tau_p"),
+    let tau = |name: &str| {
+        fx.sensor_set(&format!("tau_{name}"))
+            .unwrap_or_else(|| fx.sensor_value("tau_p"))
     };
     let pressure = |name: &str, state| Channel {
         name: name.into(),

@@ -90,17 +90,8 @@ impl Problem<'_> {
     pub(super) fn eval(&self, u: &[f64], sens: bool) -> Result<Eval, FitError> {
         let th = self.values(u);
         let n = self.model.n_states();
-        for (k, b) in self.bounds.iter().enumerate() {
-            if let Some((lo, hi)) = b.filter(|&(lo, hi)| !(lo..=hi).contains(&th[k])) {
-                let name = self.vars[k].name.clone();
-                let value = th[k];
-                return Err(FitError::OutsideBounds {
-                    name,
-                    value,
-                    lo,
-                    hi,
-                });
-            }
+        for (k, &b) in self.bounds.iter().enumerate() {
+            super::super::vars::check_within(&self.vars[k].name, th[k], b)?;
         }
         let p = self.params_with(&th);
         let columns = if sens { self.columns() } else { Vec::new() };

@@ -394,17 +394,18 @@ impl EffectSettings {
         Ok(out)
     }
 
+    /// A sensor parameter's value when set.
+    pub fn sensor_set(&self, name: &str) -> Option<f64> {
+        self.sensor.iter().find(|(n, _)| n == name).map(|(_, v)| *v)
+    }
+
     /// A sensor parameter's value (its null when not set).
     pub fn sensor_value(&self, name: &str) -> f64 {
-        self.sensor
-            .iter()
-            .find(|(n, _)| n == name)
-            .map(|(_, v)| *v)
-            .unwrap_or_else(|| {
-                effect_of_param(name)
-                    .and_then(|(_, p)| p.null)
-                    .unwrap_or(0.0)
-            })
+        self.sensor_set(name).unwrap_or_else(|| {
+            effect_of_param(name)
+                .and_then(|(_, p)| p.null)
+                .unwrap_or(0.0)
+        })
     }
 
     /// Apply the model settings to a parameter vector of the augmented model.
