@@ -22,11 +22,13 @@ class _Bar:
 
     def __init__(self, desc: str, unit: str) -> None:
         self.desc, self.unit = desc, unit
-        self.bar = None
+        self.bar = None  # the tqdm bar, when tqdm is installed and the total is known
+        self.opened = False
         self.shown = -1
 
     def __call__(self, done: float, total: float, line: Optional[str]) -> None:
-        if self.bar is None:
+        if not self.opened:
+            self.opened = True
             self.bar = self._open(total)
         if line is not None:
             self._write(line)
@@ -34,20 +36,22 @@ class _Bar:
             self._move(done, total)
 
     def _open(self, total: float):
+        if not total > 0:
+            return None  # work of unknown size reports lines only
         try:
             from tqdm.auto import tqdm
         except ImportError:
-            return False
-        return tqdm(total=total if total > 0 else None, desc=self.desc, unit=self.unit, leave=False)
+            return None
+        return tqdm(total=total, desc=self.desc, unit=self.unit, leave=False)
 
     def _write(self, line: str) -> None:
-        if self.bar:
+        if self.bar is not None:
             self.bar.write(line)
         else:
             print(line, file=sys.stderr)
 
     def _move(self, done: float, total: float) -> None:
-        if self.bar:
+        if self.bar is not None:
             self.bar.n = round(done, 6)
             self.bar.refresh()
         elif total > 0:
@@ -57,7 +61,7 @@ class _Bar:
                 print(f"{self.desc}: {10 * tenth} %", file=sys.stderr)
 
     def close(self) -> None:
-        if self.bar:
+        if self.bar is not None:
             self.bar.close()
 
 

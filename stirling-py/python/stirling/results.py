@@ -643,6 +643,13 @@ class Fit(Fields):
     intervals and covariance, the optional multiple-shooting refinement, the free-run check,
     and the measured-vs-model series (:attr:`series`)."""
 
+    __slots__ = ("_series",)
+
+    def __init__(self, raw: Mapping[str, Any]) -> None:
+        raw = dict(raw)
+        object.__setattr__(self, "_series", raw.pop("series", {}))
+        super().__init__(raw)
+
     @property
     def params(self) -> Dict[str, float]:
         """Every parameter after the fit."""
@@ -679,7 +686,7 @@ class Fit(Fields):
     def series(self) -> Dict[str, List[Fields]]:
         """Measured vs model per stage (``stage1``, ``stage2``, ``free_run``): ``channel``,
         ``t`` (s), ``measured``, ``model`` (arrays in the channel's unit)."""
-        return {k: [Fields(x) for x in v] for k, v in self._raw["series"].items()}
+        return {k: [Fields(x) for x in v] for k, v in self._series.items()}
 
     def __repr__(self) -> str:
         est = ", ".join(f"{k} = {e.value:.4g}" for k, e in list(self.estimates.items())[:6])
