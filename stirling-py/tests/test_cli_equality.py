@@ -65,8 +65,9 @@ def test_fit_gives_the_command_lines_numbers(cli, tmp_path):
 
 
 def test_diagnosis_gives_the_command_lines_numbers(cli, tmp_path):
-    path, rec = record(tmp_path, effects={"leak": 2e-8})
+    path, rec = record(tmp_path, effects={"sensor_lag": 0.002})
     js = cli("diagnose", "cv1", "--data", str(path), "--json")
     d = stirling.load("cv1").diagnose(rec)
     close(drop_timings(d.raw), drop_timings(js), 1e-9, "diagnosis")
-    assert d.verdict.verdict == js["verdict"]["verdict"]
+    assert d.verdict.verdict == js["verdict"]["verdict"] == "effect"
+    assert d.effect == "sensor_lag"
