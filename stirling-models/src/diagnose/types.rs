@@ -84,6 +84,49 @@ pub struct EffectEstimate {
     pub unit: String,
 }
 
+/// A fraction with its 95 % interval.
+#[derive(Clone, Copy, Debug, Serialize)]
+pub struct Interval {
+    pub value: f64,
+    pub ci_low: f64,
+    pub ci_high: f64,
+}
+
+/// One step of the explanation: the effect named (or a pair tried together), fitted jointly
+/// with the nominal parameters and every effect named before it.
+#[derive(Clone, Debug, Serialize)]
+pub struct Step {
+    /// 1 for the first step.
+    pub step: usize,
+    /// The effect named at this step (two for a pair tried together).
+    pub effects: Vec<String>,
+    /// The score p-value of the effect(s) at this step's null (the previous step's fit).
+    pub p_value: f64,
+    /// Held-out BIC change against the previous step (negative: better).
+    pub delta_bic: f64,
+    /// Every effect parameter named so far, refitted jointly at this step, 95 % intervals.
+    pub params: Vec<EffectEstimate>,
+    /// The fraction of the previous step's held-out gap this step closes.
+    pub closure: Interval,
+    /// The fraction of the nominal model's held-out gap closed after this step.
+    pub cumulative: Interval,
+    /// Held-out error after this step (noise variances; 1 is the floor).
+    pub holdout_error: f64,
+    /// Held-out error per channel after this step.
+    pub channels: Vec<ChannelError>,
+    /// The simulated gap after this step against the calibrated nominal model (features
+    /// and residual by phase of the cycle).
+    pub simulation_gap: Option<sim_gap::SimulationGap>,
+    /// Why the simulated gap is missing, if it is.
+    pub simulation_gap_note: Option<String>,
+    /// The candidates of this step's round, ranked.
+    pub ranking: Vec<RankEntry>,
+    pub seconds: f64,
+    /// Residual series after this step, for the report.
+    #[serde(skip)]
+    pub eval: Option<Eval>,
+}
+
 /// The diagnosis.
 #[derive(Clone, Debug, Serialize)]
 pub struct Diagnosis {
@@ -98,7 +141,12 @@ pub struct Diagnosis {
     /// Why the simulated gap is missing, if it is.
     pub simulation_gap_note: Option<String>,
     pub localization: localize::Localization,
+    /// The first round's candidates (on the nominal calibration), ranked.
     pub ranking: Vec<RankEntry>,
+    /// The explanation step by step (empty when no effect closes a significant part).
+    pub steps: Vec<Step>,
+    /// After the last step, the round that named nothing more, ranked (empty without steps).
+    pub remainder: Vec<RankEntry>,
     pub verdict: verdict::Verdict,
     /// Fits run (the nominal calibration and every joint fit).
     pub fits: usize,

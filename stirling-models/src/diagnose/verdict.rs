@@ -17,7 +17,7 @@
 use serde::Serialize;
 
 use super::context::Eval;
-use super::types::{ParamShift, RankEntry};
+use super::types::{ParamShift, RankEntry, Step};
 
 /// The lower closure bound a winner must clear. Chosen on the verdict self-checks of
 /// docs/diagnosis.md (34 records, `nsection` n = 2, `p,x,y`): the library effects named
@@ -33,8 +33,14 @@ pub const STRONG_BIC: f64 = -10.0;
 pub struct Verdict {
     /// `effect`, `unexplained` or `no_significant_gap`.
     pub verdict: String,
-    /// The leading effect (for `effect`; for `unexplained`, the best candidate tried).
+    /// The leading effect (for `effect`, the first named; for `unexplained`, the best
+    /// candidate tried).
     pub effect: Option<String>,
+    /// Every effect named, in the order of the steps (empty unless `effect`).
+    pub effects: Vec<String>,
+    /// Whether a significant gap remains that the named effects do not explain (always for
+    /// `unexplained`, never for `no_significant_gap`).
+    pub unexplained_remainder: bool,
     pub closure_fraction: Option<f64>,
     pub ci_low: Option<f64>,
     pub ci_high: Option<f64>,
@@ -145,6 +151,11 @@ pub fn decide(
     let mk = |v: &str, r: Option<&RankEntry>, reason: String| Verdict {
         verdict: v.into(),
         effect: r.map(|r| r.effect.clone()),
+        effects: r
+            .filter(|_| v == "effect")
+            .map(|r| vec![r.effect.clone()])
+            .unwrap_or_default(),
+        unexplained_remainder: v == "unexplained",
         closure_fraction: r.and_then(|r| r.closure_fraction),
         ci_low: r.and_then(|r| r.ci_low),
         ci_high: r.and_then(|r| r.ci_high),
@@ -162,5 +173,84 @@ pub fn decide(
             let r = top.filter(|t| t.fitted);
             mk("unexplained", r, format!("{significant} candidate(s) significant, {better} lower the held-out BIC, but none closes more than {MIN_CLOSURE} of the gap with confidence"))
         }
+    }
+}
+
+/// Decide from the steps of the explanation (`last`: the round after the last step that
+/// named nothing more); without steps, from the first round's `ranking` ([`decide`]).
+///
+/// The named effects are the verdict when the whole chain closes a significant part of the
+/// nominal gap: the lower bound of its cumulative closure clears [`MIN_CLOSURE`], the bound a
+/// single effect had to clear. A chain of effects that each close a little (a cause outside the
+/// library explained away in pieces) stays `unexplained`. A remainder is reported when a
+/// candidate of the last round is still significant: a systematic deviation is left that no
+/// library effect closes.
+pub fn decide_steps(
+    (steps, ranking, last): (&[Step], &[RankEntry], &[RankEntry]),
+    nominal: &Eval,
+    alpha: f64,
+    candidates: usize,
+    shifts: &[ParamShift],
+) -> Verdict {
+    let Some(end) = steps.last() else {
+        return decide(ranking, nominal, alpha, candidates, shifts);
+    };
+    let level = alpha / candidates.max(1) as f64;
+    let named: Vec<String> = steps.iter().flat_map(|s| s.effects.clone()).collect();
+    let cum = end.cumulative;
+    let chain = steps
+        .iter()
+        .map(|s| {
+            format!(
+                "`{}` closes {:.2} [{:.2}, {:.2}] of what remained (p {:.1e}, BIC {:.0})",
+                s.effects.join("` + `"),
+                s.closure.value,
+                s.closure.ci_low,
+                s.closure.ci_high,
+                s.p_value,
+                s.delta_bic
+            )
+        })
+        .collect::<Vec<_>>()
+        .join("; then ");
+    let total = format!(
+        "together {:.2} [{:.2}, {:.2}] of the gap (held-out error {:.3} -> {:.3} noise variances)",
+        cum.value, cum.ci_low, cum.ci_high, nominal.holdout_error, end.holdout_error
+    );
+    let base = Verdict {
+        verdict: String::new(),
+        effect: named.first().cloned(),
+        effects: Vec::new(),
+        unexplained_remainder: true,
+        closure_fraction: Some(cum.value),
+        ci_low: Some(cum.ci_low),
+        ci_high: Some(cum.ci_high),
+        gap: nominal.holdout_error,
+        reason: String::new(),
+    };
+    if !(cum.ci_low > MIN_CLOSURE) {
+        return Verdict {
+            verdict: "unexplained".into(),
+            reason: format!("{chain}: {total}, not more than {MIN_CLOSURE} with confidence: the library does not explain the gap"),
+            ..base
+        };
+    }
+    let left: Vec<&str> = last
+        .iter()
+        .filter(|r| r.p_value < level)
+        .map(|r| r.effect.as_str())
+        .collect();
+    let remainder = !left.is_empty();
+    let tail = if remainder {
+        format!("; a gap remains that the library does not explain ({} still significant at {level:.1e}, none closes a significant part)", left.join(", "))
+    } else {
+        format!("; no candidate is significant at {level:.1e} on what remains")
+    };
+    Verdict {
+        verdict: "effect".into(),
+        effects: named,
+        unexplained_remainder: remainder,
+        reason: format!("{chain}: {total}{tail}"),
+        ..base
     }
 }
