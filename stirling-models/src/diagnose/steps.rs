@@ -110,7 +110,8 @@ pub fn explain(
             }
             break;
         };
-        let step = make_step(ctx, nominal_eval, &named, ranking, opts, step_clock);
+        let mut step = make_step(ctx, nominal_eval, &named, ranking, opts, step_clock);
+        step.step = out.steps.len() + 1;
         report(opts, || step_line(&step, clock));
         for (e, shapes) in named.effects.iter().zip(&named.shapes) {
             basis.effects.push(EffectAt {
