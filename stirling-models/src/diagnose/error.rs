@@ -44,6 +44,8 @@ pub enum DiagnoseError {
     },
     #[error("unknown effect `{name}`: expected one of {known}")]
     UnknownEffect { name: String, known: String },
+    #[error("effect `{name}` is named twice in the candidates: name each once")]
+    DuplicateEffect { name: String },
     #[error("effect `{effect}` does not apply to `{model}` (it applies to {applies})")]
     NotApplicable {
         effect: String,

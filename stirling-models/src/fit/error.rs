@@ -31,6 +31,8 @@ pub enum FitError {
     Start(String),
     #[error("unknown parameter `{name}` of model `{model}`: see `stirling info {model}`")]
     UnknownParameter { name: String, model: String },
+    #[error("parameter `{name}` is named twice in the free parameters: name each once")]
+    DuplicateFree { name: String },
     #[error(
         "parameter `{name}` does not enter the equations of `{model}`: it cannot be identified"
     )]

@@ -1,0 +1,67 @@
+//! Answers that would look right and are not are refused with the cause (issue 38, "wrong
+//! answers with exit 0"): an equilibrium outside the physical range (a bounce pressure of
+//! 100 bar puts the gas volume below zero), a parameter freed twice (its interval would come
+//! from a rank-deficient problem), an effect named twice among the diagnosis's candidates.
+
+mod support;
+
+use support::{fails_with, s, scratch};
+
+/// A short moving record (13.4 Hz), enough for the option checks that come first.
+fn record(name: &str) -> std::path::PathBuf {
+    let dir = scratch(name);
+    let f = dir.join(format!("{name}.csv"));
+    let mut text = String::from("t,p,x,y\n");
+    for k in 0..4000 {
+        let t = k as f64 * 5e-4;
+        let w = (2.0 * std::f64::consts::PI * 13.4 * t).sin();
+        text.push_str(&format!(
+            "{t},{},{},{}\n",
+            101325.0 + 7000.0 * w,
+            0.01 * w,
+            0.008 * w
+        ));
+    }
+    std::fs::write(&f, text).unwrap();
+    f
+}
+
+#[test]
+fn a_nonphysical_equilibrium_is_an_error_naming_the_quantity() {
+    for args in [
+        &["linearize", "cv1", "--set", "Pb=1e7"][..],
+        &["linearize", "cv1", "--set", "Pb=1e7", "--json"][..],
+    ] {
+        fails_with(
+            args,
+            &["equilibrium is not physical", "volume of `gas`", "-1.37"],
+        );
+    }
+}
+
+#[test]
+fn a_parameter_freed_twice_is_refused() {
+    let f = record("dup_free");
+    fails_with(
+        &["fit", "cv1", "--data", s(&f), "--free", "kd,kd"],
+        &["`kd` is named twice"],
+    );
+}
+
+#[test]
+fn an_effect_named_twice_is_refused() {
+    let f = record("dup_effect");
+    fails_with(
+        &[
+            "diagnose",
+            "nsection",
+            "--n",
+            "2",
+            "--data",
+            s(&f),
+            "--effects",
+            "leak,leak",
+        ],
+        &["effect `leak` is named twice"],
+    );
+}
