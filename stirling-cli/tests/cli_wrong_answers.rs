@@ -65,3 +65,27 @@ fn an_effect_named_twice_is_refused() {
         &["effect `leak` is named twice"],
     );
 }
+
+#[test]
+fn a_record_too_coarse_for_its_cycle_is_refused() {
+    // 13.4 Hz sampled at 120 Hz: 9 samples per cycle
+    let dir = scratch("coarse");
+    let f = dir.join("coarse.csv");
+    let mut text = String::from("t,p,x,y\n");
+    for k in 0..1200 {
+        let t = k as f64 / 120.0;
+        let w = (2.0 * std::f64::consts::PI * 13.4 * t).sin();
+        let v = (2.0 * std::f64::consts::PI * 13.4 * t + 1.4).sin();
+        text.push_str(&format!(
+            "{t},{},{},{}\n",
+            101325.0 + 5800.0 * w,
+            0.0079 * v,
+            0.0062 * w
+        ));
+    }
+    std::fs::write(&f, text).unwrap();
+    fails_with(
+        &["fit", "cv1", "--data", s(&f)],
+        &["samples per cycle", "at least 10", "alias"],
+    );
+}
