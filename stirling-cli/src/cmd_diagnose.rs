@@ -210,6 +210,13 @@ fn run_self_check(a: &DiagnoseArgs) -> anyhow::Result<()> {
         },
         ..Default::default()
     };
+    // before the run, not after it: an earlier self-check is kept unless --force
+    files::prepare_dir(
+        &a.out,
+        &["selfcheck.json", "selfcheck.md"],
+        a.force,
+        "--out",
+    )?;
     let clock = std::time::Instant::now();
     let progress = |c: &selfcheck::outcome::Outcome, done: usize, total: usize| {
         let el = clock.elapsed().as_secs_f64();

@@ -89,3 +89,18 @@ fn a_record_too_coarse_for_its_cycle_is_refused() {
         &["samples per cycle", "at least 10", "alias"],
     );
 }
+
+#[test]
+fn the_self_check_keeps_an_earlier_report_without_force() {
+    let dir = scratch("selfcheck_kept");
+    std::fs::write(dir.join("selfcheck.json"), "{}").unwrap();
+    // refused before any case runs
+    fails_with(
+        &["diagnose", "--self-check", "--out", s(&dir)],
+        &["selfcheck.json", "pass --force"],
+    );
+    assert_eq!(
+        std::fs::read_to_string(dir.join("selfcheck.json")).unwrap(),
+        "{}"
+    );
+}
