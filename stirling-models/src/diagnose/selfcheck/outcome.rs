@@ -12,7 +12,7 @@ use super::record::{record, seeded_start, signature, Signature};
 use crate::diagnose::run::diagnose;
 use crate::diagnose::steps::MIN_STEP_CLOSURE;
 use crate::diagnose::types::{Diagnosis, RankEntry};
-use crate::diagnose::verdict::{pick, Pick, Thresholds};
+use crate::diagnose::verdict::{pick, Pick, Thresholds, GROSS_GAP};
 use crate::diagnose::DiagnoseError;
 
 /// One case of the verdict self-check.
@@ -47,6 +47,8 @@ pub struct Outcome {
     pub ranking: Vec<RankEntry>,
     /// The steps of the explanation (what the thresholds re-decide).
     pub steps: Vec<StepBrief>,
+    /// The nominal model's held-out error (noise variances).
+    pub gap: f64,
     pub signature: Signature,
     pub seconds: f64,
     /// Set when the case failed to run (rig or diagnosis error): counted as wrong.
@@ -93,7 +95,7 @@ impl Outcome {
             return "error".into();
         }
         if self.steps.is_empty() {
-            return label_of(pick(&self.ranking, self.candidates, th));
+            return label_of(pick(&self.ranking, self.candidates, self.gap, th));
         }
         let level = th.alpha / self.candidates.max(1) as f64;
         let mut named = Vec::new();
@@ -107,7 +109,7 @@ impl Outcome {
         }
         if !named.is_empty() && cumulative > th.min_closure {
             set_label(&named)
-        } else if self.ranking.iter().any(|r| r.p_value < level) {
+        } else if self.ranking.iter().any(|r| r.p_value < level) || self.gap > GROSS_GAP {
             "unexplained".into()
         } else {
             "no_significant_gap".into()
@@ -134,6 +136,7 @@ impl Outcome {
             truth_rank: None,
             ranking: Vec::new(),
             steps: Vec::new(),
+            gap: 0.0,
             signature: Signature::default(),
             seconds: 0.0,
             error: None,
@@ -150,6 +153,7 @@ impl Outcome {
             .as_ref()
             .and_then(|n| d.ranking.iter().position(|r| &r.effect == n).map(|i| i + 1));
         self.verdict = verdict_label(&d);
+        self.gap = d.verdict.gap;
         self.steps = d
             .steps
             .iter()
