@@ -7,20 +7,8 @@ use stirling::models::diagnose::RankEntry;
 
 fn entry(effect: &str, p_value: f64) -> RankEntry {
     RankEntry {
-        effect: effect.into(),
-        score: 0.0,
-        dof: 1,
         p_value,
-        fitted: false,
-        delta_bic: None,
-        holdout_error: None,
-        closure_fraction: None,
-        ci_low: None,
-        ci_high: None,
-        params: Vec::new(),
-        note: None,
-        seconds: 0.0,
-        moved: false,
+        ..RankEntry::named(effect)
     }
 }
 

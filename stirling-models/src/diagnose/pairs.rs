@@ -139,19 +139,10 @@ fn needed(ctx: &Context, pair: &Eval, single: &Assessed, k: usize) -> bool {
 /// The ranking entry of a pair (`a + b`) with its joint score.
 fn pair_entry(a: &RankEntry, b: &RankEntry, score: &super::score::Score) -> RankEntry {
     RankEntry {
-        effect: format!("{} + {}", a.effect, b.effect),
         score: score.stat,
         dof: score.dof,
         p_value: score.p_value,
-        fitted: false,
-        delta_bic: None,
-        holdout_error: None,
-        closure_fraction: None,
-        ci_low: None,
-        ci_high: None,
-        params: Vec::new(),
         note: Some("a pair tried together".into()),
-        seconds: 0.0,
-        moved: false,
+        ..RankEntry::named(&format!("{} + {}", a.effect, b.effect))
     }
 }

@@ -249,16 +249,7 @@ fn steps_section(s: &mut String, d: &Diagnosis) {
             .iter()
             .map(|c| format!("{} {:.2}", c.channel, c.ratio))
             .collect();
-        let params: Vec<String> = st
-            .params
-            .iter()
-            .map(|q| {
-                format!(
-                    "{} = {:.3e} [{:.3e}, {:.3e}] {}",
-                    q.name, q.value, q.ci_low, q.ci_high, q.unit
-                )
-            })
-            .collect();
+        let params = param_list(&st.params);
         let _ = writeln!(
             s,
             "| {} | {} | {} | {} | {:.3} | {} | {} |",
@@ -268,7 +259,7 @@ fn steps_section(s: &mut String, d: &Diagnosis) {
             iv(&st.cumulative),
             st.holdout_error,
             ch.join(", "),
-            params.join("; ")
+            params
         );
     }
     for st in &d.steps {
@@ -346,16 +337,7 @@ fn ranking_section(s: &mut String, d: &Diagnosis) {
     let _ = writeln!(s, "\n## Ranking\n\n| effect | score | p | fitted | delta BIC | held-out error | closure [95 % CI] | parameters |\n|---|---|---|---|---|---|---|---|");
     let opt = |v: Option<f64>| v.map(|v| format!("{v:.3}")).unwrap_or_else(|| "-".into());
     for r in &d.ranking {
-        let params: Vec<String> = r
-            .params
-            .iter()
-            .map(|q| {
-                format!(
-                    "{} = {:.3e} [{:.3e}, {:.3e}] {}",
-                    q.name, q.value, q.ci_low, q.ci_high, q.unit
-                )
-            })
-            .collect();
+        let params = param_list(&r.params);
         let _ = writeln!(
             s,
             "| {} | {:.2} | {:.2e} | {} | {} | {} | {} [{}, {}] | {} |",
@@ -368,7 +350,21 @@ fn ranking_section(s: &mut String, d: &Diagnosis) {
             opt(r.closure_fraction),
             opt(r.ci_low),
             opt(r.ci_high),
-            params.join("; ")
+            params
         );
     }
+}
+
+/// Estimates with their intervals, `; `-separated.
+fn param_list(params: &[super::types::EffectEstimate]) -> String {
+    params
+        .iter()
+        .map(|q| {
+            format!(
+                "{} = {:.3e} [{:.3e}, {:.3e}] {}",
+                q.name, q.value, q.ci_low, q.ci_high, q.unit
+            )
+        })
+        .collect::<Vec<_>>()
+        .join("; ")
 }

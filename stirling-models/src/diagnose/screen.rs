@@ -82,22 +82,7 @@ impl Screened {
 }
 
 fn empty_entry(e: &EffectInfo) -> RankEntry {
-    RankEntry {
-        effect: e.name.into(),
-        score: f64::NAN,
-        dof: 0,
-        p_value: f64::NAN,
-        fitted: false,
-        delta_bic: None,
-        holdout_error: None,
-        closure_fraction: None,
-        ci_low: None,
-        ci_high: None,
-        params: Vec::new(),
-        note: None,
-        seconds: 0.0,
-        moved: false,
-    }
+    RankEntry::named(e.name)
 }
 
 /// The score screen of one candidate (over the travel grid for the end stops), at the

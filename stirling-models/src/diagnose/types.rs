@@ -73,6 +73,28 @@ pub struct RankEntry {
     pub moved: bool,
 }
 
+impl RankEntry {
+    /// An entry of `effect` before its screen: nothing measured yet.
+    pub fn named(effect: &str) -> Self {
+        RankEntry {
+            effect: effect.into(),
+            score: f64::NAN,
+            dof: 0,
+            p_value: f64::NAN,
+            fitted: false,
+            delta_bic: None,
+            holdout_error: None,
+            closure_fraction: None,
+            ci_low: None,
+            ci_high: None,
+            params: Vec::new(),
+            note: None,
+            seconds: 0.0,
+            moved: false,
+        }
+    }
+}
+
 /// A fitted effect parameter.
 #[derive(Clone, Debug, Serialize)]
 pub struct EffectEstimate {
