@@ -26,6 +26,8 @@ mod candidates;
 pub mod closure;
 /// The record, its blocks and noise, and the residuals of a model on it.
 pub mod context;
+/// The diagonal of the Gauss-Newton covariance.
+pub mod covariance;
 /// Per-cycle features and waveforms by phase of the cycle.
 mod cycle_features;
 /// Why a diagnosis failed.

@@ -10,51 +10,17 @@
 use nalgebra::DVector;
 
 use super::context::{Context, Eval};
+use super::covariance::covariance_diagonal;
 use super::joint::{Basis, EffectAt, Joint};
 use super::joint_fit::{fit, settle};
 use super::score::Score;
 use super::screen::Screened;
+pub use super::types::{Assessed, SetFit};
 use super::types::{EffectEstimate, RankEntry};
 use super::DiagnoseError;
 use crate::effects::{EffectInfo, EffectTarget};
 use crate::fit::lm::{self, LmOptions};
 use crate::fit::FittedStage;
-
-/// A candidate's screen and fit.
-pub struct Assessed {
-    pub entry: RankEntry,
-    /// The fitted model's evaluation on the record.
-    pub eval: Option<Eval>,
-    /// The fit: the joint variables at the optimum, every effect parameter of the problem
-    /// (the accepted ones refitted, then the candidate's), the shape setting it started from.
-    pub fit: Option<SetFit>,
-}
-
-/// The joint fit of a candidate set on a basis.
-#[derive(Clone, Debug)]
-pub struct SetFit {
-    pub effects: Vec<&'static EffectInfo>,
-    pub x: Vec<f64>,
-    pub params: Vec<EffectEstimate>,
-    pub shapes: Vec<(&'static str, f64)>,
-}
-
-/// The diagonal of the Gauss-Newton covariance `(J^T J)^-1` over the columns `free` of `j`
-/// (unit residual variance), from the SVD of `J` (squaring `J` first loses the small singular
-/// values); directions below 1e-12 of the largest singular value count as zero.
-pub fn covariance_diagonal(j: &nalgebra::DMatrix<f64>, free: &[usize]) -> Option<Vec<f64>> {
-    let svd = j.select_columns(free).svd(false, true);
-    let vt = svd.v_t?;
-    let smax = svd.singular_values.max();
-    let inv2 = svd
-        .singular_values
-        .map(|v| if v > 1e-12 * smax { 1.0 / (v * v) } else { 0.0 });
-    Some(
-        (0..free.len())
-            .map(|k| (0..inv2.len()).map(|m| vt[(m, k)].powi(2) * inv2[m]).sum())
-            .collect(),
-    )
-}
 
 /// Estimates with 95 % intervals from the Gauss-Newton covariance at the optimum.
 fn estimates(joint: &Joint, res: &lm::LmResult, fixed: &[usize]) -> Vec<EffectEstimate> {

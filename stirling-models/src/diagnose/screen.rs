@@ -6,8 +6,8 @@
 
 use super::context::Context;
 use super::joint::{Basis, EffectAt, EffectVar, Joint};
-use super::rank::Assessed;
 use super::score::{robust_score, Score};
+use super::types::Assessed;
 use super::types::RankEntry;
 use super::DiagnoseError;
 use crate::effects::EffectInfo;

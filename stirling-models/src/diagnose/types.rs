@@ -3,7 +3,8 @@
 use serde::Serialize;
 
 use super::context::Eval;
-use super::{localize, sim_gap, verdict};
+use super::{localize, sim_gap};
+use crate::effects::EffectInfo;
 
 /// One channel's error on the held-out block.
 #[derive(Clone, Debug, Serialize)]
@@ -149,6 +150,46 @@ pub struct Step {
     pub eval: Option<Eval>,
 }
 
+/// The verdict.
+#[derive(Clone, Debug, Serialize)]
+pub struct Verdict {
+    /// `effect`, `unexplained` or `no_significant_gap`.
+    pub verdict: String,
+    /// The leading effect (for `effect`, the first named; for `unexplained`, the best
+    /// candidate tried).
+    pub effect: Option<String>,
+    /// Every effect named, in the order of the steps (empty unless `effect`).
+    pub effects: Vec<String>,
+    /// Whether a significant gap remains that the named effects do not explain (always for
+    /// `unexplained`, never for `no_significant_gap`).
+    pub unexplained_remainder: bool,
+    pub closure_fraction: Option<f64>,
+    pub ci_low: Option<f64>,
+    pub ci_high: Option<f64>,
+    /// Held-out error of the nominal model in noise variances (1: the noise floor).
+    pub gap: f64,
+    pub reason: String,
+}
+
+/// A candidate's screen and fit.
+pub struct Assessed {
+    pub entry: RankEntry,
+    /// The fitted model's evaluation on the record.
+    pub eval: Option<Eval>,
+    /// The fit: the joint variables at the optimum, every effect parameter of the problem
+    /// (the accepted ones refitted, then the candidate's), the shape setting it started from.
+    pub fit: Option<SetFit>,
+}
+
+/// The joint fit of a candidate set on a basis.
+#[derive(Clone, Debug)]
+pub struct SetFit {
+    pub effects: Vec<&'static EffectInfo>,
+    pub x: Vec<f64>,
+    pub params: Vec<EffectEstimate>,
+    pub shapes: Vec<(&'static str, f64)>,
+}
+
 /// The diagnosis.
 #[derive(Clone, Debug, Serialize)]
 pub struct Diagnosis {
@@ -169,7 +210,7 @@ pub struct Diagnosis {
     pub steps: Vec<Step>,
     /// After the last step, the round that named nothing more, ranked (empty without steps).
     pub remainder: Vec<RankEntry>,
-    pub verdict: verdict::Verdict,
+    pub verdict: Verdict,
     /// Fits run (the nominal calibration and every joint fit).
     pub fits: usize,
     pub seconds: f64,

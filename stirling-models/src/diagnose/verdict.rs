@@ -17,6 +17,7 @@
 use serde::Serialize;
 
 use super::context::Eval;
+pub use super::types::Verdict;
 use super::types::{ParamShift, RankEntry, Step};
 
 /// The lower closure bound a winner must clear. Chosen on the verdict self-checks of
@@ -34,27 +35,6 @@ pub const MIN_CLOSURE: f64 = 0.5;
 pub const GROSS_GAP: f64 = 25.0;
 /// The held-out BIC change that counts as an improvement ("strong evidence", Kass-Raftery).
 pub const STRONG_BIC: f64 = -10.0;
-
-/// The verdict.
-#[derive(Clone, Debug, Serialize)]
-pub struct Verdict {
-    /// `effect`, `unexplained` or `no_significant_gap`.
-    pub verdict: String,
-    /// The leading effect (for `effect`, the first named; for `unexplained`, the best
-    /// candidate tried).
-    pub effect: Option<String>,
-    /// Every effect named, in the order of the steps (empty unless `effect`).
-    pub effects: Vec<String>,
-    /// Whether a significant gap remains that the named effects do not explain (always for
-    /// `unexplained`, never for `no_significant_gap`).
-    pub unexplained_remainder: bool,
-    pub closure_fraction: Option<f64>,
-    pub ci_low: Option<f64>,
-    pub ci_high: Option<f64>,
-    /// Held-out error of the nominal model in noise variances (1: the noise floor).
-    pub gap: f64,
-    pub reason: String,
-}
 
 /// Calibrated parameters further than this from their estimates (prior standard deviations)
 /// are named in the verdict.
