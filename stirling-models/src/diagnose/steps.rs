@@ -6,11 +6,11 @@
 //!
 //! A step names one effect when its score is significant at the family-wise level, it lowers
 //! the held-out BIC strongly against the last step and the lower bound of its closure of what
-//! remains clears [`MIN_STEP_CLOSURE`]. When no single candidate does, but two or more are
+//! remains clears [`MIN_STEP_CLOSURE`](crate::diagnose::steps::MIN_STEP_CLOSURE). When no single candidate does, but two or more are
 //! significant, pairs of them are fitted together (`pairs.rs`): two effects that each
 //! alone fit the wrong shape (a quadratic regenerator loss and a pressure lag) can close the
 //! gap together. Whether the named effects explain the gap is the verdict's
-//! ([`super::verdict::decide`]): the closure of the whole chain, not of its steps.
+//! ([`decide`](crate::diagnose::verdict::decide)): the closure of the whole chain, not of its steps.
 
 use std::time::Instant;
 
