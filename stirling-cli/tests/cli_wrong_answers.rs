@@ -104,3 +104,40 @@ fn the_self_check_keeps_an_earlier_report_without_force() {
         "{}"
     );
 }
+
+#[test]
+fn shards_run_from_other_base_parameters_are_not_merged() {
+    let dir = scratch("merge_base");
+    let (a, b) = (dir.join("a"), dir.join("b"));
+    for (out, shard, extra) in [(&a, "1/2", None), (&b, "2/2", Some("kd=700"))] {
+        let mut args = vec![
+            "sweep",
+            "cv1",
+            "--grid",
+            "Th=500:700:4",
+            "--shard",
+            shard,
+            "--out",
+            s(out),
+        ];
+        if let Some(set) = extra {
+            args.extend(["--set", set]);
+        }
+        let run = support::stirling(&args);
+        assert!(
+            run.status.success(),
+            "{}",
+            String::from_utf8_lossy(&run.stderr)
+        );
+    }
+    fails_with(
+        &[
+            "sweep-merge",
+            s(&a.join("sweep.json")),
+            s(&b.join("sweep.json")),
+            "--out",
+            s(&dir.join("merged")),
+        ],
+        &["shard 2/2 was run from other base parameters", "`kd`"],
+    );
+}
