@@ -247,7 +247,12 @@ pub fn plan(opts: &VerdictOptions) -> Result<Vec<Planned>, DiagnoseError> {
     let effects = effect_names(opts)?;
     let outside = outside_names(opts)?;
     let mut cases = split_cases(opts, Split::Tune, &effects, &outside);
-    cases.extend(split_cases(opts, Split::Eval, &effects, &outside));
+    let eval = split_cases(opts, Split::Eval, &effects, &outside);
+    if eval.is_empty() {
+        // refused before the tuning set runs, not after it
+        return Err(DiagnoseError::EmptyEvaluation);
+    }
+    cases.extend(eval);
     Ok(cases
         .into_iter()
         .enumerate()
@@ -297,6 +302,16 @@ mod tests {
             .iter()
             .filter(|c| c.split == Split::Eval)
             .all(|c| !tune.contains(&c.seed)));
+    }
+
+    #[test]
+    fn an_empty_evaluation_set_is_refused_up_front() {
+        let o = VerdictOptions {
+            seeds: (1, 0),
+            clean: (2, 0),
+            ..Default::default()
+        };
+        assert!(matches!(plan(&o), Err(DiagnoseError::EmptyEvaluation)));
     }
 
     #[test]
