@@ -90,6 +90,10 @@ pub struct DiagnoseArgs {
     /// Self-check: strengths of the outside causes, as multiples of their unit (> 0)
     #[arg(long, value_delimiter = ',', default_value = "1", allow_negative_numbers = true, value_parser = ranges::positive)]
     pub outside_strengths: Vec<f64>,
+    /// Self-check: every pair of the library effects at this multiple of their units (0: no
+    /// pairs)
+    #[arg(long, default_value_t = 1.0, value_parser = ranges::non_negative)]
+    pub pair_strength: f64,
     /// Self-check: cases run at once (each diagnosis also uses both cores)
     #[arg(long, default_value_t = 2, value_parser = ranges::at_least_one)]
     pub jobs: usize,
@@ -192,6 +196,7 @@ fn run_self_check(a: &DiagnoseArgs) -> anyhow::Result<()> {
         strengths: a.strengths.clone(),
         outside,
         outside_strengths: a.outside_strengths.clone(),
+        pair_strength: (a.pair_strength > 0.0).then_some(a.pair_strength),
         seeds: a.seeds,
         clean: a.clean,
         t_end: a.t_end,
@@ -205,6 +210,13 @@ fn run_self_check(a: &DiagnoseArgs) -> anyhow::Result<()> {
         },
         ..Default::default()
     };
+    // before the run, not after it: an earlier self-check is kept unless --force
+    files::prepare_dir(
+        &a.out,
+        &["selfcheck.json", "selfcheck.md"],
+        a.force,
+        "--out",
+    )?;
     let clock = std::time::Instant::now();
     let progress = |c: &selfcheck::outcome::Outcome, done: usize, total: usize| {
         let el = clock.elapsed().as_secs_f64();
@@ -247,17 +259,24 @@ fn print_text(o: &mut impl Write, path: &Path, d: &Diagnosis) -> io::Result<()> 
         d.holdout.0,
         d.holdout.1
     )?;
+    let named = if d.verdict.effects.is_empty() {
+        d.verdict.effect.iter().cloned().collect::<Vec<_>>()
+    } else {
+        d.verdict.effects.clone()
+    };
     writeln!(
         o,
-        "\nverdict: {}{} ({})",
+        "\nverdict: {}{}{} ({})",
         d.verdict.verdict,
-        d.verdict
-            .effect
-            .as_ref()
-            .map(|e| format!(" `{e}`"))
-            .unwrap_or_default(),
+        named.iter().map(|e| format!(" `{e}`")).collect::<String>(),
+        if d.verdict.unexplained_remainder && d.verdict.verdict == "effect" {
+            " + an unexplained remainder"
+        } else {
+            ""
+        },
         d.verdict.reason
     )?;
+    print_steps(o, d)?;
     match (&d.simulation_gap, &d.simulation_gap_note) {
         (Some(g), _) => writeln!(
             o,
@@ -276,6 +295,46 @@ fn print_text(o: &mut impl Write, path: &Path, d: &Diagnosis) -> io::Result<()> 
         "\n{} fits (nominal and joint), {:.1} s",
         d.fits, d.seconds
     )
+}
+
+/// The explanation step by step: what each step named, closed and left.
+fn print_steps(o: &mut impl Write, d: &Diagnosis) -> io::Result<()> {
+    if d.steps.is_empty() {
+        return Ok(());
+    }
+    writeln!(
+        o,
+        "\nsteps (each refits the nominal parameters and every effect named so far):"
+    )?;
+    for s in &d.steps {
+        let left: Vec<String> = s
+            .channels
+            .iter()
+            .map(|c| format!("{} {:.2}", c.channel, c.ratio))
+            .collect();
+        writeln!(
+            o,
+            "  {}. {:<24} closes {:.2} [{:.2}, {:.2}] of what remained; {:.2} [{:.2}, {:.2}] in all; held-out error {:.3}; rms/noise {}",
+            s.step,
+            s.effects.join(" + "),
+            s.closure.value,
+            s.closure.ci_low,
+            s.closure.ci_high,
+            s.cumulative.value,
+            s.cumulative.ci_low,
+            s.cumulative.ci_high,
+            s.holdout_error,
+            left.join(", ")
+        )?;
+        for q in &s.params {
+            writeln!(
+                o,
+                "       {} = {:.4e} [{:.4e}, {:.4e}] {}",
+                q.name, q.value, q.ci_low, q.ci_high, q.unit
+            )?;
+        }
+    }
+    Ok(())
 }
 
 /// The driven subsystems' held-out gap per channel and the calibrated parameters.

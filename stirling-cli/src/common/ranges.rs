@@ -58,6 +58,15 @@ pub fn positive(s: &str) -> Parsed<f64> {
     Ok(v)
 }
 
+/// A finite number >= 0.
+pub fn non_negative(s: &str) -> Parsed<f64> {
+    let v = number(s)?;
+    if v < 0.0 {
+        return Err(RangeError::Outside("must be a finite number >= 0"));
+    }
+    Ok(v)
+}
+
 /// A solver tolerance in (0, 0.1].
 pub fn tolerance(s: &str) -> Parsed<f64> {
     let v = number(s)?;

@@ -18,6 +18,9 @@ pub(super) fn candidates(
     let Some(names) = names else {
         return Ok(pool);
     };
+    if let Some(name) = crate::fit::identify::first_duplicate(names) {
+        return Err(DiagnoseError::DuplicateEffect { name });
+    }
     let mut v = Vec::new();
     for n in names {
         if let Some(e) = pool.iter().find(|e| e.name == n) {

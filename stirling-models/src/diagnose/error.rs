@@ -44,6 +44,10 @@ pub enum DiagnoseError {
     },
     #[error("unknown effect `{name}`: expected one of {known}")]
     UnknownEffect { name: String, known: String },
+    #[error("the self-check's evaluation set is empty (no evaluation seed and no clean evaluation record): give --seeds TUNE:EVAL or --clean TUNE:EVAL with EVAL >= 1")]
+    EmptyEvaluation,
+    #[error("effect `{name}` is named twice in the candidates: name each once")]
+    DuplicateEffect { name: String },
     #[error("effect `{effect}` does not apply to `{model}` (it applies to {applies})")]
     NotApplicable {
         effect: String,

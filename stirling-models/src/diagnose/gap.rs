@@ -8,22 +8,7 @@ use crate::fit::FittedStage;
 
 /// The nominal model's held-out gap per channel, with the calibrated parameters.
 pub(super) fn gap_before(ctx: &Context, nominal: &Eval, stages: &[FittedStage]) -> GapBefore {
-    let (a, b) = ctx.hold_idx;
-    let channels = nominal
-        .channels
-        .iter()
-        .zip(&nominal.hp)
-        .map(|(c, r)| {
-            let rms = (r[a..b].iter().map(|v| v * v).sum::<f64>() / (b - a) as f64).sqrt();
-            let s = ctx.noise_of(c);
-            ChannelError {
-                channel: c.clone(),
-                rms,
-                noise: s,
-                ratio: rms / s,
-            }
-        })
-        .collect();
+    let channels = channel_errors(ctx, nominal);
     let fitted: Vec<(&fit::vars::Var, f64)> = stages
         .iter()
         .flat_map(|st| st.stage.vars.iter())
@@ -54,4 +39,23 @@ pub(super) fn gap_before(ctx: &Context, nominal: &Eval, stages: &[FittedStage]) 
         train_error: nominal.train_error,
         params,
     }
+}
+
+/// The held-out error of an evaluation per channel.
+pub(super) fn channel_errors(ctx: &Context, ev: &Eval) -> Vec<ChannelError> {
+    let (a, b) = ctx.hold_idx;
+    ev.channels
+        .iter()
+        .zip(&ev.hp)
+        .map(|(c, r)| {
+            let rms = (r[a..b].iter().map(|v| v * v).sum::<f64>() / (b - a) as f64).sqrt();
+            let s = ctx.noise_of(c);
+            ChannelError {
+                channel: c.clone(),
+                rms,
+                noise: s,
+                ratio: rms / s,
+            }
+        })
+        .collect()
 }

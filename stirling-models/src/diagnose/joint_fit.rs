@@ -42,7 +42,7 @@ pub fn fit(
     opts: &LmOptions,
 ) -> Result<(lm::LmResult, Vec<usize>), DiagnoseError> {
     let mut u0 = start.to_vec();
-    let strengths: Vec<&EffectVar> = joint.effect.iter().filter(|v| !v.shape).collect();
+    let strengths: Vec<&EffectVar> = joint.candidate().filter(|v| !v.shape).collect();
     for (v, &s) in strengths.iter().zip(&score.step) {
         // a strength the screen dropped still gets a small push to explore its side
         u0[v.index] = v.inside(if v.bounded {
@@ -100,12 +100,11 @@ fn fit_from(
     Err(DiagnoseError::JointBounds)
 }
 
-/// Whether every strength (not the shapes) of the effect is among the `fixed` variables: the
-/// problem is then the nominal calibration.
+/// Whether every strength (not the shapes) of the candidate is among the `fixed` variables:
+/// the problem is then the basis's (the nominal calibration, or the last step's).
 fn all_held(joint: &Joint, fixed: &[usize]) -> bool {
     joint
-        .effect
-        .iter()
+        .candidate()
         .filter(|v| !v.shape)
         .all(|v| fixed.contains(&v.index))
 }

@@ -18,12 +18,16 @@
 //!   phase, work, growth), before and after the leading effect, with intervals and one summary
 //!   closure.
 
+/// One round of candidates on a basis: screen, fit, rank, close.
+mod assess;
 mod blocks;
 mod candidates;
 /// How far: the closed fraction of the held-out gap with a bootstrap interval over cycles.
 pub mod closure;
 /// The record, its blocks and noise, and the residuals of a model on it.
 pub mod context;
+/// The diagonal of the Gauss-Newton covariance.
+pub mod covariance;
 /// Per-cycle features and waveforms by phase of the cycle.
 mod cycle_features;
 /// Why a diagnosis failed.
@@ -35,6 +39,8 @@ pub mod joint;
 mod joint_fit;
 /// Where: residuals by channel, harmonic, phase of the cycle and subsystem.
 pub mod localize;
+/// Pairs of significant candidates tried together.
+mod pairs;
 /// Which: fit and rank the screened candidates.
 pub mod rank;
 /// The Markdown report and its figures.
@@ -49,6 +55,8 @@ pub mod screen;
 pub mod selfcheck;
 /// The simulated gap: held-out cycle features of the free run, before and after.
 pub mod sim_gap;
+/// The explanation step by step.
+pub mod steps;
 /// What a diagnosis reports.
 pub mod types;
 /// The verdict a user reads.
@@ -58,7 +66,9 @@ pub use candidates::nominal_model;
 pub use context::{Context, Eval, Prediction};
 pub use error::DiagnoseError;
 pub use run::diagnose;
-pub use types::{ChannelError, Diagnosis, EffectEstimate, GapBefore, ParamShift, RankEntry};
+pub use types::{
+    ChannelError, Diagnosis, EffectEstimate, GapBefore, Interval, ParamShift, RankEntry, Step,
+};
 
 use crate::fit::FitOptions;
 

@@ -10,39 +10,17 @@
 use nalgebra::DVector;
 
 use super::context::{Context, Eval};
-use super::joint::Joint;
+use super::covariance::covariance_diagonal;
+use super::joint::{Basis, EffectAt, Joint};
 use super::joint_fit::{fit, settle};
 use super::score::Score;
 use super::screen::Screened;
+pub use super::types::{Assessed, SetFit};
 use super::types::{EffectEstimate, RankEntry};
 use super::DiagnoseError;
 use crate::effects::{EffectInfo, EffectTarget};
 use crate::fit::lm::{self, LmOptions};
 use crate::fit::FittedStage;
-
-/// A candidate's screen and fit.
-pub struct Assessed {
-    pub entry: RankEntry,
-    /// The fitted model's evaluation on the record.
-    pub eval: Option<Eval>,
-}
-
-/// The diagonal of the Gauss-Newton covariance `(J^T J)^-1` over the columns `free` of `j`
-/// (unit residual variance), from the SVD of `J` (squaring `J` first loses the small singular
-/// values); directions below 1e-12 of the largest singular value count as zero.
-pub fn covariance_diagonal(j: &nalgebra::DMatrix<f64>, free: &[usize]) -> Option<Vec<f64>> {
-    let svd = j.select_columns(free).svd(false, true);
-    let vt = svd.v_t?;
-    let smax = svd.singular_values.max();
-    let inv2 = svd
-        .singular_values
-        .map(|v| if v > 1e-12 * smax { 1.0 / (v * v) } else { 0.0 });
-    Some(
-        (0..free.len())
-            .map(|k| (0..inv2.len()).map(|m| vt[(m, k)].powi(2) * inv2[m]).sum())
-            .collect(),
-    )
-}
 
 /// Estimates with 95 % intervals from the Gauss-Newton covariance at the optimum.
 fn estimates(joint: &Joint, res: &lm::LmResult, fixed: &[usize]) -> Vec<EffectEstimate> {
@@ -80,16 +58,15 @@ fn estimates(joint: &Joint, res: &lm::LmResult, fixed: &[usize]) -> Vec<EffectEs
         .collect()
 }
 
-/// Fit one screened candidate jointly and evaluate it on the held-out block. `significant`:
-/// its score is; only such a candidate can be the verdict and only those rank ahead of the
-/// others ([`sort`]), so its fit is taken to the fixed point of the two stages
-/// (`joint_fit::settle`), while the others (fitted for the report with `--fit-all`) keep the
-/// first fit but get the start in their own basin that the score cannot see (`starts`).
+/// Fit one screened candidate jointly on `basis` (whose evaluation is `base_eval`) and
+/// evaluate it on the held-out block. `significant`: its score is; only such a candidate can
+/// be named and only those rank ahead of the others ([`sort`]), so its fit is taken to the
+/// fixed point of the two stages (`joint_fit::settle`), while the others (fitted for the
+/// report with `--fit-all`) keep the first fit but get the start in their own basin that the
+/// score cannot see (`starts`).
 pub fn assess(
     ctx: &Context,
-    nominal: &[FittedStage],
-    s2: &[f64],
-    nominal_eval: &Eval,
+    on: &On,
     screened: Screened,
     opts: &LmOptions,
     significant: bool,
@@ -102,20 +79,15 @@ pub fn assess(
         ..
     } = screened;
     let Some(score) = score else {
-        return Assessed { entry, eval: None };
+        return Assessed {
+            entry,
+            eval: None,
+            fit: None,
+        };
     };
     let clock = std::time::Instant::now();
-    let out = fit_candidate(
-        ctx,
-        nominal,
-        s2,
-        nominal_eval,
-        e,
-        &score,
-        &shapes,
-        (opts, significant),
-        &mut entry,
-    );
+    let cands = [EffectAt { effect: e, shapes }];
+    let out = fit_set(ctx, on, &cands, &score, (opts, significant), &mut entry);
     entry.seconds += clock.elapsed().as_secs_f64();
     if let Some(progress) = ctx.progress {
         progress(&format!(
@@ -129,66 +101,107 @@ pub fn assess(
         ));
     }
     match out {
-        Ok(eval) => Assessed { entry, eval },
+        Ok((eval, fit)) => Assessed {
+            entry,
+            eval: Some(eval),
+            fit: Some(fit),
+        },
         Err(e) => {
             entry.note = Some(e.to_string());
-            Assessed { entry, eval: None }
+            Assessed {
+                entry,
+                eval: None,
+                fit: None,
+            }
         }
     }
 }
 
-#[allow(clippy::too_many_arguments)]
-fn fit_candidate(
+/// What a candidate is fitted on: the nominal stages and their variance factors, and the
+/// basis (the effects accepted so far) with its evaluation.
+pub struct On<'s, 'a> {
+    pub nominal: &'s [FittedStage<'a>],
+    pub s2: &'s [f64],
+    pub basis: &'s Basis,
+    pub base_eval: &'s Eval,
+}
+
+/// The joint fit of a candidate set (one effect, or a pair tried together) on a basis, its
+/// held-out evaluation, and the entry's estimates, held-out error and BIC change against the
+/// basis.
+pub fn fit_set(
     ctx: &Context,
-    nominal: &[FittedStage],
-    s2: &[f64],
-    nominal_eval: &Eval,
-    e: &'static EffectInfo,
+    on: &On,
+    cands: &[EffectAt],
     score: &Score,
-    shapes: &[(&'static str, f64)],
     (opts, significant): (&LmOptions, bool),
     entry: &mut RankEntry,
-) -> Result<Option<Eval>, DiagnoseError> {
-    let mut joint = Joint::new(ctx.model, nominal, s2, e, shapes, !shapes.is_empty())?;
-    let best = best_fit(ctx, &joint, nominal, (e, !significant), score, shapes, opts)?;
+) -> Result<(Eval, SetFit), DiagnoseError> {
+    let free_shapes = cands.iter().any(|c| !c.shapes.is_empty());
+    let mut joint = Joint::new(ctx.model, on.nominal, on.s2, on.basis, cands, free_shapes)?;
+    let best = best_fit(ctx, &joint, cands, !significant, score, opts)?;
     let (res, fixed) = if significant {
         settle(&mut joint, best, opts)
     } else {
         best
     };
-    entry.params = estimates(&joint, &res, &fixed);
-    entry.moved = moved(e, &entry.params);
+    let all = estimates(&joint, &res, &fixed);
+    entry.params = joint
+        .effect
+        .iter()
+        .zip(&all)
+        .filter(|(v, _)| !v.base)
+        .map(|(_, q)| q.clone())
+        .collect();
+    entry.moved = cands.iter().any(|c| moved(c.effect, &entry.params));
     let ev = ctx.eval_joint(&joint, &res.x, joint.effect_values(&res.x))?;
-    let k = joint.effect.len() - fixed.len();
-    let n_h = ctx.holdout_points(nominal_eval) as f64;
+    let k = joint.candidate().count() - fixed.len().min(joint.candidate().count());
+    let n_h = ctx.holdout_points(on.base_eval) as f64;
     entry.fitted = true;
     entry.holdout_error = Some(ev.holdout_error);
-    let prior_change = joint.prior_cost(&res.x) - joint.prior_cost(&joint.start(nominal));
+    let prior_change = joint.prior_cost(&res.x) - joint.prior_cost(&joint.start());
     entry.delta_bic = Some(
-        n_h * (ev.holdout_error / nominal_eval.holdout_error).ln()
+        n_h * (ev.holdout_error / on.base_eval.holdout_error).ln()
             + k as f64 * n_h.ln()
             + prior_change,
     );
-    Ok(Some(ev))
+    let shapes = cands
+        .iter()
+        .flat_map(|c| c.shapes.iter().copied())
+        .collect();
+    Ok((
+        ev,
+        SetFit {
+            effects: cands.iter().map(|c| c.effect).collect(),
+            x: res.x,
+            params: all,
+            shapes,
+        },
+    ))
 }
 
 /// The starts of a joint fit (see [`best_fit`]): a fixed strength (else the one-step
 /// estimate), and whether the nominal parameters are reset (`reset`: add that start for a
 /// model effect).
-fn starts(e: &EffectInfo, shapes: &[(&'static str, f64)], reset: bool) -> Vec<(Option<f64>, bool)> {
+fn starts(cands: &[EffectAt], reset: bool) -> Vec<(Option<f64>, bool)> {
     let mut starts: Vec<(Option<f64>, bool)> = vec![(None, false)];
-    if !shapes.is_empty() {
+    if cands.iter().any(|c| !c.shapes.is_empty()) {
         starts.extend([(Some(0.3), false), (Some(1.0), false)]);
     }
-    if reset && e.target == EffectTarget::Model {
+    let model_effect = cands.len() == 1 && cands[0].effect.target == EffectTarget::Model;
+    if reset && model_effect {
         starts.push((Some(1.0), true));
     }
     starts
 }
 
 /// How many starts the joint fit of a significant `e` runs.
-pub fn start_count(e: &EffectInfo, shapes: &[(&'static str, f64)]) -> usize {
-    starts(e, shapes, false).len()
+pub fn start_count(e: &'static EffectInfo, shapes: &[(&'static str, f64)]) -> usize {
+    let c = [EffectAt {
+        effect: e,
+        shapes: shapes.to_vec(),
+    }];
+    starts(&c, false).len()
 }
 
 /// The joint fit from every start, the lowest cost kept. Starts: from the nominal optimum at
@@ -204,15 +217,14 @@ pub fn start_count(e: &EffectInfo, shapes: &[(&'static str, f64)]) -> usize {
 fn best_fit(
     ctx: &Context,
     joint: &Joint,
-    nominal: &[FittedStage],
-    (e, reset): (&EffectInfo, bool),
+    cands: &[EffectAt],
+    reset: bool,
     score: &Score,
-    shapes: &[(&'static str, f64)],
     opts: &LmOptions,
 ) -> Result<(lm::LmResult, Vec<usize>), DiagnoseError> {
     use rayon::prelude::*;
-    let starts = starts(e, shapes, reset);
-    let null = joint.start(nominal);
+    let starts = starts(cands, reset);
+    let null = joint.start();
     let results: Vec<Result<(lm::LmResult, Vec<usize>), DiagnoseError>> = starts
         .par_iter()
         .map(|&(s0, reset)| {
@@ -222,9 +234,9 @@ fn best_fit(
             }
             ctx.fits.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
             let u0 = if reset {
-                joint.reset_start(nominal)
+                joint.reset_start()
             } else {
-                joint.start(nominal)
+                joint.start()
             };
             fit(joint, &u0, &null, &sc, opts)
         })

@@ -31,19 +31,41 @@ fn io(path: &Path) -> impl Fn(std::io::Error) -> ReportError + '_ {
     }
 }
 
-/// The simulated residual by phase of the cycle, before and after (if measured).
+/// The simulated residual by phase of the cycle, of the calibrated model and after each
+/// step (without steps, after the leading fitted candidate), where measured.
 fn phase_figure(d: &Diagnosis, dir: &Path) -> Result<Option<String>, DrawError> {
     let Some(g) = &d.simulation_gap else {
         return Ok(None);
     };
-    let after = format!("with `{}`", g.effect.as_deref().unwrap_or("-"));
+    // (label, gap) of every simulated "after" column: one per step, or the diagnosis's
+    let afters: Vec<(String, &super::sim_gap::SimulationGap)> = if d.steps.is_empty() {
+        vec![(format!("with `{}`", g.effect.as_deref().unwrap_or("-")), g)]
+    } else {
+        d.steps
+            .iter()
+            .filter_map(|st| {
+                let sg = st.simulation_gap.as_ref()?;
+                Some((
+                    format!("after step {}: + {}", st.step, st.effects.join(" + ")),
+                    sg,
+                ))
+            })
+            .collect()
+    };
     let panels: Vec<plot::phase_residual::Panel> = g
         .phase_residuals
         .iter()
         .map(|r| {
             let mut lines = vec![("calibrated model", r.before.as_slice())];
-            if let Some(a) = &r.after {
-                lines.push((after.as_str(), a.as_slice()));
+            for (label, sg) in &afters {
+                let after = sg
+                    .phase_residuals
+                    .iter()
+                    .find(|q| q.channel == r.channel)
+                    .and_then(|q| q.after.as_deref());
+                if let Some(a) = after {
+                    lines.push((label.as_str(), a));
+                }
             }
             plot::phase_residual::Panel {
                 channel: &r.channel,
@@ -59,6 +81,36 @@ fn phase_figure(d: &Diagnosis, dir: &Path) -> Result<Option<String>, DrawError> 
             g.block.0, g.block.1
         ),
         &panels,
+    )?;
+    Ok(Some(f.into()))
+}
+
+/// The waterfall of the held-out gap (excess error over the noise floor) through the
+/// steps, with the 95 % interval of the level after each.
+fn waterfall_figure(d: &Diagnosis, dir: &Path) -> Result<Option<String>, DrawError> {
+    if d.steps.is_empty() {
+        return Ok(None);
+    }
+    let start = d.gap_before.holdout_error - 1.0;
+    let labels: Vec<String> = d.steps.iter().map(|s| s.effects.join(" + ")).collect();
+    let drops: Vec<plot::waterfall::Drop> = d
+        .steps
+        .iter()
+        .zip(&labels)
+        .map(|(s, label)| plot::waterfall::Drop {
+            label,
+            after: start * (1.0 - s.cumulative.value),
+            low: start * (1.0 - s.cumulative.ci_high),
+            high: start * (1.0 - s.cumulative.ci_low),
+        })
+        .collect();
+    let f = "gap_waterfall.svg";
+    plot::waterfall::waterfall(
+        &dir.join(f),
+        "held-out gap closed step by step (driven subsystems)",
+        "held-out error - 1 [noise variances]",
+        start,
+        &drops,
     )?;
     Ok(Some(f.into()))
 }
@@ -141,7 +193,8 @@ fn overlay_figure(
 /// Write `report.md` and the figures into `dir`; returns the Markdown path.
 pub fn write(d: &Diagnosis, data: &Measured, dir: &Path) -> Result<PathBuf, ReportError> {
     std::fs::create_dir_all(dir).map_err(io(dir))?;
-    let mut figs: Vec<String> = phase_figure(d, dir)?.into_iter().collect();
+    let mut figs: Vec<String> = waterfall_figure(d, dir)?.into_iter().collect();
+    figs.extend(phase_figure(d, dir)?);
     figs.extend(localization_figures(d, dir)?);
     for c in &d.localization.channels {
         figs.extend(overlay_figure(d, data, &c.channel, dir)?);
@@ -154,11 +207,14 @@ pub fn write(d: &Diagnosis, data: &Measured, dir: &Path) -> Result<PathBuf, Repo
 fn markdown(d: &Diagnosis, data: &Measured, figs: &[String]) -> String {
     let mut s = String::new();
     let v = &d.verdict;
-    let effect = v
-        .effect
-        .as_ref()
-        .map(|e| format!(" (`{e}`)"))
-        .unwrap_or_default();
+    let effect = if v.effects.len() > 1 {
+        format!(" (`{}`)", v.effects.join("`, `"))
+    } else {
+        v.effect
+            .as_ref()
+            .map(|e| format!(" (`{e}`)"))
+            .unwrap_or_default()
+    };
     let _ = writeln!(s, "# Gap diagnosis: `{}` on `{}`\n", d.model, data.source);
     let _ = writeln!(s, "**Verdict: {}{effect}**; {}\n", v.verdict, v.reason);
     let _ = writeln!(
@@ -166,6 +222,7 @@ fn markdown(d: &Diagnosis, data: &Measured, figs: &[String]) -> String {
         "Training {:.3}:{:.3} s, held out {:.3}:{:.3} s; {} fits, {:.1} s.\n",
         d.train.0, d.train.1, d.holdout.0, d.holdout.1, d.fits, d.seconds
     );
+    steps_section(&mut s, d);
     simulated_section(&mut s, d);
     driven_section(&mut s, d);
     ranking_section(&mut s, d);
@@ -174,6 +231,55 @@ fn markdown(d: &Diagnosis, data: &Measured, figs: &[String]) -> String {
         let _ = writeln!(s, "![{f}]({f})");
     }
     s
+}
+
+fn steps_section(s: &mut String, d: &Diagnosis) {
+    if d.steps.is_empty() {
+        return;
+    }
+    let _ = writeln!(
+        s,
+        "## The explanation step by step\n\nEach step refits the nominal parameters and every effect named so far jointly; closures are of the held-out excess error (1 is the noise floor), with 95 % bootstrap intervals over cycles. Figure `gap_waterfall.svg`.\n\n| step | effect | closes of what remained | in all | held-out error | rms/noise by channel | parameters |\n|---|---|---|---|---|---|---|"
+    );
+    let iv =
+        |i: &super::types::Interval| format!("{:.2} [{:.2}, {:.2}]", i.value, i.ci_low, i.ci_high);
+    for st in &d.steps {
+        let ch: Vec<String> = st
+            .channels
+            .iter()
+            .map(|c| format!("{} {:.2}", c.channel, c.ratio))
+            .collect();
+        let params = param_list(&st.params);
+        let _ = writeln!(
+            s,
+            "| {} | {} | {} | {} | {:.3} | {} | {} |",
+            st.step,
+            st.effects.join(" + "),
+            iv(&st.closure),
+            iv(&st.cumulative),
+            st.holdout_error,
+            ch.join(", "),
+            params
+        );
+    }
+    for st in &d.steps {
+        if let Some(g) = &st.simulation_gap {
+            let _ = writeln!(
+                s,
+                "\nAfter step {} (`{}`), the model simulated on its own over the held-out block ({} cycles):\n\n{}",
+                st.step,
+                st.effects.join(" + "),
+                g.cycles,
+                g.markdown()
+            );
+        }
+    }
+    if d.verdict.unexplained_remainder {
+        let _ = writeln!(
+            s,
+            "\n**A gap remains that the library does not explain.**\n"
+        );
+    }
 }
 
 fn simulated_section(s: &mut String, d: &Diagnosis) {
@@ -231,16 +337,7 @@ fn ranking_section(s: &mut String, d: &Diagnosis) {
     let _ = writeln!(s, "\n## Ranking\n\n| effect | score | p | fitted | delta BIC | held-out error | closure [95 % CI] | parameters |\n|---|---|---|---|---|---|---|---|");
     let opt = |v: Option<f64>| v.map(|v| format!("{v:.3}")).unwrap_or_else(|| "-".into());
     for r in &d.ranking {
-        let params: Vec<String> = r
-            .params
-            .iter()
-            .map(|q| {
-                format!(
-                    "{} = {:.3e} [{:.3e}, {:.3e}] {}",
-                    q.name, q.value, q.ci_low, q.ci_high, q.unit
-                )
-            })
-            .collect();
+        let params = param_list(&r.params);
         let _ = writeln!(
             s,
             "| {} | {:.2} | {:.2e} | {} | {} | {} | {} [{}, {}] | {} |",
@@ -253,7 +350,21 @@ fn ranking_section(s: &mut String, d: &Diagnosis) {
             opt(r.closure_fraction),
             opt(r.ci_low),
             opt(r.ci_high),
-            params.join("; ")
+            params
         );
     }
+}
+
+/// Estimates with their intervals, `; `-separated.
+fn param_list(params: &[super::types::EffectEstimate]) -> String {
+    params
+        .iter()
+        .map(|q| {
+            format!(
+                "{} = {:.3e} [{:.3e}, {:.3e}] {}",
+                q.name, q.value, q.ci_low, q.ci_high, q.unit
+            )
+        })
+        .collect::<Vec<_>>()
+        .join("; ")
 }

@@ -6,15 +6,11 @@ use stirling_dsl::Model;
 
 use super::blocks::{blocks, Blocks};
 use super::candidates::candidates;
-use super::context::{predict, Context, Eval, Prediction};
+use super::context::{predict, Context, Prediction};
 use super::gap::gap_before;
-use super::types::{Diagnosis, RankEntry};
-use super::{
-    closure, joint, localize, rank, schedule, score, screen, sim_gap, verdict, DiagnoseError,
-    DiagnoseOptions,
-};
+use super::types::{Diagnosis, EffectEstimate};
+use super::{joint, localize, score, sim_gap, steps, verdict, DiagnoseError, DiagnoseOptions};
 use crate::data::Measured;
-use crate::effects::EffectInfo;
 use crate::fit::free_run::SensorOffsets;
 use crate::fit::{self, FitOptions, FittedStage, Identification};
 use crate::signal::noise_sigma;
@@ -37,7 +33,7 @@ pub fn diagnose(
     let nominal = ctx.eval(&all, vec![], p_nom.clone())?;
     let s2 = variance_factors(&stages)?;
     let localization = localize::localize(data, &nominal, &ctx);
-    report_progress(opts, || {
+    super::assess::report(opts, || {
         format!(
             "nominal calibration done ({:.1} s); assessing {} candidate effects",
             clock.elapsed().as_secs_f64(),
@@ -45,22 +41,27 @@ pub fn diagnose(
         )
     });
     let gap_before = gap_before(&ctx, &nominal, &stages);
-    let nom = Nominal {
-        stages: &stages,
-        s2: &s2,
-        eval: &nominal,
-        absorbed: absorbed(&gap_before),
-    };
-    let assessed = assess_all(&ctx, &nom, &cands, opts, clock);
-    let after = assessed.first().and_then(|a| a.eval.clone());
-    let ranking: Vec<RankEntry> = assessed.into_iter().map(|a| a.entry).collect();
-    let verdict = verdict::decide(
-        &ranking,
+    let absorbed = absorbed(&gap_before);
+    let ex = steps::explain(
+        &ctx,
+        (&stages, &s2),
+        &nominal,
+        &cands,
+        opts,
+        (absorbed, clock),
+    );
+    let verdict = verdict::decide_steps(
+        (&ex.steps, &ex.first, &ex.last),
         &nominal,
         opts.alpha,
         cands.len(),
         &gap_before.shifts,
     );
+    let after = ex
+        .steps
+        .last()
+        .and_then(|s| s.eval.clone())
+        .or(ex.first_eval);
     let mut diagnosis = Diagnosis {
         simulation_gap: None,
         simulation_gap_note: None,
@@ -70,10 +71,12 @@ pub fn diagnose(
         holdout: b.holdout,
         gap_before,
         localization,
-        ranking,
+        ranking: ex.first,
+        steps: ex.steps,
+        remainder: ex.last,
         verdict,
         fits: ctx.fits.load(std::sync::atomic::Ordering::Relaxed),
-        seconds: clock.elapsed().as_secs_f64(),
+        seconds: 0.0,
         before: Some(nominal),
         after,
     };
@@ -82,7 +85,8 @@ pub fn diagnose(
         blocks: &b,
         p_nom: &p_nom,
     };
-    attach_simulated_gap(&mut diagnosis, model, data, &nominal_run, opts);
+    attach_simulated_gaps(&mut diagnosis, model, data, &nominal_run, opts);
+    diagnosis.seconds = clock.elapsed().as_secs_f64();
     Ok(diagnosis)
 }
 
@@ -99,13 +103,6 @@ fn absorbed(gap: &super::types::GapBefore) -> bool {
     gap.shifts
         .iter()
         .any(|s| s.prior_sd.is_some_and(|z| z.abs() > ABSORBED_SD))
-}
-
-/// A progress line, when the caller asked for them.
-fn report_progress(opts: &DiagnoseOptions, line: impl FnOnce() -> String) {
-    if let Some(progress) = opts.progress {
-        progress(&line());
-    }
 }
 
 /// The options of the nominal calibration: the diagnosis's blocks, the stages without the
@@ -189,124 +186,6 @@ fn context<'a>(
 /// says the calibration absorbed something (see [`assess_all`]).
 const ABSORBED_SD: f64 = 2.0;
 
-/// The nominal calibration as the candidates see it.
-struct Nominal<'s, 'a> {
-    stages: &'s [FittedStage<'a>],
-    /// The stages' variance factors.
-    s2: &'s [f64],
-    eval: &'s Eval,
-    /// Whether a calibrated parameter moved beyond [`ABSORBED_SD`] prior deviations.
-    absorbed: bool,
-}
-
-/// A joint fit stops when an accepted step lowers the cost (half the chi-square of the
-/// weighted residuals, which have unit variance) by less than this: 1/50 of the held-out BIC
-/// change a verdict needs ([`verdict::STRONG_BIC`], in -2 log likelihood). On the lag record
-/// of docs/diagnosis.md the fits' last iterations gained 0.01 to 0.3 each.
-const JOINT_FATOL: f64 = 0.1;
-
-/// Screen every candidate, fit the significant ones, rank them and attach the closure of
-/// each fitted one. The candidates are independent: one per core.
-///
-/// Only a significant candidate can be the verdict ([`verdict::pick`]; the self-check's
-/// tuning can only tighten the level), and the significant ones rank ahead of every other,
-/// so fitting the others changes no verdict: they are fitted with `fit_all` only (for the
-/// report). When the calibration moved a parameter beyond [`ABSORBED_SD`] prior deviations
-/// the progress line says so: an effect may be absorbed there, and `--fit-all` shows how
-/// each model effect fits from its own basin (the nominal parameters reset). On the lag
-/// record of docs/diagnosis.md those fits were 18 of 77 CPU seconds.
-fn assess_all(
-    ctx: &Context,
-    nom: &Nominal,
-    cands: &[&'static EffectInfo],
-    opts: &DiagnoseOptions,
-    clock: Instant,
-) -> Vec<rank::Assessed> {
-    use rayon::prelude::*;
-    let mut lm = opts.fit.lm;
-    lm.max_iter = opts.joint_iters;
-    // trial steps of at most one typical strength: far trials (an engine stopped by friction)
-    // are slow to integrate and rejected anyway
-    lm.max_step = 1.0;
-    lm.fatol = JOINT_FATOL;
-    let level = opts.alpha / cands.len().max(1) as f64;
-    let (stages, s2, nominal) = (nom.stages, nom.s2, nom.eval);
-    let screened: Vec<screen::Screened> = cands
-        .par_iter()
-        .map(|e| screen::screen_candidate(ctx, stages, s2, e))
-        .collect();
-    let fit = |s: &screen::Screened| opts.fit_all || s.significant(level);
-    report_progress(opts, || {
-        let sig = screened.iter().filter(|s| s.significant(level)).count();
-        let fitted = screened.iter().filter(|s| fit(s)).count();
-        screen_line(
-            screened.len(),
-            (sig, fitted, level),
-            nom.absorbed,
-            opts,
-            clock,
-        )
-    });
-    let mut assessed = schedule::longest_first(screened, |s| {
-        if fit(&s) {
-            let significant = s.significant(level);
-            rank::assess(ctx, stages, s2, nominal, s, &lm, significant)
-        } else {
-            s.unfitted("not fitted: its score is not significant (--fit-all fits it)")
-        }
-    });
-    rank::sort(&mut assessed, level);
-    attach_closures(ctx, nominal, &mut assessed, opts);
-    assessed
-}
-
-/// The progress line after the screen: how many candidates are significant, how many are
-/// fitted, and why more are fitted than are significant.
-fn screen_line(
-    screened: usize,
-    (sig, fitted, level): (usize, usize, f64),
-    absorbed: bool,
-    opts: &DiagnoseOptions,
-    clock: Instant,
-) -> String {
-    let why = if opts.fit_all {
-        " (--fit-all)"
-    } else if absorbed && fitted < screened {
-        " (the calibration moved a parameter beyond 2 prior sd: an effect may be absorbed there; --fit-all fits the others too)"
-    } else {
-        ""
-    };
-    format!(
-        "screened {screened} candidates ({:.1} s): {sig} significant at {level:.1e}; fitting {fitted}{why}",
-        clock.elapsed().as_secs_f64(),
-    )
-}
-
-/// The driven closure, with its interval, of every fitted candidate.
-fn attach_closures(
-    ctx: &Context,
-    nominal: &Eval,
-    assessed: &mut [rank::Assessed],
-    opts: &DiagnoseOptions,
-) {
-    for a in assessed.iter_mut() {
-        if let Some(ev) = &a.eval {
-            let c = closure::closure(
-                ctx.data,
-                nominal,
-                ev,
-                ctx.hold_idx,
-                ctx,
-                opts.bootstrap,
-                opts.seed,
-            );
-            a.entry.closure_fraction = Some(c.fraction);
-            a.entry.ci_low = Some(c.ci_low);
-            a.entry.ci_high = Some(c.ci_high);
-        }
-    }
-}
-
 /// What the simulated gap needs of the nominal calibration.
 struct NominalRun<'a> {
     offsets: &'a SensorOffsets,
@@ -314,48 +193,85 @@ struct NominalRun<'a> {
     p_nom: &'a [f64],
 }
 
-/// The simulated gap before and after the leading fitted candidate (the sensor effects
-/// distort the simulated outputs as they distort the data); when it cannot be computed, the
-/// reason instead.
-fn attach_simulated_gap(
+/// The simulated gap before and after each step (the sensor effects distort the simulated
+/// outputs as they distort the data), the last one's (or, without steps, the leading fitted
+/// candidate's) as the diagnosis's; when it cannot be computed, the reason instead.
+fn attach_simulated_gaps(
     d: &mut Diagnosis,
     model: &dyn Model,
     data: &Measured,
     nominal: &NominalRun,
     opts: &DiagnoseOptions,
 ) {
+    for k in 0..d.steps.len() {
+        let step = &d.steps[k];
+        let Some(ev) = step.eval.as_ref() else {
+            continue;
+        };
+        let label = step.effects.join(" + ");
+        let sim = simulated_gap(
+            model,
+            data,
+            nominal,
+            opts,
+            Some((&label, &ev.p, &step.params)),
+        );
+        let step = &mut d.steps[k];
+        match sim {
+            Ok(g) => step.simulation_gap = Some(g),
+            Err(e) => step.simulation_gap_note = Some(e.to_string()),
+        }
+    }
+    if let Some(last) = d.steps.last() {
+        d.simulation_gap = last.simulation_gap.clone();
+        d.simulation_gap_note = last.simulation_gap_note.clone();
+        return;
+    }
+    let top = d.ranking.first().filter(|r| r.fitted);
+    let effect = d
+        .after
+        .as_ref()
+        .zip(top)
+        .map(|(ev, r)| (r.effect.as_str(), ev.p.as_slice(), r.params.as_slice()));
+    match simulated_gap(model, data, nominal, opts, effect) {
+        Ok(g) => d.simulation_gap = Some(g),
+        Err(e) => d.simulation_gap_note = Some(e.to_string()),
+    }
+}
+
+/// The simulated gap of the calibrated model, and of the model after the effects whose
+/// parameters `p` and estimates (the sensor distortions among them) are given.
+fn simulated_gap(
+    model: &dyn Model,
+    data: &Measured,
+    nominal: &NominalRun,
+    opts: &DiagnoseOptions,
+    effect: Option<(&str, &[f64], &[EffectEstimate])>,
+) -> Result<sim_gap::SimulationGap, sim_gap::SimGapError> {
     let before = sim_gap::Simulated {
         p: nominal.p_nom,
         tau_p: 0.0,
         gain: (0.0, 0.0),
     };
-    let top = d.ranking.first().filter(|r| r.fitted);
-    let value = |name: &str| {
-        top.and_then(|r| r.params.iter().find(|q| q.name == name))
-            .map_or(0.0, |q| q.value)
-    };
-    let effect = d.after.as_ref().zip(top).map(|(ev, r)| {
+    let after = effect.map(|(name, p, params)| {
+        let value = |n: &str| params.iter().find(|q| q.name == n).map_or(0.0, |q| q.value);
         (
-            r.effect.as_str(),
+            name,
             sim_gap::Simulated {
-                p: &ev.p,
+                p,
                 tau_p: value("tau_p").max(0.0),
                 gain: (value("gain_x"), value("gain_y")),
             },
         )
     });
-    let sim = sim_gap::simulation_gap(
+    sim_gap::simulation_gap(
         model,
         data,
         nominal.offsets,
         nominal.blocks.holdout,
         &before,
-        effect.as_ref().map(|(n, m)| (*n, m)),
+        after.as_ref().map(|(n, m)| (*n, m)),
         opts.bootstrap,
         opts.seed,
-    );
-    match sim {
-        Ok(g) => d.simulation_gap = Some(g),
-        Err(e) => d.simulation_gap_note = Some(e.to_string()),
-    }
+    )
 }

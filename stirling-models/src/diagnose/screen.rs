@@ -5,9 +5,9 @@
 //! with a Bonferroni factor, and the joint fit starts from that travel with the travel free.
 
 use super::context::Context;
-use super::joint::{EffectVar, Joint};
-use super::rank::Assessed;
+use super::joint::{Basis, EffectAt, EffectVar, Joint};
 use super::score::{robust_score, Score};
+use super::types::Assessed;
 use super::types::RankEntry;
 use super::DiagnoseError;
 use crate::effects::EffectInfo;
@@ -35,11 +35,12 @@ fn shape_grid(ctx: &Context, e: &EffectInfo) -> Vec<Vec<(&'static str, f64)>> {
 /// The score test of `joint` at its start.
 fn screen(ctx: &Context, joint: &Joint, u0: &[f64]) -> Result<Score, DiagnoseError> {
     let (r, j, blocks) = joint.residuals(u0)?;
-    let strengths: Vec<&EffectVar> = joint.effect.iter().filter(|v| !v.shape).collect();
+    // the candidate's strengths are tested; its shapes are inert at the null; the accepted
+    // effects' variables are nuisances like the nominal ones
+    let strengths: Vec<&EffectVar> = joint.candidate().filter(|v| !v.shape).collect();
     let test: Vec<usize> = strengths.iter().map(|v| v.index).collect();
     let skip: Vec<usize> = joint
-        .effect
-        .iter()
+        .candidate()
         .filter(|v| v.shape)
         .map(|v| v.index)
         .collect();
@@ -75,34 +76,22 @@ impl Screened {
         Assessed {
             entry: self.entry,
             eval: None,
+            fit: None,
         }
     }
 }
 
 fn empty_entry(e: &EffectInfo) -> RankEntry {
-    RankEntry {
-        effect: e.name.into(),
-        score: f64::NAN,
-        dof: 0,
-        p_value: f64::NAN,
-        fitted: false,
-        delta_bic: None,
-        holdout_error: None,
-        closure_fraction: None,
-        ci_low: None,
-        ci_high: None,
-        params: Vec::new(),
-        note: None,
-        seconds: 0.0,
-        moved: false,
-    }
+    RankEntry::named(e.name)
 }
 
-/// The score screen of one candidate (over the travel grid for the end stops).
+/// The score screen of one candidate (over the travel grid for the end stops), at the
+/// optimum of `basis` (the nominal calibration and the effects accepted so far).
 pub fn screen_candidate(
     ctx: &Context,
     nominal: &[FittedStage],
     s2: &[f64],
+    basis: &Basis,
     e: &'static EffectInfo,
 ) -> Screened {
     let clock = std::time::Instant::now();
@@ -110,8 +99,12 @@ pub fn screen_candidate(
     let grid = shape_grid(ctx, e);
     let mut best: Option<(Score, Vec<(&'static str, f64)>)> = None;
     for shapes in &grid {
-        let sc = Joint::new(ctx.model, nominal, s2, e, shapes, false)
-            .and_then(|joint| screen(ctx, &joint, &joint.start(nominal)));
+        let cand = [EffectAt {
+            effect: e,
+            shapes: shapes.clone(),
+        }];
+        let sc = Joint::new(ctx.model, nominal, s2, basis, &cand, false)
+            .and_then(|joint| screen(ctx, &joint, &joint.start()));
         match sc {
             Ok(sc) if best.as_ref().is_none_or(|(b, _)| sc.stat > b.stat) => {
                 best = Some((sc, shapes.clone()))
@@ -144,4 +137,17 @@ pub fn screen_candidate(
         eval_seconds: entry.seconds / grid.len().max(1) as f64,
         entry,
     }
+}
+
+/// The joint score test of a set of candidates (a pair tried together) on `basis`, at the
+/// shape settings their single screens chose.
+pub fn screen_set(
+    ctx: &Context,
+    nominal: &[FittedStage],
+    s2: &[f64],
+    basis: &Basis,
+    cands: &[EffectAt],
+) -> Result<Score, DiagnoseError> {
+    let joint = Joint::new(ctx.model, nominal, s2, basis, cands, false)?;
+    screen(ctx, &joint, &joint.start())
 }

@@ -3,7 +3,8 @@
 use serde::Serialize;
 
 use super::context::Eval;
-use super::{localize, sim_gap, verdict};
+use super::{localize, sim_gap};
+use crate::effects::EffectInfo;
 
 /// One channel's error on the held-out block.
 #[derive(Clone, Debug, Serialize)]
@@ -73,6 +74,28 @@ pub struct RankEntry {
     pub moved: bool,
 }
 
+impl RankEntry {
+    /// An entry of `effect` before its screen: nothing measured yet.
+    pub fn named(effect: &str) -> Self {
+        RankEntry {
+            effect: effect.into(),
+            score: f64::NAN,
+            dof: 0,
+            p_value: f64::NAN,
+            fitted: false,
+            delta_bic: None,
+            holdout_error: None,
+            closure_fraction: None,
+            ci_low: None,
+            ci_high: None,
+            params: Vec::new(),
+            note: None,
+            seconds: 0.0,
+            moved: false,
+        }
+    }
+}
+
 /// A fitted effect parameter.
 #[derive(Clone, Debug, Serialize)]
 pub struct EffectEstimate {
@@ -82,6 +105,89 @@ pub struct EffectEstimate {
     pub ci_low: f64,
     pub ci_high: f64,
     pub unit: String,
+}
+
+/// A fraction with its 95 % interval.
+#[derive(Clone, Copy, Debug, Serialize)]
+pub struct Interval {
+    pub value: f64,
+    pub ci_low: f64,
+    pub ci_high: f64,
+}
+
+/// One step of the explanation: the effect named (or a pair tried together), fitted jointly
+/// with the nominal parameters and every effect named before it.
+#[derive(Clone, Debug, Serialize)]
+pub struct Step {
+    /// 1 for the first step.
+    pub step: usize,
+    /// The effect named at this step (two for a pair tried together).
+    pub effects: Vec<String>,
+    /// The score p-value of the effect(s) at this step's null (the previous step's fit).
+    pub p_value: f64,
+    /// Held-out BIC change against the previous step (negative: better).
+    pub delta_bic: f64,
+    /// Every effect parameter named so far, refitted jointly at this step, 95 % intervals.
+    pub params: Vec<EffectEstimate>,
+    /// The fraction of the previous step's held-out gap this step closes.
+    pub closure: Interval,
+    /// The fraction of the nominal model's held-out gap closed after this step.
+    pub cumulative: Interval,
+    /// Held-out error after this step (noise variances; 1 is the floor).
+    pub holdout_error: f64,
+    /// Held-out error per channel after this step.
+    pub channels: Vec<ChannelError>,
+    /// The simulated gap after this step against the calibrated nominal model (features
+    /// and residual by phase of the cycle).
+    pub simulation_gap: Option<sim_gap::SimulationGap>,
+    /// Why the simulated gap is missing, if it is.
+    pub simulation_gap_note: Option<String>,
+    /// The candidates of this step's round, ranked.
+    pub ranking: Vec<RankEntry>,
+    pub seconds: f64,
+    /// Residual series after this step, for the report.
+    #[serde(skip)]
+    pub eval: Option<Eval>,
+}
+
+/// The verdict.
+#[derive(Clone, Debug, Serialize)]
+pub struct Verdict {
+    /// `effect`, `unexplained` or `no_significant_gap`.
+    pub verdict: String,
+    /// The leading effect (for `effect`, the first named; for `unexplained`, the best
+    /// candidate tried).
+    pub effect: Option<String>,
+    /// Every effect named, in the order of the steps (empty unless `effect`).
+    pub effects: Vec<String>,
+    /// Whether a significant gap remains that the named effects do not explain (always for
+    /// `unexplained`, never for `no_significant_gap`).
+    pub unexplained_remainder: bool,
+    pub closure_fraction: Option<f64>,
+    pub ci_low: Option<f64>,
+    pub ci_high: Option<f64>,
+    /// Held-out error of the nominal model in noise variances (1: the noise floor).
+    pub gap: f64,
+    pub reason: String,
+}
+
+/// A candidate's screen and fit.
+pub struct Assessed {
+    pub entry: RankEntry,
+    /// The fitted model's evaluation on the record.
+    pub eval: Option<Eval>,
+    /// The fit: the joint variables at the optimum, every effect parameter of the problem
+    /// (the accepted ones refitted, then the candidate's), the shape setting it started from.
+    pub fit: Option<SetFit>,
+}
+
+/// The joint fit of a candidate set on a basis.
+#[derive(Clone, Debug)]
+pub struct SetFit {
+    pub effects: Vec<&'static EffectInfo>,
+    pub x: Vec<f64>,
+    pub params: Vec<EffectEstimate>,
+    pub shapes: Vec<(&'static str, f64)>,
 }
 
 /// The diagnosis.
@@ -98,8 +204,13 @@ pub struct Diagnosis {
     /// Why the simulated gap is missing, if it is.
     pub simulation_gap_note: Option<String>,
     pub localization: localize::Localization,
+    /// The first round's candidates (on the nominal calibration), ranked.
     pub ranking: Vec<RankEntry>,
-    pub verdict: verdict::Verdict,
+    /// The explanation step by step (empty when no effect closes a significant part).
+    pub steps: Vec<Step>,
+    /// After the last step, the round that named nothing more, ranked (empty without steps).
+    pub remainder: Vec<RankEntry>,
+    pub verdict: Verdict,
     /// Fits run (the nominal calibration and every joint fit).
     pub fits: usize,
     pub seconds: f64,

@@ -31,6 +31,8 @@ pub enum FitError {
     Start(String),
     #[error("unknown parameter `{name}` of model `{model}`: see `stirling info {model}`")]
     UnknownParameter { name: String, model: String },
+    #[error("parameter `{name}` is named twice in the free parameters: name each once")]
+    DuplicateFree { name: String },
     #[error(
         "parameter `{name}` does not enter the equations of `{model}`: it cannot be identified"
     )]
@@ -48,6 +50,13 @@ pub enum FitError {
     },
     #[error("{file}: the training block ({seconds:.3} s) holds fewer than two cycles of the motion: the record is too short (or does not oscillate) to identify the dynamics")]
     TooFewCycles { file: String, seconds: f64 },
+    #[error("{file}: the record samples at {rate:.4} Hz, {per_cycle:.1} samples per cycle of its {freq:.4} Hz motion: too coarse to follow the cycle (at least {} samples per cycle are needed; a record sampled below twice the engine's frequency shows an alias of the motion, not the motion): record at a higher rate, or check the time column's unit", excitation::MIN_SAMPLES_PER_CYCLE)]
+    Undersampled {
+        file: String,
+        rate: f64,
+        freq: f64,
+        per_cycle: f64,
+    },
     #[error("the training block {from}:{to} holds {samples} samples, fewer than 11")]
     ShortTraining { from: f64, to: f64, samples: usize },
     #[error("{file}: {stage} needs the columns p, x and y")]

@@ -7,6 +7,12 @@ use super::FitError;
 use crate::data::Measured;
 use crate::signal::{cycle_frequency, noise_sigma};
 
+/// Least samples per cycle of the recorded motion: below it the record cannot follow the
+/// cycle, and a record sampled below twice the engine's frequency shows an alias of the motion
+/// (a 13.4 Hz engine sampled at 1 Hz shows a 0.4 Hz oscillation of 2.5 samples per cycle,
+/// which a fit took for a soft spring: kd 55.8 against 650.7).
+pub const MIN_SAMPLES_PER_CYCLE: f64 = 10.0;
+
 /// Least ratio of a channel's standard deviation to its noise level on the training block.
 pub const MIN_SIGNAL_TO_NOISE: f64 = 5.0;
 
@@ -33,10 +39,19 @@ pub fn check(data: &Measured, tr: (usize, usize), dt: f64) -> Result<(), FitErro
         .iter()
         .filter_map(|c| data.channel(c))
         .find_map(|v| cycle_frequency(&v[tr.0..=tr.1], dt));
-    if cycles.is_none() {
+    let Some(freq) = cycles else {
         return Err(FitError::TooFewCycles {
             file: data.source.clone(),
             seconds: (tr.1 - tr.0) as f64 * dt,
+        });
+    };
+    let per_cycle = 1.0 / (freq * dt);
+    if per_cycle < MIN_SAMPLES_PER_CYCLE {
+        return Err(FitError::Undersampled {
+            file: data.source.clone(),
+            rate: 1.0 / dt,
+            freq,
+            per_cycle,
         });
     }
     Ok(())

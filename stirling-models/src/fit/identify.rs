@@ -376,6 +376,11 @@ pub fn identify_stages<'a>(
     let layout = StateLayout::working_gas(model);
     let rec = Record::new(model, &layout, p0, data, opts)?;
     let free = opts.free.clone().unwrap_or_else(|| default_free(model, p0));
+    if let Some(name) = first_duplicate(&free) {
+        // a parameter freed twice gets two columns of one Jacobian: its interval would be
+        // taken from a rank-deficient problem
+        return Err(FitError::DuplicateFree { name });
+    }
     check_bounds(model, p0, &free, &opts.bounds)?;
     let (mech, gas_free) = classify(model, p0, &free)?;
     let run = Run {
@@ -427,4 +432,13 @@ pub fn identify_stages<'a>(
         notes,
     };
     Ok((id, st.fitted))
+}
+
+/// The first name that appears twice in `names`.
+pub(crate) fn first_duplicate(names: &[String]) -> Option<String> {
+    names
+        .iter()
+        .enumerate()
+        .find(|(i, n)| names[..*i].contains(n))
+        .map(|(_, n)| n.clone())
 }

@@ -169,6 +169,12 @@ pub fn solve_with(
         r = rn;
     }
     let residual = f.iter().fold(0.0, |m: f64, v| m.max(v.abs()));
+    if let Err(crate::sim::SimError::Nonphysical {
+        quantity, value, ..
+    }) = crate::sim::physical::check_physical(model, p, 0.0, &x)
+    {
+        return Err(LinearError::Nonphysical { quantity, value });
+    }
     Ok(Equilibrium {
         x,
         residual,

@@ -84,6 +84,8 @@ pub enum LinearError {
         residual: f64,
         tol: f64,
     },
+    #[error("equilibrium is not physical: the {quantity} is {value:.4e} there (volumes, pressures, temperatures and masses must be positive); the parameters put the engine outside its working range: check the values you set (e.g. the bounce pressure against the mean pressure, spring rates)")]
+    Nonphysical { quantity: String, value: f64 },
     #[error("equilibrium: the Newton system is singular at iteration {iteration}")]
     Singular { iteration: usize },
     #[error("non-finite values in the {what}")]

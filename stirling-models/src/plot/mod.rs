@@ -25,3 +25,5 @@ pub mod series;
 pub mod sweep_map;
 /// Start-up time response (x, y, pressures against time).
 pub mod timeseries;
+/// The diagnosis's gap, step by step.
+pub mod waterfall;

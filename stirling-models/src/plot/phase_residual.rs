@@ -78,7 +78,12 @@ fn draw_panel(
     c.draw_series(LineSeries::new(vec![(0.0, 0.0), (360.0, 0.0)], BLACK))
         .map_err(|e| err(&e))?;
     for (li, (name, v)) in panel.lines.iter().enumerate() {
-        let color = if li == 0 { BLUE } else { RED };
+        // the calibrated model in blue; after it, red, then the palette's other colours
+        let color = match li {
+            0 => BLUE.to_rgba(),
+            1 => RED.to_rgba(),
+            k => Palette99::pick(k + 1).to_rgba(),
+        };
         let bin = 360.0 / v.len().max(1) as f64;
         let pts: Vec<(f64, f64)> = v
             .iter()

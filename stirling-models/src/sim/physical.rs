@@ -58,8 +58,9 @@ impl<'m> PhysicalCheck<'m> {
         let (pr, vol, temp) = &mut *guard;
         self.model.pv(self.p, x, pr, vol);
         for i in 0..pr.len() {
-            // a space declared without a rest volume (the bounce space) only counts displacement
-            if self.rest[i] > 0.0 && !(vol[i] > 0.0) {
+            // a space declared without a rest volume (the bounce space) only counts
+            // displacement; a CV element (the first `n_cv` vessels) always holds gas
+            if (i < self.n_cv || self.rest[i] > 0.0) && !(vol[i] > 0.0) {
                 return bad(format!("volume of `{}` (m^3)", self.vessel(i)), vol[i]);
             }
             if !(pr[i] > 0.0) {

@@ -68,6 +68,10 @@ pub struct Sweep {
     #[serde(default)]
     pub units: Vec<String>,
     pub ties: Vec<Tie>,
+    /// The base parameters every point starts from (name, value), before its axes and ties:
+    /// shards of one sweep share them (empty in files written before they were recorded).
+    #[serde(default)]
+    pub base: Vec<(String, f64)>,
     /// Points in the whole grid.
     pub total: usize,
     /// The shard these results are (`None`: the whole grid, or merged shards).
@@ -126,10 +130,37 @@ pub fn run(
             .map(|i| model.params()[i].unit.to_string())
             .collect(),
         ties: opts.ties.clone(),
+        base: model
+            .params()
+            .iter()
+            .zip(base)
+            .map(|(q, v)| (q.name.to_string(), *v))
+            .collect(),
         total,
         shard: opts.shard,
         points,
     })
+}
+
+/// A shard as `i/N` (`whole grid` without one).
+fn shard_label(shard: Option<(usize, usize)>) -> String {
+    shard.map_or("(whole grid)".into(), |(i, n)| format!("{i}/{n}"))
+}
+
+/// The first base parameter that differs between two shards, as `name a here, b there`.
+fn base_difference(a: &[(String, f64)], b: &[(String, f64)]) -> Option<String> {
+    if a.len() != b.len() {
+        return Some(format!("{} against {} parameters", a.len(), b.len()));
+    }
+    a.iter()
+        .zip(b)
+        .find(|(x, y)| x.0 != y.0 || x.1.to_bits() != y.1.to_bits())
+        .map(|(x, y)| {
+            format!(
+                "`{}` {:e} in the first, `{}` {:e} in this one",
+                x.0, x.1, y.0, y.1
+            )
+        })
 }
 
 /// Every axis and tie names a parameter of the model, no axis twice.
@@ -174,8 +205,16 @@ pub fn merge(parts: Vec<Sweep>) -> Result<Sweep, SweepError> {
         if !same || p.ties != out.ties || p.total != out.total {
             return Err(SweepError::Merge {
                 why: format!(
-                    "shard {:?} is of another sweep (model, n, axes, ties or grid size differ)",
-                    p.shard
+                    "shard {} is of another sweep (model, n, axes, ties or grid size differ)",
+                    shard_label(p.shard)
+                ),
+            });
+        }
+        if let Some(why) = base_difference(&out.base, &p.base) {
+            return Err(SweepError::Merge {
+                why: format!(
+                    "shard {} was run from other base parameters ({why}): it belongs to another sweep",
+                    shard_label(p.shard)
                 ),
             });
         }

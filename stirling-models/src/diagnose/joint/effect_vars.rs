@@ -4,7 +4,7 @@
 
 use stirling_dsl::Model;
 
-use super::{is_mechanics, EffectVar};
+use super::{is_mechanics, EffectAt, EffectVar};
 use crate::diagnose::DiagnoseError;
 use crate::effects::{EffectInfo, EffectTarget};
 use crate::fit::sensitivity::Signal;
@@ -21,20 +21,48 @@ pub(super) struct EffectVars {
 }
 
 impl EffectVars {
-    /// The effect's strengths (and, with `free_shapes`, its shapes) and where they enter.
+    /// The variables of the effects accepted so far (`base`, their shapes free) and of the
+    /// candidates (their strengths and, with `free_shapes`, their shapes), and where they
+    /// enter.
     pub fn of(
         model: &dyn Model,
         nominal: &[FittedStage],
-        e: &EffectInfo,
-        shapes: &[(&str, f64)],
+        base: &[EffectAt],
+        cands: &[EffectAt],
         free_shapes: bool,
     ) -> Result<Self, DiagnoseError> {
-        let n_nom: usize = nominal.iter().map(|s| s.stage.vars.len()).sum();
         let mut v = EffectVars {
             effect: Vec::new(),
             adds: Vec::new(),
             linked: Vec::new(),
         };
+        for a in base {
+            v.add(
+                model,
+                nominal,
+                a.effect,
+                &a.shapes,
+                (!a.shapes.is_empty(), true),
+            )?;
+        }
+        for c in cands {
+            v.add(model, nominal, c.effect, &c.shapes, (free_shapes, false))?;
+        }
+        Ok(v)
+    }
+
+    /// Add the variables of one effect (`free_shapes`: fit its shapes; `base`: an accepted
+    /// effect, a nuisance of the problem rather than its candidate).
+    fn add(
+        &mut self,
+        model: &dyn Model,
+        nominal: &[FittedStage],
+        e: &EffectInfo,
+        shapes: &[(&str, f64)],
+        (free_shapes, base): (bool, bool),
+    ) -> Result<(), DiagnoseError> {
+        let n_nom: usize = nominal.iter().map(|s| s.stage.vars.len()).sum();
+        let v = self;
         for q in e.params {
             let shape_value = shapes.iter().find(|(n, _)| *n == q.name).map(|s| s.1);
             let (initial, scale) = match (q.null, shape_value) {
@@ -54,6 +82,7 @@ impl EffectVars {
                 scale,
                 bounded: q.null.is_some() && !q.name.starts_with("gain"),
                 shape: q.null.is_none(),
+                base,
                 unit: q.unit.into(),
             });
             for (si, st) in nominal.iter().enumerate() {
@@ -80,7 +109,7 @@ impl EffectVars {
                 });
             }
         }
-        Ok(v)
+        Ok(())
     }
 
     /// Nominal stage `si` extended by the effect's variables, with the joint index of each

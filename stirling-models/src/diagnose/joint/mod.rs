@@ -41,6 +41,9 @@ pub struct EffectVar {
     pub bounded: bool,
     /// A shape parameter (end-stop travel): not a strength; not tested, only fitted.
     pub shape: bool,
+    /// A variable of an effect accepted at an earlier step ([`Basis`]): fitted with the
+    /// nominal variables, never tested.
+    pub base: bool,
     pub unit: String,
     /// The range the model declares for it (`in lo..hi`): the joint fit starts and stays
     /// inside.
@@ -60,6 +63,32 @@ impl EffectVar {
     }
 }
 
+/// An effect with the shape setting (end-stop travels) it is fitted from: a candidate, or
+/// one accepted at an earlier step of the diagnosis.
+#[derive(Clone, Debug)]
+pub struct EffectAt {
+    pub effect: &'static EffectInfo,
+    pub shapes: Vec<(&'static str, f64)>,
+}
+
+/// What a candidate extends: the nominal stages with the effects accepted so far, at their
+/// joint optimum `x` (every nominal stage's variables, then the accepted effects' variables).
+#[derive(Clone, Debug)]
+pub struct Basis {
+    pub effects: Vec<EffectAt>,
+    pub x: Vec<f64>,
+}
+
+impl Basis {
+    /// The nominal calibration: no effect accepted.
+    pub fn nominal(nominal: &[FittedStage]) -> Self {
+        Basis {
+            effects: Vec::new(),
+            x: nominal.iter().flat_map(|s| s.u.iter().copied()).collect(),
+        }
+    }
+}
+
 /// The stacked problem.
 #[derive(Clone)]
 pub struct Joint<'a> {
@@ -74,6 +103,8 @@ pub struct Joint<'a> {
     /// Where stage 1 reads the gas stage's pressure differences, when both are in the
     /// problem (records without `p_hot`; see [`Joint::rebase`]).
     dp_link: Option<rebase::DpLink>,
+    /// The basis's optimum: the start of the candidate's variables at their null.
+    base_x: Vec<f64>,
 }
 
 /// Whether a stage is the mechanics stage (positions out, pressures in).
@@ -93,21 +124,29 @@ pub fn variance_factor(st: &FittedStage) -> Result<f64, FitError> {
 }
 
 impl<'a> Joint<'a> {
-    /// Extend the nominal stages by the variables of `e` (`shapes`: values of the effect's
-    /// shape parameters; `free_shapes`: fit them too). `s2`: the nominal variance factors.
+    /// Extend the nominal stages by the variables of the accepted effects of `basis` and of
+    /// the candidates `cands` (one effect, or a pair tried together; `free_shapes`: fit their
+    /// shape parameters too). `s2`: the nominal variance factors. With accepted effects, stage 1's pressure
+    /// differences are taken at the basis's optimum ([`Joint::rebase`]).
     pub fn new(
         model: &dyn Model,
         nominal: &[FittedStage<'a>],
         s2: &[f64],
-        e: &EffectInfo,
-        shapes: &[(&str, f64)],
+        basis: &Basis,
+        cands: &[EffectAt],
         free_shapes: bool,
     ) -> Result<Self, DiagnoseError> {
-        let vars = EffectVars::of(model, nominal, e, shapes, free_shapes)?;
+        let vars = EffectVars::of(model, nominal, &basis.effects, cands, free_shapes)?;
+        let all_shapes: Vec<(&str, f64)> = basis
+            .effects
+            .iter()
+            .chain(cands)
+            .flat_map(|a| a.shapes.iter().copied())
+            .collect();
         let n_nom: usize = nominal.iter().map(|s| s.stage.vars.len()).sum();
         let (mut stages, mut map, mut weight) = (Vec::new(), Vec::new(), Vec::new());
         for (si, st) in nominal.iter().enumerate() {
-            let Some((ext, m)) = vars.extend(model, nominal, si, st, shapes) else {
+            let Some((ext, m)) = vars.extend(model, nominal, si, st, &all_shapes) else {
                 continue;
             };
             map.push(m);
@@ -115,28 +154,39 @@ impl<'a> Joint<'a> {
             stages.push((si, ext));
         }
         let dp_link = rebase::DpLink::of(&stages, &map);
-        Ok(Joint {
+        let mut joint = Joint {
             stages,
             map,
             weight,
             n_vars: n_nom + vars.effect.len(),
             effect: vars.effect,
             dp_link,
-        })
+            base_x: basis.x.clone(),
+        };
+        if !basis.effects.is_empty() {
+            joint.rebase(&joint.start())?;
+        }
+        Ok(joint)
     }
 
-    /// The joint variables at the nominal optimum with the effect at its null.
-    pub fn start(&self, nominal: &[FittedStage]) -> Vec<f64> {
-        let mut u: Vec<f64> = nominal.iter().flat_map(|s| s.u.iter().copied()).collect();
+    /// The joint variables at the basis's optimum (the nominal one, or the last step's), the
+    /// candidate at its null.
+    pub fn start(&self) -> Vec<f64> {
+        let mut u = self.base_x.clone();
         u.resize(self.n_vars, 0.0);
         u
+    }
+
+    /// The candidates' variables (those of no accepted effect).
+    pub fn candidate(&self) -> impl Iterator<Item = &EffectVar> {
+        self.effect.iter().filter(|v| !v.base)
     }
 
     /// [`Joint::start`] with the nominal model parameters back at their starting values (the
     /// engineering estimates): a start in the effect's own basin when the nominal calibration
     /// absorbed the effect into parameters that moved far (a leak into the heat transfer).
-    pub fn reset_start(&self, nominal: &[FittedStage]) -> Vec<f64> {
-        let mut u = self.start(nominal);
+    pub fn reset_start(&self) -> Vec<f64> {
+        let mut u = self.start();
         let n_nom = self.n_vars - self.effect.len();
         for (k, (_, st)) in self.stages.iter().enumerate() {
             for (v, &i) in st.stage.vars.iter().zip(&self.map[k]) {

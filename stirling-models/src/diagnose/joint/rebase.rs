@@ -133,7 +133,7 @@ impl Joint<'_> {
         let free: Vec<usize> = (0..jacobian.ncols())
             .filter(|c| !fixed.contains(c))
             .collect();
-        let Some(var) = crate::diagnose::rank::covariance_diagonal(jacobian, &free) else {
+        let Some(var) = crate::diagnose::covariance::covariance_diagonal(jacobian, &free) else {
             return f64::INFINITY;
         };
         self.map[link.gas]

@@ -110,12 +110,7 @@ impl Bench<'_> {
             .iter()
             .position(|r| r.effect == truth)
             .map(|i| i + 1);
-        let verdict = d
-            .verdict
-            .effect
-            .clone()
-            .filter(|_| d.verdict.verdict == "effect")
-            .unwrap_or_else(|| d.verdict.verdict.clone());
+        let verdict = super::outcome::verdict_label(&d);
         let entry = d.ranking.iter().find(|r| r.effect == truth);
         let fitted = entry
             .map(|r| {

@@ -18,6 +18,22 @@ pub struct Confusion {
     /// naming a gap is an alarm on a clean record).
     pub clean: usize,
     pub false_alarms: usize,
+    /// Per class of record (`single`, `pair`, `outside`, `clean`): right and total.
+    pub classes: Vec<(String, usize, usize)>,
+}
+
+/// The class of a truth label: `clean`, `outside` (`outside:NAME`), `pair` (`a+b`),
+/// `single`.
+pub fn class_of(label: &str) -> &'static str {
+    if label == "clean" {
+        "clean"
+    } else if label.starts_with("outside:") {
+        "outside"
+    } else if label.contains('+') {
+        "pair"
+    } else {
+        "single"
+    }
 }
 
 impl Confusion {
@@ -43,7 +59,17 @@ impl Confusion {
             counts[r][c] += 1;
         }
         let clean: Vec<_> = cases.iter().filter(|(t, _, _)| t == "clean").collect();
+        let classes = ["single", "pair", "outside", "clean"]
+            .iter()
+            .map(|k| {
+                let of: Vec<_> = cases.iter().filter(|(t, _, _)| class_of(t) == *k).collect();
+                let right = of.iter().filter(|(_, e, v)| e == v).count();
+                (k.to_string(), right, of.len())
+            })
+            .filter(|(_, _, n)| *n > 0)
+            .collect();
         Confusion {
+            classes,
             rows,
             columns,
             counts,

@@ -7,11 +7,12 @@ use std::time::Instant;
 use serde::Serialize;
 use stirling_dsl::Model;
 
-use super::plan::{Planned, Split, Truth, VerdictOptions};
+use super::plan::{set_label, Planned, Split, Truth, VerdictOptions};
 use super::record::{record, seeded_start, signature, Signature};
 use crate::diagnose::run::diagnose;
+use crate::diagnose::steps::MIN_STEP_CLOSURE;
 use crate::diagnose::types::{Diagnosis, RankEntry};
-use crate::diagnose::verdict::{pick, Pick, Thresholds};
+use crate::diagnose::verdict::{pick, Pick, Thresholds, GROSS_GAP};
 use crate::diagnose::DiagnoseError;
 
 /// One case of the verdict self-check.
@@ -42,12 +43,38 @@ pub struct Outcome {
     pub ci_high: Option<f64>,
     /// Rank of the withheld effect (1 = first), if it is a library effect.
     pub truth_rank: Option<usize>,
-    /// The ranking (what the thresholds are tuned on).
+    /// The first round's ranking (what the thresholds are tuned on).
     pub ranking: Vec<RankEntry>,
+    /// The steps of the explanation (what the thresholds re-decide).
+    pub steps: Vec<StepBrief>,
+    /// The nominal model's held-out error (noise variances).
+    pub gap: f64,
     pub signature: Signature,
     pub seconds: f64,
     /// Set when the case failed to run (rig or diagnosis error): counted as wrong.
     pub error: Option<String>,
+}
+
+/// What the thresholds re-decide of one step of the explanation.
+#[derive(Clone, Debug, Serialize)]
+pub struct StepBrief {
+    pub effects: Vec<String>,
+    pub p_value: f64,
+    pub delta_bic: f64,
+    /// Lower bound of the step's closure of what remained.
+    pub ci_low: f64,
+    /// Lower bound of the cumulative closure after the step.
+    pub cumulative_low: f64,
+}
+
+/// The verdict label of a diagnosis: the set of named effects (`a+b`), `unexplained` or
+/// `no_significant_gap`.
+pub fn verdict_label(d: &Diagnosis) -> String {
+    if d.verdict.verdict == "effect" && !d.verdict.effects.is_empty() {
+        set_label(&d.verdict.effects)
+    } else {
+        d.verdict.verdict.clone()
+    }
 }
 
 /// A verdict label from the rule's pick.
@@ -60,12 +87,33 @@ pub fn label_of(p: Pick<'_>) -> String {
 }
 
 impl Outcome {
-    /// The verdict of this case under `th` (an errored case keeps `error`).
+    /// The verdict of this case under `th` (an errored case keeps `error`): the steps that
+    /// still clear the rule with `th`'s level and BIC bound, named when their cumulative
+    /// closure clears `th`'s closure bound; without steps, the first round's pick.
     pub fn relabel(&self, th: &Thresholds) -> String {
         if self.error.is_some() {
             return "error".into();
         }
-        label_of(pick(&self.ranking, self.candidates, th))
+        if self.steps.is_empty() {
+            return label_of(pick(&self.ranking, self.candidates, self.gap, th));
+        }
+        let level = th.alpha / self.candidates.max(1) as f64;
+        let mut named = Vec::new();
+        let mut cumulative = f64::NEG_INFINITY;
+        for s in &self.steps {
+            if !(s.p_value < level && s.delta_bic < th.strong_bic && s.ci_low > MIN_STEP_CLOSURE) {
+                break;
+            }
+            named.extend(s.effects.iter().cloned());
+            cumulative = s.cumulative_low;
+        }
+        if !named.is_empty() && cumulative > th.min_closure {
+            set_label(&named)
+        } else if self.ranking.iter().any(|r| r.p_value < level) || self.gap > GROSS_GAP {
+            "unexplained".into()
+        } else {
+            "no_significant_gap".into()
+        }
     }
 
     fn blank(c: &Planned) -> Self {
@@ -87,6 +135,8 @@ impl Outcome {
             ci_high: None,
             truth_rank: None,
             ranking: Vec::new(),
+            steps: Vec::new(),
+            gap: 0.0,
             signature: Signature::default(),
             seconds: 0.0,
             error: None,
@@ -102,12 +152,19 @@ impl Outcome {
         self.truth_rank = name
             .as_ref()
             .and_then(|n| d.ranking.iter().position(|r| &r.effect == n).map(|i| i + 1));
-        self.verdict = d
-            .verdict
-            .effect
-            .clone()
-            .filter(|_| d.verdict.verdict == "effect")
-            .unwrap_or(d.verdict.verdict.clone());
+        self.verdict = verdict_label(&d);
+        self.gap = d.verdict.gap;
+        self.steps = d
+            .steps
+            .iter()
+            .map(|s| StepBrief {
+                effects: s.effects.clone(),
+                p_value: s.p_value,
+                delta_bic: s.delta_bic,
+                ci_low: s.closure.ci_low,
+                cumulative_low: s.cumulative.ci_low,
+            })
+            .collect();
         self.tuned_verdict = self.verdict.clone();
         self.top = d.ranking.first().map(|r| r.effect.clone());
         // the closure of the truth when it was fitted, else of the leading candidate

@@ -26,6 +26,15 @@ pub enum Truth {
     Effect { name: String, strength: f64 },
     /// A cause outside the library at `strength` times its unit ([`crate::outside::OUTSIDE`]).
     Outside { name: String, strength: f64 },
+    /// Two library effects at once, each at `strength` times its self-check unit.
+    Pair { names: Vec<String>, strength: f64 },
+}
+
+/// The label of a set of named effects: the names in alphabetical order, joined by `+`.
+pub fn set_label(names: &[String]) -> String {
+    let mut v = names.to_vec();
+    v.sort();
+    v.join("+")
 }
 
 impl Truth {
@@ -35,6 +44,17 @@ impl Truth {
             Truth::Clean => "clean".into(),
             Truth::Effect { name, .. } => name.clone(),
             Truth::Outside { name, .. } => format!("outside:{name}"),
+            Truth::Pair { names, .. } => set_label(names),
+        }
+    }
+
+    /// The class of the record: `clean`, `single`, `pair`, `outside`.
+    pub fn class(&self) -> &'static str {
+        match self {
+            Truth::Clean => "clean",
+            Truth::Effect { .. } => "single",
+            Truth::Pair { .. } => "pair",
+            Truth::Outside { .. } => "outside",
         }
     }
 
@@ -44,13 +64,16 @@ impl Truth {
             Truth::Clean => "no_significant_gap".into(),
             Truth::Effect { name, .. } => name.clone(),
             Truth::Outside { .. } => "unexplained".into(),
+            Truth::Pair { names, .. } => set_label(names),
         }
     }
 
     pub fn strength(&self) -> f64 {
         match self {
             Truth::Clean => 0.0,
-            Truth::Effect { strength, .. } | Truth::Outside { strength, .. } => *strength,
+            Truth::Effect { strength, .. }
+            | Truth::Outside { strength, .. }
+            | Truth::Pair { strength, .. } => *strength,
         }
     }
 }
@@ -80,6 +103,8 @@ pub struct VerdictOptions {
     pub outside: Option<Vec<String>>,
     /// Strengths of the outside causes, as multiples of their unit.
     pub outside_strengths: Vec<f64>,
+    /// Every pair of the library effects at this multiple of their units (`None`: no pairs).
+    pub pair_strength: Option<f64>,
     /// Noise seeds per effect / outside case in the tuning and the evaluation set.
     pub seeds: (usize, usize),
     /// Clean records in the tuning and the evaluation set (each its own seed and start).
@@ -106,6 +131,7 @@ impl Default for VerdictOptions {
             strengths: vec![1.0, 2.0],
             outside: None,
             outside_strengths: vec![1.0],
+            pair_strength: Some(1.0),
             seeds: (1, 1),
             clean: (10, 20),
             t_end: 2.0,
@@ -190,6 +216,14 @@ fn split_cases(
                 ));
             }
         }
+        if let Some(m) = opts.pair_strength {
+            for (i, a) in effects.iter().enumerate() {
+                for b in &effects[i + 1..] {
+                    let names = vec![a.clone(), b.clone()];
+                    out.push((Truth::Pair { names, strength: m }, split, base + s));
+                }
+            }
+        }
         for name in outside {
             for &m in &opts.outside_strengths {
                 out.push((
@@ -213,7 +247,12 @@ pub fn plan(opts: &VerdictOptions) -> Result<Vec<Planned>, DiagnoseError> {
     let effects = effect_names(opts)?;
     let outside = outside_names(opts)?;
     let mut cases = split_cases(opts, Split::Tune, &effects, &outside);
-    cases.extend(split_cases(opts, Split::Eval, &effects, &outside));
+    let eval = split_cases(opts, Split::Eval, &effects, &outside);
+    if eval.is_empty() {
+        // refused before the tuning set runs, not after it
+        return Err(DiagnoseError::EmptyEvaluation);
+    }
+    cases.extend(eval);
     Ok(cases
         .into_iter()
         .enumerate()
@@ -263,6 +302,16 @@ mod tests {
             .iter()
             .filter(|c| c.split == Split::Eval)
             .all(|c| !tune.contains(&c.seed)));
+    }
+
+    #[test]
+    fn an_empty_evaluation_set_is_refused_up_front() {
+        let o = VerdictOptions {
+            seeds: (1, 0),
+            clean: (2, 0),
+            ..Default::default()
+        };
+        assert!(matches!(plan(&o), Err(DiagnoseError::EmptyEvaluation)));
     }
 
     #[test]

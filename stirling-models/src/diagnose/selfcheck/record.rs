@@ -47,6 +47,13 @@ pub fn rig_config(opts: &VerdictOptions, c: &Planned) -> RigConfig {
             effects: verdict_settings(name, *strength),
             ..base
         },
+        Truth::Pair { names, strength } => RigConfig {
+            effects: names
+                .iter()
+                .flat_map(|n| verdict_settings(n, *strength))
+                .collect(),
+            ..base
+        },
         Truth::Outside { name, strength } => {
             let set = outside(name)
                 .map(|o| vec![format!("{}={}", o.param, strength * o.typical)])

@@ -43,12 +43,24 @@ pub fn case_row(c: &Outcome) -> String {
     )
 }
 
+/// Right / total per class of record on the evaluation set.
+fn class_line(v: &VerdictCheck) -> String {
+    v.eval
+        .classes
+        .iter()
+        .map(|(k, r, n)| format!("{k} {r}/{n} ({})", pct(*r as f64 / *n as f64)))
+        .collect::<Vec<_>>()
+        .join(", ")
+}
+
 /// The summary lines: accuracy and false alarms on the evaluation set.
 pub fn headline(v: &VerdictCheck) -> String {
     let t = &v.tuned.thresholds;
+    let classes = class_line(v);
     format!(
         "evaluation set: verdicts right {}/{} ({}), false alarms on clean records {}/{} ({}); with the diagnosis's default thresholds {}/{} right, {}/{} false alarms\n\
          thresholds tuned on {} tuning cases: score level {:.1e} (family-wise), held-out BIC change < {}, closure lower bound > {} ({}/{} right there)\n\
+         by class: {classes}\n\
          {} cases, {:.0} s wall, {:.0} s summed over cases",
         v.eval.right, v.eval.total, pct(v.eval.accuracy()), v.eval.false_alarms, v.eval.clean, pct(v.eval.false_alarm_rate()),
         v.eval_default.right, v.eval_default.total, v.eval_default.false_alarms, v.eval_default.clean,

@@ -1,0 +1,143 @@
+//! Answers that would look right and are not are refused with the cause (issue 38, "wrong
+//! answers with exit 0"): an equilibrium outside the physical range (a bounce pressure of
+//! 100 bar puts the gas volume below zero), a parameter freed twice (its interval would come
+//! from a rank-deficient problem), an effect named twice among the diagnosis's candidates.
+
+mod support;
+
+use support::{fails_with, s, scratch};
+
+/// A short moving record (13.4 Hz), enough for the option checks that come first.
+fn record(name: &str) -> std::path::PathBuf {
+    let dir = scratch(name);
+    let f = dir.join(format!("{name}.csv"));
+    let mut text = String::from("t,p,x,y\n");
+    for k in 0..4000 {
+        let t = k as f64 * 5e-4;
+        let w = (2.0 * std::f64::consts::PI * 13.4 * t).sin();
+        text.push_str(&format!(
+            "{t},{},{},{}\n",
+            101325.0 + 7000.0 * w,
+            0.01 * w,
+            0.008 * w
+        ));
+    }
+    std::fs::write(&f, text).unwrap();
+    f
+}
+
+#[test]
+fn a_nonphysical_equilibrium_is_an_error_naming_the_quantity() {
+    for args in [
+        &["linearize", "cv1", "--set", "Pb=1e7"][..],
+        &["linearize", "cv1", "--set", "Pb=1e7", "--json"][..],
+    ] {
+        fails_with(
+            args,
+            &["equilibrium is not physical", "volume of `gas`", "-1.37"],
+        );
+    }
+}
+
+#[test]
+fn a_parameter_freed_twice_is_refused() {
+    let f = record("dup_free");
+    fails_with(
+        &["fit", "cv1", "--data", s(&f), "--free", "kd,kd"],
+        &["`kd` is named twice"],
+    );
+}
+
+#[test]
+fn an_effect_named_twice_is_refused() {
+    let f = record("dup_effect");
+    fails_with(
+        &[
+            "diagnose",
+            "nsection",
+            "--n",
+            "2",
+            "--data",
+            s(&f),
+            "--effects",
+            "leak,leak",
+        ],
+        &["effect `leak` is named twice"],
+    );
+}
+
+#[test]
+fn a_record_too_coarse_for_its_cycle_is_refused() {
+    // 13.4 Hz sampled at 120 Hz: 9 samples per cycle
+    let dir = scratch("coarse");
+    let f = dir.join("coarse.csv");
+    let mut text = String::from("t,p,x,y\n");
+    for k in 0..1200 {
+        let t = k as f64 / 120.0;
+        let w = (2.0 * std::f64::consts::PI * 13.4 * t).sin();
+        let v = (2.0 * std::f64::consts::PI * 13.4 * t + 1.4).sin();
+        text.push_str(&format!(
+            "{t},{},{},{}\n",
+            101325.0 + 5800.0 * w,
+            0.0079 * v,
+            0.0062 * w
+        ));
+    }
+    std::fs::write(&f, text).unwrap();
+    fails_with(
+        &["fit", "cv1", "--data", s(&f)],
+        &["samples per cycle", "at least 10", "alias"],
+    );
+}
+
+#[test]
+fn the_self_check_keeps_an_earlier_report_without_force() {
+    let dir = scratch("selfcheck_kept");
+    std::fs::write(dir.join("selfcheck.json"), "{}").unwrap();
+    // refused before any case runs
+    fails_with(
+        &["diagnose", "--self-check", "--out", s(&dir)],
+        &["selfcheck.json", "pass --force"],
+    );
+    assert_eq!(
+        std::fs::read_to_string(dir.join("selfcheck.json")).unwrap(),
+        "{}"
+    );
+}
+
+#[test]
+fn shards_run_from_other_base_parameters_are_not_merged() {
+    let dir = scratch("merge_base");
+    let (a, b) = (dir.join("a"), dir.join("b"));
+    for (out, shard, extra) in [(&a, "1/2", None), (&b, "2/2", Some("kd=700"))] {
+        let mut args = vec![
+            "sweep",
+            "cv1",
+            "--grid",
+            "Th=500:700:4",
+            "--shard",
+            shard,
+            "--out",
+            s(out),
+        ];
+        if let Some(set) = extra {
+            args.extend(["--set", set]);
+        }
+        let run = support::stirling(&args);
+        assert!(
+            run.status.success(),
+            "{}",
+            String::from_utf8_lossy(&run.stderr)
+        );
+    }
+    fails_with(
+        &[
+            "sweep-merge",
+            s(&a.join("sweep.json")),
+            s(&b.join("sweep.json")),
+            "--out",
+            s(&dir.join("merged")),
+        ],
+        &["shard 2/2 was run from other base parameters", "`kd`"],
+    );
+}

@@ -1,0 +1,143 @@
+//! The stepwise diagnosis on records that carry two library effects at once (`nsection`
+//! n = 2, the seed's sensors `p`, `x`, `y`): the verdict a user reads names both effects
+//! and nothing else, with the steps that named them; a clean record still gives
+//! `no_significant_gap` and names nothing. The wider self-check (every pair) is in
+//! docs/diagnosis.md, "Several effects at once".
+
+use stirling::models::diagnose::selfcheck::record::{seeded_start, through_csv};
+use stirling::models::diagnose::selfcheck::verdict_settings;
+use stirling::models::diagnose::{diagnose, nominal_model, DiagnoseOptions, Diagnosis};
+use stirling::models::rig::{self, RigConfig};
+
+/// A 2 s record at 1 kHz with `effects` (each at `m` times its self-check unit) diagnosed
+/// over `candidates` from a perturbed start.
+fn diagnosed(effects: &[&str], m: f64, seed: u64, candidates: &[&str]) -> Diagnosis {
+    let cfg = RigConfig {
+        model: "nsection".into(),
+        n: Some(2),
+        t_end: 2.0,
+        settle: 0.1,
+        rate: 1000.0,
+        seed,
+        channels: ["p", "x", "y"].map(String::from).to_vec(),
+        effects: effects
+            .iter()
+            .flat_map(|e| verdict_settings(e, m))
+            .collect(),
+        ..Default::default()
+    };
+    let dir = tempdir(seed);
+    let data = through_csv(rig::run(&cfg).unwrap(), &dir, 0).unwrap();
+    let (model, p_nom) = nominal_model("nsection", Some(2)).unwrap();
+    let p0 = seeded_start(model.as_ref(), &p_nom, 0.08, seed ^ 0x5EED);
+    let opts = DiagnoseOptions {
+        effects: Some(candidates.iter().map(|s| s.to_string()).collect()),
+        bootstrap: 200,
+        ..Default::default()
+    };
+    let d = diagnose(model.as_ref(), &p0, &data, &opts).unwrap();
+    let _ = std::fs::remove_dir_all(&dir);
+    eprintln!(
+        "{effects:?}: {} {:?} remainder {} ({}) in {:.1} s",
+        d.verdict.verdict,
+        d.verdict.effects,
+        d.verdict.unexplained_remainder,
+        d.verdict.reason,
+        d.seconds
+    );
+    d
+}
+
+fn tempdir(seed: u64) -> std::path::PathBuf {
+    let dir = std::env::temp_dir().join(format!("stirling-steps-{}-{seed}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+/// The named effects as a sorted set.
+fn named(d: &Diagnosis) -> Vec<String> {
+    let mut v = d.verdict.effects.clone();
+    v.sort();
+    v
+}
+
+/// The steps' record is whole: numbered from 1, each with its closure inside its interval,
+/// the cumulative closure growing, every named effect's parameters estimated.
+fn check_steps(d: &Diagnosis) {
+    assert!(!d.steps.is_empty());
+    let mut last = f64::NEG_INFINITY;
+    for (k, s) in d.steps.iter().enumerate() {
+        assert_eq!(s.step, k + 1);
+        assert!(s.closure.ci_low <= s.closure.value && s.closure.value <= s.closure.ci_high);
+        assert!(s.cumulative.value > last, "cumulative closure must grow");
+        last = s.cumulative.value;
+        assert!(s.params.iter().all(|q| q.value.is_finite()));
+        assert_eq!(s.channels.len(), 3);
+    }
+    let json = serde_json::to_value(d).unwrap();
+    assert_eq!(
+        json["verdict"]["effects"].as_array().unwrap().len(),
+        d.verdict.effects.len()
+    );
+    assert_eq!(json["steps"].as_array().unwrap().len(), d.steps.len());
+}
+
+#[test]
+fn coulomb_friction_and_a_leak_are_both_named() {
+    let d = diagnosed(
+        &["coulomb", "leak"],
+        1.0,
+        41,
+        &["coulomb", "leak", "sensor_gain"],
+    );
+    assert_eq!(d.verdict.verdict, "effect", "{}", d.verdict.reason);
+    assert_eq!(named(&d), ["coulomb", "leak"], "{}", d.verdict.reason);
+    check_steps(&d);
+    // the leak's conductance is recovered within its interval's reach (truth 1e-8)
+    let g = d
+        .steps
+        .last()
+        .unwrap()
+        .params
+        .iter()
+        .find(|q| q.name == "Gleak")
+        .unwrap();
+    assert!((g.value / 1e-8 - 1.0).abs() < 0.3, "Gleak {:e}", g.value);
+}
+
+#[test]
+fn quadratic_regenerator_friction_and_a_pressure_lag_are_both_named() {
+    let d = diagnosed(
+        &["regen_quadratic", "sensor_lag"],
+        1.0,
+        42,
+        &["regen_quadratic", "sensor_lag", "sensor_gain"],
+    );
+    assert_eq!(d.verdict.verdict, "effect", "{}", d.verdict.reason);
+    assert_eq!(
+        named(&d),
+        ["regen_quadratic", "sensor_lag"],
+        "{}",
+        d.verdict.reason
+    );
+    check_steps(&d);
+    let c = d.steps.last().unwrap().cumulative;
+    assert!(c.ci_low > 0.5, "cumulative closure {c:?}");
+}
+
+#[test]
+fn a_clean_record_names_nothing() {
+    let d = diagnosed(
+        &[],
+        1.0,
+        43,
+        &["coulomb", "leak", "sensor_gain", "sensor_lag"],
+    );
+    assert_eq!(
+        d.verdict.verdict, "no_significant_gap",
+        "{}",
+        d.verdict.reason
+    );
+    assert!(d.verdict.effects.is_empty() && d.steps.is_empty());
+    assert!(!d.verdict.unexplained_remainder);
+}
