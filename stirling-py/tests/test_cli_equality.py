@@ -34,7 +34,8 @@ def test_simulation_arrays_equal_the_command_lines(cli, tmp_path):
     # the CSV holds 11 significant digits
     np.testing.assert_allclose(table[:, 0], sim.t, rtol=1e-10, atol=0)
     np.testing.assert_allclose(table[:, 1:], sim.x, rtol=1e-10, atol=1e-300)
-    assert np.array_equal(sim.x[-1], sim.final_state)
+    # the last sample is interpolated at t_end; the final state is the solver's own
+    np.testing.assert_allclose(sim.x[-1], sim.final_state, rtol=1e-6)
 
 
 def test_limit_cycle_equals_the_command_lines(cli):
@@ -57,7 +58,7 @@ def test_fit_gives_the_command_lines_numbers(cli, tmp_path):
     path, rec = record(tmp_path)
     js = cli("fit", "cv1", "--data", str(path), "--json")
     fit = stirling.load("cv1").fit(rec)
-    close(drop_timings(fit.raw), drop_timings(js), 1e-9, "fit")
+    close(drop_timings(fit.raw), drop_timings(js), 1e-12, "fit")
     kd = fit.estimates["kd"]
     assert kd.covers(650.74) and kd.std_error > 0
     cov = fit.stage1.covariance
@@ -68,6 +69,6 @@ def test_diagnosis_gives_the_command_lines_numbers(cli, tmp_path):
     path, rec = record(tmp_path, effects={"sensor_lag": 0.002})
     js = cli("diagnose", "cv1", "--data", str(path), "--json")
     d = stirling.load("cv1").diagnose(rec)
-    close(drop_timings(d.raw), drop_timings(js), 1e-9, "diagnosis")
+    close(drop_timings(d.raw), drop_timings(js), 1e-12, "diagnosis")
     assert d.verdict.verdict == js["verdict"]["verdict"] == "effect"
     assert d.effect == "sensor_lag"
