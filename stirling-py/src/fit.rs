@@ -37,14 +37,16 @@ pub fn bounds(
         }
         match v.extract::<(f64, f64)>() {
             Ok((lo, hi)) if lo.is_finite() && hi.is_finite() && lo < hi => out.push((name, lo, hi)),
-            _ => return Err(Failure::from(ParamError::Parse {
-                path: "bounds".into(),
-                why: format!(
+            _ => {
+                return Err(Failure::from(ParamError::Parse {
+                    path: "bounds".into(),
+                    why: format!(
                     "bounds of `{name}`: expected (lo, hi) with finite numbers lo < hi, found {}",
                     v.repr()?
                 ),
-            })
-            .into()),
+                })
+                .into())
+            }
         }
     }
     Ok(out)

@@ -35,12 +35,19 @@ pub struct Reporter {
     tx: Mutex<Sender<Event>>,
     total: f64,
     last: AtomicU64,
+    /// Whether anyone listens: without a callback no event is sent, so the waiting thread
+    /// wakes only to check for signals (an event per progress step cost a simulated second
+    /// of `nsection` n = 2 about 6 ms of thread wake-ups on 2 cores).
+    listening: bool,
 }
 
 impl Reporter {
     /// Report `done` (out of the total the work was started with); only steps of a
     /// thousandth are sent.
     pub fn at(&self, done: f64) {
+        if !self.listening {
+            return;
+        }
         let step = if self.total > 0.0 {
             (STEPS * done / self.total).clamp(0.0, STEPS) as u64
         } else {
@@ -59,6 +66,9 @@ impl Reporter {
 
     /// Report a line of text.
     pub fn line(&self, line: &str) {
+        if !self.listening {
+            return;
+        }
         self.send(Event::Line(line.to_string()));
     }
 
@@ -88,6 +98,7 @@ where
         tx: Mutex::new(tx),
         total,
         last: AtomicU64::new(0),
+        listening: progress.is_some(),
     };
     let (outcome, caught) = std::thread::scope(|s| {
         let worker = s.spawn(move || {
