@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 
 use anyhow::bail;
 use clap::Args;
-use stirling_models::data::{check_uniform, read_csv_lines};
+use stirling_models::data::check_uniform;
 use stirling_models::diagnose::localize::Localization;
 use stirling_models::diagnose::{self, selfcheck, DiagnoseOptions, Diagnosis, RankEntry};
 
@@ -53,6 +53,11 @@ pub struct DiagnoseArgs {
     /// Overwrite an existing report and figures
     #[arg(long)]
     pub force: bool,
+    /// Replace isolated outlier samples (more than 12 robust sd off the cubic through their
+    /// neighbours) by that interpolation, each named on stderr; without it a record with
+    /// outliers is refused
+    #[arg(long)]
+    pub drop_outliers: bool,
     /// Run the verdict self-check instead of diagnosing a file: rig records (p,x,y) with each
     /// library effect at each strength, with causes outside the library and clean records,
     /// thresholds tuned on the tuning seeds and the confusion matrix of verdicts on the
@@ -140,7 +145,7 @@ pub fn run(a: &DiagnoseArgs) -> anyhow::Result<()> {
     if let Some(dir) = &a.report {
         files::prepare_dir(dir, &REPORT, a.force, "--report")?;
     }
-    let (data, lines) = read_csv_lines(path)?;
+    let (data, lines) = common::read_record(path, a.drop_outliers)?;
     check_uniform(&data, Some(&lines))?;
     let (train, holdout) = common::blocks(a.train.as_deref(), a.holdout.as_deref(), &data, 0.6)?;
     let (model, mut p0) = diagnose::nominal_model(model_name, a.with.n)?;

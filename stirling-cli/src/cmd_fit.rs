@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 
 use clap::Args;
 use stirling_dsl::Closure;
-use stirling_models::data::{check_uniform, read_csv_lines};
+use stirling_models::data::check_uniform;
 use stirling_models::fit::free_run::FreeRun;
 use stirling_models::fit::multiple_shooting::MultipleShooting;
 use stirling_models::fit::report::{Estimate, FitStats};
@@ -52,6 +52,11 @@ pub struct FitArgs {
     /// Overwrite existing figures
     #[arg(long)]
     pub force: bool,
+    /// Replace isolated outlier samples (more than 12 robust sd off the cubic through their
+    /// neighbours) by that interpolation, each named on stderr; without it a record with
+    /// outliers is refused
+    #[arg(long)]
+    pub drop_outliers: bool,
     /// Refine by multiple shooting over segments of about this many cycles (on up to 0.5 s
     /// of the training block) before the free run
     #[arg(long, value_name = "CYCLES", allow_negative_numbers = true, value_parser = ranges::cycles)]
@@ -62,7 +67,7 @@ pub fn run(a: &FitArgs) -> anyhow::Result<()> {
     if let Some(dir) = &a.plot {
         files::prepare_dir(dir, &FIGURES, a.force, "--plot")?;
     }
-    let (data, lines) = read_csv_lines(&a.data)?;
+    let (data, lines) = common::read_record(&a.data, a.drop_outliers)?;
     check_uniform(&data, Some(&lines))?;
     let (train, holdout) = common::blocks(a.train.as_deref(), a.holdout.as_deref(), &data, 0.7)?;
     let model = stirling_models::build(&a.model, a.with.n, Closure::Full)?;

@@ -20,6 +20,25 @@ use anyhow::Context;
 use clap::Args;
 use stirling_dsl::{Closure, Model};
 
+/// Read a record (`--data`) and the file line of each sample; with `drop` (`--drop-outliers`)
+/// its outliers are replaced by their neighbours' interpolation, each named on stderr.
+pub fn read_record(
+    path: &std::path::Path,
+    drop: bool,
+) -> anyhow::Result<(stirling_models::data::Measured, Vec<usize>)> {
+    let (mut data, lines) = stirling_models::data::read_csv_lines(path)?;
+    if drop {
+        for o in stirling_models::data::outliers::repair(&mut data) {
+            let line = lines.get(o.index).copied().unwrap_or(0);
+            note(format_args!(
+                "{}:{line}: dropped an outlier, {o}",
+                path.display()
+            ));
+        }
+    }
+    Ok((data, lines))
+}
+
 /// The bounds of `--bounds FILE` (none without the option).
 pub fn bounds_file(
     model: &dyn Model,

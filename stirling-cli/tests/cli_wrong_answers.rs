@@ -141,3 +141,90 @@ fn shards_run_from_other_base_parameters_are_not_merged() {
         &["shard 2/2 was run from other base parameters", "`kd`"],
     );
 }
+
+/// The record of [`record`] with every time multiplied by `factor`, or one sample of `x`
+/// replaced.
+fn altered(name: &str, factor: f64, x_at: Option<(usize, f64)>) -> std::path::PathBuf {
+    let src = std::fs::read_to_string(record(name)).unwrap();
+    let mut out = String::new();
+    for (i, line) in src.lines().enumerate() {
+        if i == 0 {
+            out.push_str(line);
+        } else {
+            let mut f: Vec<String> = line.split(',').map(String::from).collect();
+            f[0] = format!("{}", f[0].parse::<f64>().unwrap() * factor);
+            if let Some((_, v)) = x_at.filter(|(k, _)| *k + 1 == i) {
+                f[2] = format!("{v}");
+            }
+            out.push_str(&f.join(","));
+        }
+        out.push('\n');
+    }
+    let path = scratch(name).join("altered.csv");
+    std::fs::write(&path, out).unwrap();
+    path
+}
+
+#[test]
+fn a_record_far_from_the_engines_frequency_is_refused_with_the_likely_cause() {
+    // time in milliseconds: the motion looks 1000 times too slow
+    let ms = altered("freq_ms", 1000.0, None);
+    fails_with(
+        &["fit", "cv1", "--data", s(&ms)],
+        &["cycles at", "the model at", "looks like milliseconds"],
+    );
+    // a record whose samples are 1e-12 s apart: it gave NaN correlations and zero-width
+    // intervals
+    let ps = altered("freq_ps", 1e-12 / 5e-4, None);
+    fails_with(
+        &["fit", "cv1", "--data", s(&ps)],
+        &["cycles at", "the model at", "time column's unit"],
+    );
+}
+
+#[test]
+fn an_outlier_sample_is_refused_by_name_not_fitted() {
+    // one position of 0.4 m in a record of millimetres pulled hh to 1136 (truth 500)
+    let f = altered("outlier", 1.0, Some((1500, 0.4)));
+    fails_with(
+        &["fit", "cv1", "--data", s(&f)],
+        &["1 outlier sample", "`x` at sample 1500", "--drop-outliers"],
+    );
+}
+
+#[test]
+fn swapped_position_columns_are_named_as_the_likely_cause() {
+    // x and y swapped gave kp 3233 (truth 61.5) at a 97 % position fit and a -177 % pressure
+    // fit, with nothing said
+    let dir = scratch("swapped");
+    let rec = dir.join("rig.csv");
+    support::succeeds(&[
+        "rig",
+        "cv1",
+        "--settle",
+        "2",
+        "--t-end",
+        "2",
+        "--out",
+        s(&rec),
+    ]);
+    let mut text = String::new();
+    for line in std::fs::read_to_string(&rec).unwrap().lines() {
+        if line.starts_with('#') || line.starts_with('t') {
+            text.push_str(line);
+        } else {
+            let mut f: Vec<&str> = line.split(',').collect();
+            f.swap(2, 3);
+            text.push_str(&f.join(","));
+        }
+        text.push('\n');
+    }
+    let swapped = dir.join("swapped.csv");
+    std::fs::write(&swapped, text).unwrap();
+    let out = support::stirling(&["fit", "cv1", "--data", s(&swapped)]);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        stdout.contains("not to be trusted") && stdout.contains("x and y columns swapped"),
+        "{stdout}"
+    );
+}

@@ -11,6 +11,8 @@
 mod csv;
 /// Sensor offsets, estimated from the data.
 pub mod offsets;
+/// Isolated outlier samples: found, refused by the fit, or replaced on request.
+pub mod outliers;
 mod sampling;
 mod text;
 

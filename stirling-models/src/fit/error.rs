@@ -50,6 +50,19 @@ pub enum FitError {
     },
     #[error("{file}: the training block ({seconds:.3} s) holds fewer than two cycles of the motion: the record is too short (or does not oscillate) to identify the dynamics")]
     TooFewCycles { file: String, seconds: f64 },
+    #[error("{file}: {count} outlier sample(s), first {first}: a corrupt sample would pull the fit (pass --drop-outliers to replace each by its neighbours' interpolation, or repair the file)")]
+    Outliers {
+        file: String,
+        count: usize,
+        first: String,
+    },
+    #[error("{file}: the record cycles at {record:.4} Hz, the model at {model:.4} Hz (its dominant pole at rest, from the parameters given), more than {}x apart: {hint}", excitation::MAX_FREQUENCY_RATIO)]
+    FrequencyMismatch {
+        file: String,
+        record: f64,
+        model: f64,
+        hint: String,
+    },
     #[error("{file}: the record samples at {rate:.4} Hz, {per_cycle:.1} samples per cycle of its {freq:.4} Hz motion: too coarse to follow the cycle (at least {} samples per cycle are needed; a record sampled below twice the engine's frequency shows an alias of the motion, not the motion): record at a higher rate, or check the time column's unit", excitation::MIN_SAMPLES_PER_CYCLE)]
     Undersampled {
         file: String,

@@ -3,8 +3,12 @@
 //! that begins near rest and grows passes (its motion over the block is large); a record
 //! without motion, or shorter than a couple of cycles, is refused with the reason.
 
+use stirling_dsl::Model;
+
 use super::FitError;
 use crate::data::Measured;
+use crate::linear::dynamics::dynamic_poles;
+use crate::linear::equilibrium::NewtonOptions;
 use crate::signal::{cycle_frequency, noise_sigma};
 
 /// Least samples per cycle of the recorded motion: below it the record cannot follow the
@@ -35,16 +39,76 @@ pub fn check(data: &Measured, tr: (usize, usize), dt: f64) -> Result<(), FitErro
             });
         }
     }
-    let cycles = ["x", "y", "p"]
-        .iter()
-        .filter_map(|c| data.channel(c))
-        .find_map(|v| cycle_frequency(&v[tr.0..=tr.1], dt));
-    let Some(freq) = cycles else {
+    let Some(freq) = record_frequency(data, tr, dt) else {
         return Err(FitError::TooFewCycles {
             file: data.source.clone(),
             seconds: (tr.1 - tr.0) as f64 * dt,
         });
     };
+    check_rate(data, freq, dt)
+}
+
+/// The record's cycle frequency on the training block `tr`, when it has one.
+pub fn record_frequency(data: &Measured, tr: (usize, usize), dt: f64) -> Option<f64> {
+    ["x", "y", "p"]
+        .iter()
+        .filter_map(|c| data.channel(c))
+        .find_map(|v| cycle_frequency(&v[tr.0..=tr.1], dt))
+}
+
+/// Most the record's cycle frequency may differ from the model's (a factor either way): a
+/// factor 4 is a 16-fold spring, beyond what a start from the declared parameters reaches;
+/// a record in milliseconds moves 1000 times too slow, an aliased one too slow as well.
+pub const MAX_FREQUENCY_RATIO: f64 = 4.0;
+
+/// Refuse a record whose cycle is far from the model's own frequency at `p` (its dominant
+/// oscillatory pole at rest): a time column in the wrong unit, an aliased or resampled record,
+/// or another engine. Models without an oscillatory pole (or whose rest state cannot be
+/// linearized) are not checked here.
+pub fn check_model_frequency(
+    model: &dyn Model,
+    p: &[f64],
+    data: &Measured,
+    tr: (usize, usize),
+    dt: f64,
+) -> Result<(), FitError> {
+    let Some(rec) = record_frequency(data, tr, dt) else {
+        return Ok(());
+    };
+    let Ok(d) = dynamic_poles(model, p, &NewtonOptions::default()) else {
+        return Ok(());
+    };
+    let Some(f_model) = d
+        .poles
+        .iter()
+        .filter(|q| q.im > 0.0)
+        .max_by(|a, b| a.re.total_cmp(&b.re))
+        .map(|q| q.freq_hz)
+    else {
+        return Ok(());
+    };
+    let ratio = rec / f_model;
+    if (1.0 / MAX_FREQUENCY_RATIO..=MAX_FREQUENCY_RATIO).contains(&ratio) {
+        return Ok(());
+    }
+    let hint = if (300.0..3000.0).contains(&(1.0 / ratio)) {
+        "the time column looks like milliseconds: give it in seconds"
+    } else if (300.0..3000.0).contains(&ratio) {
+        "the time column looks like kiloseconds or the record was decimated: give time in seconds"
+    } else if ratio < 1.0 {
+        "a record sampled too slowly shows an alias of the motion (check the rate against the engine's frequency), or the time column's unit is wrong"
+    } else {
+        "check the time column's unit, or start the fit nearer the engine (--set, --params)"
+    };
+    Err(FitError::FrequencyMismatch {
+        file: data.source.clone(),
+        record: rec,
+        model: f_model,
+        hint: hint.into(),
+    })
+}
+
+fn check_rate(data: &Measured, freq: f64, dt: f64) -> Result<(), FitError> {
     let per_cycle = 1.0 / (freq * dt);
     if per_cycle < MIN_SAMPLES_PER_CYCLE {
         return Err(FitError::Undersampled {

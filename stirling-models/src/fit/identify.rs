@@ -417,6 +417,7 @@ pub fn identify_stages<'a>(
     let ms = run.refine(data, &idx_free, &mut st.p, &mut offsets, &mut notes);
     let fr = run.validate(data, &st.p, &offsets, &mut notes);
     notes.extend(at_bounds(model, &st.p, &idx_free, &opts.bounds));
+    notes.extend(inconsistent_stages(st.stage1.as_ref(), st.stage2.as_ref()));
     let id = Identification {
         model: model.name().into(),
         n: model.n(),
@@ -432,6 +433,26 @@ pub fn identify_stages<'a>(
         notes,
     };
     Ok((id, st.fitted))
+}
+
+/// Stage 1 (positions from the measured pressure) at least this good on the training block...
+const GOOD_STAGE_FIT: f64 = 80.0;
+
+/// A fit whose positions fit well while its pressure fits worse than its mean: the two stages
+/// disagree about the record (x and y swapped gave kp 3233 against 61.5 at a 97 % position fit
+/// and a -177 % pressure fit). The likely causes, as a note the user reads.
+fn inconsistent_stages(s1: Option<&StageFit>, s2: Option<&StageFit>) -> Option<String> {
+    let (s1, s2) = (s1?, s2?);
+    let pos = ["x", "y"]
+        .iter()
+        .filter_map(|c| s1.fit_percent(c, "train"))
+        .fold(f64::INFINITY, f64::min);
+    let p = s2.fit_percent("p", "train")?;
+    (pos.is_finite() && pos >= GOOD_STAGE_FIT && p < 0.0).then(|| {
+        format!(
+            "the positions fit well from the measured pressure (stage 1, {pos:.0} %) but the pressure fits worse than its mean from the measured positions (stage 2, {p:.0} %): the estimates are not to be trusted. Likely causes: the x and y columns swapped, a channel sign-flipped, or positions in another unit than m"
+        )
+    })
 }
 
 /// The first name that appears twice in `names`.

@@ -82,6 +82,15 @@ impl<'a> Record<'a> {
             });
         }
         super::excitation::check(data, tr, dt)?;
+        super::excitation::check_model_frequency(model, p, data, tr, dt)?;
+        let outliers = crate::data::outliers::find(data);
+        if let Some(first) = outliers.first() {
+            return Err(FitError::Outliers {
+                file: data.source.clone(),
+                count: outliers.len(),
+                first: first.to_string(),
+            });
+        }
         let h = ((opts.smooth / dt).round() as usize).max(3);
         let ps = &layout.pressures;
         let have_hot = data.p_hot.is_some() && ps.len() > 1;
