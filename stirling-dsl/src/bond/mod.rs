@@ -1,0 +1,48 @@
+//! A true bond graph of a declared model (docs/bond-graphs.md): 1-junctions for the bodies
+//! with their `I`, `C`, `R` and `MSe`; `TF`s for the piston faces; each gas control volume a
+//! multiport `C` field (volume, heat and mass ports); 0-junctions where efforts are shared;
+//! `R`s for the flow resistances and heat conductances; sources for fixed temperatures and
+//! given pressures; walls as thermal `C`s. Causality by the sequential procedure (SCAP).
+//!
+//! One file per step: [`graph`] the structure, `build*` its construction from a
+//! [`crate::TopologyInfo`], [`causality`] the SCAP, [`states`] the map onto the model's
+//! states, `dot` the Graphviz text.
+
+mod build;
+mod build_gas;
+mod build_heat;
+pub mod causality;
+mod dot;
+mod ends;
+mod error;
+pub mod graph;
+pub mod states;
+
+pub use causality::Derivative;
+pub use error::BondError;
+pub use graph::{Bond, BondGraph, Domain, Kind, Node, NodeId, Store};
+
+use crate::runtime::Model;
+
+/// A bond graph with its causality assigned.
+#[derive(Clone, Debug, PartialEq)]
+pub struct CausalGraph {
+    pub graph: BondGraph,
+    /// The storage ports left in derivative causality, with their physical meaning.
+    pub derivative: Vec<Derivative>,
+}
+
+impl CausalGraph {
+    /// Graphviz DOT with causal strokes and half-arrows.
+    pub fn to_dot(&self) -> String {
+        dot::to_dot(&self.graph, &self.derivative)
+    }
+}
+
+/// The causal bond graph of `model` at its `n` and closure.
+pub fn bond_graph(model: &dyn Model) -> Result<CausalGraph, BondError> {
+    let names: Vec<&str> = model.params().iter().map(|p| p.name).collect();
+    let mut graph = build::build(model.topology(), model.n(), model.closure(), &names)?;
+    let derivative = causality::assign(&mut graph)?;
+    Ok(CausalGraph { graph, derivative })
+}
