@@ -1,6 +1,6 @@
 //! `stirling info`: what a model is made of. States with their meaning and unit,
 //! parameters with unit, value and doc, the generated equations (text or LaTeX),
-//! or the energetic (bond-graph) view as Graphviz DOT.
+//! or the model's bond graph (junctions, causal strokes, half-arrows) as Graphviz DOT.
 
 use std::path::PathBuf;
 
@@ -17,7 +17,8 @@ pub struct InfoArgs {
     /// Print the equations as LaTeX (an `aligned` block) instead of text
     #[arg(long)]
     pub latex: bool,
-    /// Write the bond-graph view of the topology as Graphviz DOT instead of the listing
+    /// Write the model's bond graph (0/1-junctions, causal strokes, half-arrows; see
+    /// docs/bond-graphs.md) as Graphviz DOT instead of the listing
     /// (DOT has no equations: not with --latex or --json)
     #[arg(long, conflicts_with_all = ["json", "latex"])]
     pub graph: bool,
@@ -37,7 +38,7 @@ pub fn run(args: &InfoArgs) -> anyhow::Result<()> {
     let (model, p) = args.model.load()?;
     let model = model.as_ref();
     if args.graph {
-        let dot = stirling_dsl::to_dot(model.topology());
+        let dot = stirling_dsl::bond::bond_graph(model)?.to_dot();
         return match &args.out {
             Some(path) => files::write_text(path, &dot, args.force, "--out"),
             None => Ok(common::print(&dot)?),

@@ -155,7 +155,15 @@ fn graph_to_stdout() {
         s.starts_with("digraph \"cv2\" {") && s.trim_end().ends_with('}'),
         "{s}"
     );
-    for needle in ["I: displacer", "C: hot", "TF: -A", "R: Rf", "Se: Tw = Th"] {
+    for needle in [
+        "I: md",
+        "C: kd",
+        "C: hot",
+        "TF: -A",
+        "R: Rf",
+        "Se: Th",
+        "arrowtail=tee",
+    ] {
         assert!(s.contains(needle), "missing `{needle}`");
     }
 }

@@ -1,4 +1,4 @@
-//! A static description of a declared topology, for the bond-graph (DOT) view and docs.
+//! A static description of a declared topology, for the bond graph ([`crate::bond`]) and docs.
 
 /// A heat port.
 #[derive(Clone, Copy, Debug)]
