@@ -129,3 +129,50 @@ fn cv1_bond_graph_dot() {
     let m = build("cv1", None, Closure::Full).unwrap();
     insta::assert_snapshot!("cv1_bond_graph", check(m.as_ref()).to_dot());
 }
+
+/// The SVG drawing (no Graphviz): one stroke and one half-arrow per bond, every label as
+/// text, and no two boxes overlapping, for `cv1` and `nsection` at 1, 2 and 10 sections.
+#[test]
+fn svg_draws_every_bond_and_label_without_overlaps() {
+    let models = [
+        build("cv1", None, Closure::Full).unwrap(),
+        build("nsection", Some(1), Closure::Full).unwrap(),
+        build("nsection", Some(2), Closure::Full).unwrap(),
+        build("nsection", Some(10), Closure::Full).unwrap(),
+    ];
+    for m in &models {
+        let cg = check(m.as_ref());
+        let svg = cg.to_svg();
+        let bonds = cg.graph.bonds.len();
+        assert_eq!(svg.matches("class=\"stroke\"").count(), bonds);
+        assert_eq!(svg.matches("class=\"half-arrow\"").count(), bonds);
+        for n in &cg.graph.nodes {
+            let text = n
+                .text()
+                .replace('&', "&amp;")
+                .replace('<', "&lt;")
+                .replace('>', "&gt;");
+            assert!(
+                svg.contains(&format!(">{text}</text>")),
+                "{}: no `{text}`",
+                m.name()
+            );
+        }
+        let lay = stirling::dsl::bond::layout::layered(&cg.graph);
+        for a in 0..lay.centre.len() {
+            for b in a + 1..lay.centre.len() {
+                let (ca, cb, ha, hb) = (lay.centre[a], lay.centre[b], lay.half[a], lay.half[b]);
+                let apart =
+                    (ca.0 - cb.0).abs() >= ha.0 + hb.0 || (ca.1 - cb.1).abs() >= ha.1 + hb.1;
+                assert!(apart, "{} n={}: nodes {a} and {b} overlap", m.name(), m.n());
+            }
+        }
+    }
+}
+
+/// The SVG of `cv1`, reviewed (structure and coordinates).
+#[test]
+fn cv1_bond_graph_svg() {
+    let m = build("cv1", None, Closure::Full).unwrap();
+    insta::assert_snapshot!("cv1_bond_graph_svg", check(m.as_ref()).to_svg());
+}

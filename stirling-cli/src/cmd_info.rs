@@ -11,6 +11,7 @@ use crate::common::{self, files, ModelArgs};
 
 /// Arguments of `stirling info`.
 #[derive(Args, Debug, Clone)]
+#[command(group(clap::ArgGroup::new("files").args(["out", "svg"]).multiple(true)))]
 pub struct InfoArgs {
     #[command(flatten)]
     pub model: ModelArgs,
@@ -25,8 +26,12 @@ pub struct InfoArgs {
     /// With --graph: write the DOT to this file instead of stdout (folders created if missing)
     #[arg(long, requires = "graph", value_name = "FILE")]
     pub out: Option<PathBuf>,
-    /// With --out: overwrite an existing file
-    #[arg(long, requires = "out")]
+    /// With --graph: draw the bond graph as SVG into this file (no Graphviz needed; the DOT
+    /// then goes only to --out, if given)
+    #[arg(long, requires = "graph", value_name = "FILE")]
+    pub svg: Option<PathBuf>,
+    /// With --out or --svg: overwrite an existing file
+    #[arg(long, requires = "files")]
     pub force: bool,
     /// Machine-readable output
     #[arg(long)]
@@ -38,10 +43,14 @@ pub fn run(args: &InfoArgs) -> anyhow::Result<()> {
     let (model, p) = args.model.load()?;
     let model = model.as_ref();
     if args.graph {
-        let dot = stirling_dsl::bond::bond_graph(model)?.to_dot();
-        return match &args.out {
-            Some(path) => files::write_text(path, &dot, args.force, "--out"),
-            None => Ok(common::print(&dot)?),
+        let graph = stirling_dsl::bond::bond_graph(model)?;
+        if let Some(path) = &args.svg {
+            files::write_text(path, &graph.to_svg(), args.force, "--svg")?;
+        }
+        return match (&args.out, &args.svg) {
+            (Some(path), _) => files::write_text(path, &graph.to_dot(), args.force, "--out"),
+            (None, Some(_)) => Ok(()),
+            (None, None) => Ok(common::print(&graph.to_dot())?),
         };
     }
     let style = if args.latex {

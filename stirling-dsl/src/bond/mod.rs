@@ -6,7 +6,7 @@
 //!
 //! One file per step: [`graph`] the structure, `build*` its construction from a
 //! [`crate::TopologyInfo`], [`causality`] the SCAP, [`states`] the map onto the model's
-//! states, `dot` the Graphviz text.
+//! states, `dot` the Graphviz text, [`layout`] and `svg` a drawing without Graphviz.
 
 mod build;
 mod build_gas;
@@ -16,7 +16,9 @@ mod dot;
 mod ends;
 mod error;
 pub mod graph;
+pub mod layout;
 pub mod states;
+mod svg;
 
 pub use causality::Derivative;
 pub use error::BondError;
@@ -36,6 +38,11 @@ impl CausalGraph {
     /// Graphviz DOT with causal strokes and half-arrows.
     pub fn to_dot(&self) -> String {
         dot::to_dot(&self.graph, &self.derivative)
+    }
+
+    /// An SVG drawing (layered layout, no Graphviz needed).
+    pub fn to_svg(&self) -> String {
+        svg::to_svg(&self.graph, &self.derivative)
     }
 }
 
