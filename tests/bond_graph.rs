@@ -131,7 +131,8 @@ fn cv1_bond_graph_dot() {
 }
 
 /// The SVG drawing (no Graphviz): one stroke and one half-arrow per bond, every label as
-/// text, and no two boxes overlapping, for `cv1` and `nsection` at 1, 2 and 10 sections.
+/// text, and no two boxes overlapping, for `cv1` and `nsection` at 1, 2 and 10 sections (set
+/// `BOND_SVG_DIR` to write them there and look at them).
 #[test]
 fn svg_draws_every_bond_and_label_without_overlaps() {
     let models = [
@@ -143,6 +144,11 @@ fn svg_draws_every_bond_and_label_without_overlaps() {
     for m in &models {
         let cg = check(m.as_ref());
         let svg = cg.to_svg();
+        // to look at the pictures: BOND_SVG_DIR=/tmp/svg cargo test --test bond_graph svg
+        if let Some(dir) = std::env::var_os("BOND_SVG_DIR") {
+            let file = std::path::Path::new(&dir).join(format!("{}_{}.svg", m.name(), m.n()));
+            std::fs::write(file, &svg).unwrap();
+        }
         let bonds = cg.graph.bonds.len();
         assert_eq!(svg.matches("class=\"stroke\"").count(), bonds);
         assert_eq!(svg.matches("class=\"half-arrow\"").count(), bonds);

@@ -50,6 +50,7 @@ impl Builder<'_> {
                 for pt in v.ports {
                     let wall = match pt.wall_ref {
                         Some(w) => self.wall_node(w, if v.array { Some(j) } else { None })?,
+                        None if v.array => self.effort_source(&at_section(pt.wall, j)),
                         None => self.effort_source(pt.wall),
                     };
                     let one = self.g.node(Kind::One, format!("Q {}.{}", v.name, pt.name));
@@ -150,4 +151,26 @@ impl Builder<'_> {
         }
         s
     }
+}
+
+/// `expr` with the section index `j` written as the number `j` (`Th - (j + 0.5) * dT / n` at
+/// section 1: `Th - (1 + 0.5) * dT / n`).
+fn at_section(expr: &str, j: usize) -> String {
+    let mut out = String::new();
+    let mut word = String::new();
+    for c in expr.chars().chain(std::iter::once(' ')) {
+        if c.is_alphanumeric() || c == '_' {
+            word.push(c);
+            continue;
+        }
+        if word == "j" {
+            out.push_str(&j.to_string());
+        } else {
+            out.push_str(&word);
+        }
+        word.clear();
+        out.push(c);
+    }
+    out.pop();
+    out
 }

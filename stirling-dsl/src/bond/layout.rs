@@ -1,10 +1,10 @@
-//! A simple layered layout of a bond graph, for drawing it without Graphviz: layers by
-//! breadth-first distance from the sources (left to right), each layer ordered by the mean
-//! position of its neighbours (a few barycentre sweeps), text-sized boxes.
+//! A simple layered layout of a bond graph, for drawing it without Graphviz: layers along the
+//! power direction (left to right, longest path), each layer ordered by the mean position of
+//! its neighbours (a few barycentre sweeps), text-sized boxes.
 
 use std::collections::VecDeque;
 
-use super::graph::{BondGraph, Kind};
+use super::graph::BondGraph;
 
 /// Horizontal gap between layers and vertical gap between boxes (px).
 const GAP_X: f64 = 56.0;
@@ -71,35 +71,70 @@ fn neighbours(g: &BondGraph) -> Vec<Vec<usize>> {
     adj
 }
 
-/// The layer of each node: its distance from the nearest source of its component (from its
-/// first node when it has no source).
+/// The layer of each node: the longest power path reaching it (bonds point from a lower to
+/// a higher layer), then each node moved right next to the nearest of its successors that
+/// is not a leaf, and each leaf (an element on one bond into it) right after its node. A
+/// directed cycle is broken at its first node.
 fn layer_of(g: &BondGraph) -> Vec<usize> {
-    let adj = neighbours(g);
-    let mut layer = vec![usize::MAX; g.nodes.len()];
-    let is_source = |k: Kind| matches!(k, Kind::Se | Kind::MSe | Kind::Sf);
-    let mut queue: VecDeque<usize> = (0..g.nodes.len())
-        .filter(|&n| is_source(g.nodes[n].kind))
-        .collect();
-    for &n in &queue {
-        layer[n] = 0;
-    }
-    loop {
-        while let Some(n) = queue.pop_front() {
-            for &m in &adj[n] {
-                if layer[m] == usize::MAX {
-                    layer[m] = layer[n] + 1;
-                    queue.push_back(m);
-                }
-            }
+    let order = topological(g);
+    let mut layer = vec![0usize; g.nodes.len()];
+    let mut placed = vec![false; g.nodes.len()];
+    for &n in &order {
+        for b in g.bonds.iter().filter(|b| b.to == n && placed[b.from]) {
+            layer[n] = layer[n].max(layer[b.from] + 1);
         }
-        match layer.iter().position(|&l| l == usize::MAX) {
-            Some(n) => {
-                layer[n] = 0;
-                queue.push_back(n);
-            }
-            None => return layer,
+        placed[n] = true;
+    }
+    let degree = |n: usize| g.bonds.iter().filter(|b| b.from == n || b.to == n).count();
+    let leaf = |n: usize| degree(n) == 1 && g.bonds.iter().any(|b| b.to == n);
+    for &n in order.iter().rev() {
+        let next = g
+            .bonds
+            .iter()
+            .filter(|b| b.from == n && layer[b.to] > layer[n] && !leaf(b.to))
+            .map(|b| layer[b.to])
+            .min();
+        if let Some(m) = next {
+            layer[n] = layer[n].max(m - 1);
         }
     }
+    for b in &g.bonds {
+        if leaf(b.to) {
+            layer[b.to] = layer[b.from] + 1;
+        }
+    }
+    layer
+}
+
+/// The nodes in an order where every bond goes forwards (Kahn's algorithm; when only
+/// nodes on cycles are left, the first of them goes next).
+fn topological(g: &BondGraph) -> Vec<usize> {
+    let mut indegree = vec![0usize; g.nodes.len()];
+    for b in &g.bonds {
+        indegree[b.to] += 1;
+    }
+    let mut done = vec![false; g.nodes.len()];
+    let mut order = Vec::with_capacity(g.nodes.len());
+    let mut queue: VecDeque<usize> = (0..g.nodes.len()).filter(|&n| indegree[n] == 0).collect();
+    while order.len() < g.nodes.len() {
+        let n = match queue.pop_front() {
+            Some(n) if !done[n] => n,
+            Some(_) => continue,
+            None => match (0..g.nodes.len()).find(|&n| !done[n]) {
+                Some(n) => n,
+                None => break,
+            },
+        };
+        done[n] = true;
+        order.push(n);
+        for b in g.bonds.iter().filter(|b| b.from == n) {
+            indegree[b.to] = indegree[b.to].saturating_sub(1);
+            if indegree[b.to] == 0 && !done[b.to] {
+                queue.push_back(b.to);
+            }
+        }
+    }
+    order
 }
 
 /// The nodes of each layer, ordered by barycentre sweeps (down then up, four times).
@@ -127,11 +162,10 @@ fn order(g: &BondGraph, layer: Vec<usize>) -> Vec<Vec<usize>> {
             (0..count.saturating_sub(1)).rev().collect()
         };
         for l in range {
-            let near = if down { l - 1 } else { l + 1 };
             let key = |n: usize| {
                 let ns: Vec<f64> = adj[n]
                     .iter()
-                    .filter(|&&m| layer[m] == near)
+                    .filter(|&&m| if down { layer[m] < l } else { layer[m] > l })
                     .map(|&m| rank[m])
                     .collect();
                 if ns.is_empty() {

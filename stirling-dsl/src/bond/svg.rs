@@ -48,7 +48,8 @@ pub fn to_svg(g: &BondGraph, derivative: &[Derivative]) -> String {
         let _ = writeln!(
             s,
             "<g class=\"node\" data-kind=\"{}\"><title>{}</title>{ring}<text x=\"{x:.1}\" y=\"{:.1}\" \
-             text-anchor=\"middle\" fill=\"{fill}\">{}</text></g>",
+             text-anchor=\"middle\" fill=\"{fill}\" stroke=\"white\" stroke-width=\"4\" \
+             paint-order=\"stroke\">{}</text></g>",
             node.kind.symbol(),
             esc(&node.label),
             y + 4.5,
