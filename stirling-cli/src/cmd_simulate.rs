@@ -247,6 +247,7 @@ fn write_csv(path: &Path, force: bool, model: &dyn Model, tr: &Trajectory) -> an
         f.flush()
     };
     rows().with_context(|| format!("cannot write {}", path.display()))?;
+    f.done()?;
     files::wrote(path);
     Ok(())
 }

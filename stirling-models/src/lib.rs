@@ -132,6 +132,8 @@ pub mod linear;
 /// Model construction: the family, the effects, the registry, parameters.
 pub mod model;
 /// SVG figures: pole map, Bode, root locus, start-up, PV diagrams, measured vs model.
+/// Files written whole or not at all (temporary file and rename, pairs under a lock).
+pub mod output;
 pub mod plot;
 /// The virtual test rig: truth model plus effects, noise, offsets, sample rate.
 pub mod rig;

@@ -2,10 +2,12 @@
 //! an existing file is never overwritten without `--force`, missing folders are created, and
 //! every file written is named on stderr. The checks run before the (long) computation.
 
-use std::fs::{self, File, OpenOptions};
-use std::io::{BufWriter, Write};
+use std::fs;
+use std::io::Write;
+
 use std::path::{Path, PathBuf};
 use std::time::SystemTime;
+use stirling_models::output::Staged;
 
 use anyhow::{bail, Context};
 
@@ -62,29 +64,48 @@ fn create_dir(dir: &Path, option: &str) -> anyhow::Result<()> {
         .with_context(|| format!("{option}: cannot create the folder {}", dir.display()))
 }
 
-/// Open a file checked by [`prepare_file`]; without `force` an existing file (one that
-/// appeared meanwhile) is still refused.
-pub fn create(path: &Path, force: bool, option: &str) -> anyhow::Result<BufWriter<File>> {
+/// Open a file checked by [`prepare_file`], written whole or not at all
+/// ([`stirling_models::output`]): call [`Output::done`] when complete; without `force` an
+/// existing file (one that appeared meanwhile) is still refused.
+pub fn create(path: &Path, force: bool, option: &str) -> anyhow::Result<Output> {
     prepare_file(path, force, option)?;
-    let mut opts = OpenOptions::new();
-    opts.write(true);
-    if force {
-        opts.create(true).truncate(true);
-    } else {
-        opts.create_new(true);
-    }
-    let f = opts
-        .open(path)
+    let staged = Staged::new(path, force)
         .with_context(|| format!("{option}: cannot create {}", path.display()))?;
-    Ok(BufWriter::new(f))
+    Ok(Output { staged, force })
+}
+
+/// A file being written by [`create`].
+pub struct Output {
+    staged: Staged,
+    force: bool,
+}
+
+impl Output {
+    /// Publish the complete file.
+    pub fn done(self) -> anyhow::Result<()> {
+        let path = self.staged.dest().to_path_buf();
+        self.staged
+            .commit(self.force)
+            .with_context(|| format!("cannot write {}", path.display()))
+    }
+}
+
+impl Write for Output {
+    fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
+        self.staged.write(buf)
+    }
+
+    fn flush(&mut self) -> std::io::Result<()> {
+        self.staged.flush()
+    }
 }
 
 /// Write `text` to a new file (the rule above) and name it on stderr.
 pub fn write_text(path: &Path, text: &str, force: bool, option: &str) -> anyhow::Result<()> {
     let mut f = create(path, force, option)?;
     f.write_all(text.as_bytes())
-        .and_then(|()| f.flush())
         .with_context(|| format!("cannot write {}", path.display()))?;
+    f.done()?;
     wrote(path);
     Ok(())
 }

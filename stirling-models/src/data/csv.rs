@@ -356,8 +356,15 @@ fn check_units(name: &str, v: &[f64]) -> Result<(), (Option<usize>, String)> {
 
 /// Write a record (channels present in `m`, in the order t, p, p_hot, x, y, then the others),
 /// with `#` comments.
+/// The file is written whole or not at all ([`crate::output`]); an existing one is replaced.
 pub fn write_csv(path: &Path, m: &Measured, comments: &[String]) -> std::io::Result<()> {
-    let mut f = std::io::BufWriter::new(std::fs::File::create(path)?);
+    let mut f = crate::output::Staged::new(path, true).map_err(std::io::Error::other)?;
+    write_csv_to(&mut f, m, comments)?;
+    f.commit(true).map_err(std::io::Error::other)
+}
+
+/// Write a record (as [`write_csv`]) to any writer.
+pub fn write_csv_to(f: &mut impl Write, m: &Measured, comments: &[String]) -> std::io::Result<()> {
     for c in comments {
         writeln!(f, "# {c}")?;
     }

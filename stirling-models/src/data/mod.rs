@@ -14,7 +14,7 @@ pub mod offsets;
 mod sampling;
 mod text;
 
-pub use csv::{parse_csv, parse_csv_bytes, read_csv, read_csv_lines, write_csv};
+pub use csv::{parse_csv, parse_csv_bytes, read_csv, read_csv_lines, write_csv, write_csv_to};
 pub use offsets::{cycle_mean, remove_position_offsets, PositionOffsets};
 pub use sampling::{check_uniform, UNIFORM_TOLERANCE};
 

@@ -200,7 +200,8 @@ pub fn write(d: &Diagnosis, data: &Measured, dir: &Path) -> Result<PathBuf, Repo
         figs.extend(overlay_figure(d, data, &c.channel, dir)?);
     }
     let path = dir.join("report.md");
-    std::fs::write(&path, markdown(d, data, &figs)).map_err(io(&path))?;
+    crate::output::write_atomic(&path, markdown(d, data, &figs).as_bytes(), true)
+        .map_err(|e| io(&path)(std::io::Error::other(e)))?;
     Ok(path)
 }
 

@@ -49,4 +49,6 @@ pub enum RigError {
     Exists(PathBuf),
     #[error("cannot write `{0}`: {1}")]
     Io(PathBuf, std::io::Error),
+    #[error(transparent)]
+    Output(#[from] crate::output::OutputError),
 }

@@ -10,8 +10,10 @@ use std::path::{Path, PathBuf};
 use serde::Serialize;
 use stirling_dsl::{Closure, Model};
 
-use crate::data::{write_csv, Measured};
+use crate::data::{write_csv_to, Measured};
 use crate::effects::{augmented, EffectSettings};
+use crate::output::{self, Staged};
+use std::io::Write;
 
 /// Why the rig could not run.
 mod error;
@@ -377,8 +379,16 @@ pub fn write(out: &RigOutput, path: &Path, force: bool) -> Result<PathBuf, RigEr
                 .join(", ")
         ),
     ];
-    write_csv(path, &out.data, &comments).map_err(|e| RigError::Io(path.to_path_buf(), e))?;
+    // the record and its truth are written whole and published together (crate::output): an
+    // interrupted run leaves neither cut, two runs on one path never mix their files
+    let mut csv = Staged::new(path, force)?;
+    write_csv_to(&mut csv, &out.data, &comments)
+        .map_err(|e| RigError::Io(path.to_path_buf(), e))?;
     let json = serde_json::to_string_pretty(&out.truth).expect("serializable");
-    std::fs::write(&side, json).map_err(|e| RigError::Io(side.clone(), e))?;
+    let mut truth = Staged::new(&side, force)?;
+    truth
+        .write_all(json.as_bytes())
+        .map_err(|e| RigError::Io(side.clone(), e))?;
+    output::commit_all(vec![csv, truth], force)?;
     Ok(side)
 }

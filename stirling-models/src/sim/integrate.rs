@@ -248,6 +248,7 @@ fn step_loop<'a, 's: 'a, M: Backend, S: OdeSolverMethod<'a, Eqn<'s, M>>>(
     for _ in 0..opts.max_steps {
         let reason = solver.step().map_err(|e| map_err(e, solver.state().t))?;
         let t = solver.state().t;
+        super::interrupt::check(t)?;
         let x = M::slice(solver.state().y).to_vec();
         if let Some(check) = hooks.check {
             check(t, &x)?;

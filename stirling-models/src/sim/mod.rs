@@ -37,6 +37,9 @@ pub mod floquet_arnoldi;
 pub mod gmres;
 /// The step loop.
 pub mod integrate;
+/// A process-wide request to stop the simulations in progress (Ctrl-C in an interactive
+/// front end).
+pub mod interrupt;
 /// Newton-Krylov shooting (large cycles).
 pub mod krylov_shooting;
 /// A dense LU solving many right-hand-side lanes at once (the sensitivity columns).
@@ -106,6 +109,8 @@ pub enum SimError {
     FloquetNotConverged { products: usize, change: f64 },
     #[error("{0}")]
     BadOption(String),
+    #[error("interrupted at t = {t:.6e} s (a stop was requested)")]
+    Interrupted { t: f64 },
 }
 
 /// A limit cycle with its figures.

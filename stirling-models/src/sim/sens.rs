@@ -151,6 +151,7 @@ pub fn integrate_sens(
     for _ in 0..opts.max_steps {
         let reason = solver.step().map_err(|e| map_err(e, solver.state().t))?;
         let t = solver.state().t;
+        super::interrupt::check(t)?;
         while next < samples.len() && samples[next] <= t {
             let ts = samples[next];
             let x = solver.interpolate(ts).map_err(|e| map_err(e, t))?;

@@ -125,7 +125,12 @@ pub fn write(v: &VerdictCheck, dir: &Path) -> Result<[PathBuf; 2], DiagnoseError
         path: json.clone(),
         source: std::io::Error::other(e),
     })?;
-    std::fs::write(&json, text).map_err(io(&json))?;
-    std::fs::write(&md, markdown(v)).map_err(io(&md))?;
+    // whole or not at all (the existing ones were refused up front without --force)
+    let atomic = |path: &std::path::Path, bytes: &[u8]| {
+        crate::output::write_atomic(path, bytes, true)
+            .map_err(|e| io(path)(std::io::Error::other(e)))
+    };
+    atomic(&json, text.as_bytes())?;
+    atomic(&md, markdown(v).as_bytes())?;
     Ok([json, md])
 }
