@@ -44,6 +44,9 @@ pub fn run(args: &InfoArgs) -> anyhow::Result<()> {
     let model = model.as_ref();
     if args.graph {
         let graph = stirling_dsl::bond::bond_graph(model)?;
+        for d in &graph.derivative {
+            eprintln!("note: derivative causality at {}", d.meaning);
+        }
         if let Some(path) = &args.svg {
             files::write_text(path, &graph.to_svg(), args.force, "--svg")?;
         }

@@ -4,9 +4,10 @@
 //! `R`s for the flow resistances and heat conductances; sources for fixed temperatures and
 //! given pressures; walls as thermal `C`s. Causality by the sequential procedure (SCAP).
 //!
-//! One file per step: [`graph`] the structure, `build*` its construction from a
-//! [`crate::TopologyInfo`], [`causality`] the SCAP, [`states`] the map onto the model's
-//! states, `dot` the Graphviz text, [`layout`] and `svg` a drawing without Graphviz.
+//! One file per step: [`graph`](crate::bond::graph) the structure, `build*` its
+//! construction from a [`crate::TopologyInfo`], [`causality`](crate::bond::causality) the
+//! SCAP, [`states`](crate::bond::states) the map onto the model's states, `dot` the Graphviz
+//! text, [`layout`](crate::bond::layout) and `svg` a drawing without Graphviz.
 
 mod build;
 mod build_gas;
