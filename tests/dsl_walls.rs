@@ -214,13 +214,13 @@ fn shared_wall_is_an_arrow_linear_in_n() {
     }
 }
 
-/// The bond-graph (DOT) view draws the walls: capacitances, their heat inputs, the ports to
-/// them and the conduction links (review it like code).
+/// The bond graph (DOT) draws the walls: 0-junctions with their capacitances and heat
+/// inputs, the ports to them and the conduction links (review it like code).
 #[test]
 fn walls_dot() {
-    use stirling::dsl::to_dot;
+    use stirling::dsl::bond::bond_graph;
     let m = HeadMatrix::new(3, Closure::Full).unwrap();
-    insta::assert_snapshot!("head_matrix_dot", to_dot(m.topology()));
+    insta::assert_snapshot!("head_matrix_dot", bond_graph(&m).unwrap().to_dot());
     let m = MatrixShell::new(3, Closure::Full).unwrap();
-    insta::assert_snapshot!("matrix_shell_dot", to_dot(m.topology()));
+    insta::assert_snapshot!("matrix_shell_dot", bond_graph(&m).unwrap().to_dot());
 }

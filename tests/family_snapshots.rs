@@ -1,7 +1,8 @@
 //! Snapshots a person reviews: the printed equations of `cv1` and of `nsection` at n = 2
-//! (text), and the bond-graph (DOT) view of `cv2`. Review changes with `cargo insta review`.
+//! (text), and the bond graph (DOT) of `cv2`. Review changes with `cargo insta review`.
 
-use stirling::dsl::{to_dot, Closure, Style};
+use stirling::dsl::bond::bond_graph;
+use stirling::dsl::{Closure, Style};
 use stirling::models::build;
 
 #[test]
@@ -19,7 +20,7 @@ fn nsection_2_equations_text() {
 #[test]
 fn cv2_bond_graph_dot() {
     let m = build("cv2", None, Closure::Full).unwrap();
-    insta::assert_snapshot!("cv2_dot", to_dot(m.topology()));
+    insta::assert_snapshot!("cv2_dot", bond_graph(m.as_ref()).unwrap().to_dot());
 }
 
 /// The equations of `cv1` do not depend on the closure: it has no links, so its mass is a constant.

@@ -151,3 +151,15 @@ fn the_gamma_engine_is_fitted_from_its_own_sensors() {
     common::fit::assert_recovered(&id, free.iter().map(|&k| truth_of(k)), 0.5);
     common::fit::assert_free_run_amplitudes(&id, &["x", "y", "p"], 0.05);
 }
+
+/// The gamma engine's bond graph (docs/bond-graphs.md): one stroke per bond, consistent
+/// junctions, integral causality on every storage element, and its states one to one with
+/// the model's, at 1, 2 and 10 regenerator sections.
+#[test]
+fn the_gamma_engine_has_an_integral_bond_graph_with_the_models_states() {
+    for closure in [Closure::Full, Closure::Frozen] {
+        for n in [1, 2, 10] {
+            common::bond::check(&Gamma::new(n, closure).unwrap());
+        }
+    }
+}

@@ -1,6 +1,6 @@
 //! `stirling info`: what a model is made of. States with their meaning and unit,
 //! parameters with unit, value and doc, the generated equations (text or LaTeX),
-//! or the energetic (bond-graph) view as Graphviz DOT.
+//! or the model's bond graph (junctions, causal strokes, half-arrows) as Graphviz DOT.
 
 use std::path::PathBuf;
 
@@ -11,21 +11,27 @@ use crate::common::{self, files, ModelArgs};
 
 /// Arguments of `stirling info`.
 #[derive(Args, Debug, Clone)]
+#[command(group(clap::ArgGroup::new("files").args(["out", "svg"]).multiple(true)))]
 pub struct InfoArgs {
     #[command(flatten)]
     pub model: ModelArgs,
     /// Print the equations as LaTeX (an `aligned` block) instead of text
     #[arg(long)]
     pub latex: bool,
-    /// Write the bond-graph view of the topology as Graphviz DOT instead of the listing
+    /// Write the model's bond graph (0/1-junctions, causal strokes, half-arrows; see
+    /// docs/bond-graphs.md) as Graphviz DOT instead of the listing
     /// (DOT has no equations: not with --latex or --json)
     #[arg(long, conflicts_with_all = ["json", "latex"])]
     pub graph: bool,
     /// With --graph: write the DOT to this file instead of stdout (folders created if missing)
     #[arg(long, requires = "graph", value_name = "FILE")]
     pub out: Option<PathBuf>,
-    /// With --out: overwrite an existing file
-    #[arg(long, requires = "out")]
+    /// With --graph: draw the bond graph as SVG into this file (no Graphviz needed; the DOT
+    /// then goes only to --out, if given)
+    #[arg(long, requires = "graph", value_name = "FILE")]
+    pub svg: Option<PathBuf>,
+    /// With --out or --svg: overwrite an existing file
+    #[arg(long, requires = "files")]
     pub force: bool,
     /// Machine-readable output
     #[arg(long)]
@@ -37,10 +43,17 @@ pub fn run(args: &InfoArgs) -> anyhow::Result<()> {
     let (model, p) = args.model.load()?;
     let model = model.as_ref();
     if args.graph {
-        let dot = stirling_dsl::to_dot(model.topology());
-        return match &args.out {
-            Some(path) => files::write_text(path, &dot, args.force, "--out"),
-            None => Ok(common::print(&dot)?),
+        let graph = stirling_dsl::bond::bond_graph(model)?;
+        for d in &graph.derivative {
+            eprintln!("note: derivative causality at {}", d.meaning);
+        }
+        if let Some(path) = &args.svg {
+            files::write_text(path, &graph.to_svg(), args.force, "--svg")?;
+        }
+        return match (&args.out, &args.svg) {
+            (Some(path), _) => files::write_text(path, &graph.to_dot(), args.force, "--out"),
+            (None, Some(_)) => Ok(()),
+            (None, None) => Ok(common::print(&graph.to_dot())?),
         };
     }
     let style = if args.latex {

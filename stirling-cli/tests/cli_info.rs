@@ -155,9 +155,45 @@ fn graph_to_stdout() {
         s.starts_with("digraph \"cv2\" {") && s.trim_end().ends_with('}'),
         "{s}"
     );
-    for needle in ["I: displacer", "C: hot", "TF: -A", "R: Rf", "Se: Tw = Th"] {
+    for needle in [
+        "I: md",
+        "C: kd",
+        "C: hot",
+        "TF: -A",
+        "R: Rf",
+        "Se: Th",
+        "arrowtail=tee",
+    ] {
         assert!(s.contains(needle), "missing `{needle}`");
     }
+}
+
+#[test]
+fn graph_svg_is_drawn_without_graphviz_and_not_overwritten_without_force() {
+    let path = scratch("cv1.svg");
+    let p = path.to_str().unwrap();
+    let _ = std::fs::remove_file(&path);
+    let out = ok(&["info", "cv1", "--graph", "--svg", p]);
+    assert!(
+        !out.contains("digraph"),
+        "the DOT went to stdout with --svg: {out}"
+    );
+    let svg = std::fs::read_to_string(&path).unwrap();
+    assert!(svg.starts_with("<svg") && svg.trim_end().ends_with("</svg>"));
+    for needle in [
+        ">1</text>",
+        ">0</text>",
+        ">I: md</text>",
+        ">TF: -Ar</text>",
+        "class=\"stroke\"",
+    ] {
+        assert!(svg.contains(needle), "missing `{needle}`");
+    }
+    std::fs::write(&path, "keep me").unwrap();
+    let err = fails(&["info", "cv1", "--graph", "--svg", p]);
+    assert!(err.contains("exists") && err.contains("--force"), "{err}");
+    assert_eq!(std::fs::read_to_string(&path).unwrap(), "keep me");
+    ok(&["info", "cv1", "--graph", "--svg", p, "--force"]);
 }
 
 #[test]

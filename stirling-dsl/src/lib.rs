@@ -17,7 +17,7 @@
 //!   `stirling_model!` macro at compile time.
 //! - The run-time interface every generated model implements: [`Model`], with
 //!   [`ParamInfo`], [`StateInfo`]/[`StateKind`], [`JacSink`], [`PowerTerms`], [`TopologyInfo`]
-//!   and the bond-graph view [`to_dot`]. The analyses of `stirling-models` take `&dyn Model`.
+//!   and the true bond graph of a model, [`bond::bond_graph`] (docs/bond-graphs.md). The analyses of `stirling-models` take `&dyn Model`.
 //!
 //! ## Declaring a model (the usual entry point)
 //!
@@ -110,6 +110,8 @@
 //! - the Jacobians are exact derivatives of the right-hand side (the smooth upwind switch
 //!   `tanh(mdot/mdot_eps)` makes them exist everywhere).
 
+/// The true bond graph of a model: junctions, causality, states.
+pub mod bond;
 mod closure;
 /// Rust emission of a whole model.
 pub mod codegen;
@@ -123,9 +125,9 @@ pub mod topology;
 pub use closure::Closure;
 pub use expr::{Arena, Id, Style, Sym};
 pub use runtime::{
-    to_dot, BodyInfo, ConductionInfo, EffectSite, FaceInfo, JacSink, JacValues, JacWrite, LinkInfo,
-    Model, ModelError, Observation, ObserveError, ParamInfo, PortInfo, PowerTerms, SensorInfo,
-    StateInfo, StateKind, TopologyInfo, VesselInfo, WallInfo,
+    to_dot, BodyElementsInfo, BodyInfo, ConductionInfo, EffectSite, FaceInfo, JacSink, JacValues,
+    JacWrite, LinkInfo, Model, ModelError, Observation, ObserveError, ParamInfo, PortInfo,
+    PowerTerms, SensorInfo, StateInfo, StateKind, TopologyInfo, VesselInfo, WallInfo,
 };
 pub use topology::{assemble, Topology};
 

@@ -2,6 +2,7 @@
 //! `stirling_model!`, seeded random physical states, and a finite-difference checker.
 #![allow(dead_code)]
 
+pub mod bond;
 pub mod fit;
 pub mod models;
 pub mod same;

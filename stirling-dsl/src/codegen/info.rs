@@ -7,6 +7,8 @@ use super::layout::Layout;
 use crate::expr::{Printer, Style};
 use crate::topology::{BlockKind, Topology, Vessel};
 
+mod bond_extras;
+
 /// `&[ParamInfo { .. }, ..]`.
 pub fn params(topo: &Topology, krate: &TokenStream) -> TokenStream {
     let items = topo.params.iter().map(|p| {
@@ -187,11 +189,12 @@ pub fn topology(topo: &Topology, lay: &Layout, krate: &TokenStream) -> TokenStre
         quote! { (#a, #b) }
     });
     let (name, doc) = (&topo.name, &topo.doc);
+    let extras = bond_extras::fields(topo, &p, krate);
     quote! {
         #krate::TopologyInfo {
             name: #name, doc: #doc, bodies: &[#(#bodies),*], couplings: &[#(#couplings),*],
             vessels: &[#(#vessels),*], links: &[#(#links),*],
-            walls: &[#(#walls),*], conductions: &[#(#conductions),*],
+            walls: &[#(#walls),*], conductions: &[#(#conductions),*], #extras
         }
     }
 }

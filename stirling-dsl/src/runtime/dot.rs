@@ -1,4 +1,6 @@
-//! The energetic (bond-graph) view of a topology as Graphviz DOT.
+//! The first, pseudo bond-graph view of a topology as Graphviz DOT (no junctions, no
+//! causality), kept for the Python binding (`stirling-py`), which draws it from the
+//! `TopologyInfo` alone. The true bond graph is [`crate::bond::bond_graph`].
 //!
 //! Bodies are inertias (`I`), gas vessels are capacitances (`C`, a given-pressure
 //! space is an effort source `Se`), each face is a transformer (`TF: a`) between a
@@ -13,7 +15,8 @@ use std::fmt::Write;
 
 use super::topology_info::TopologyInfo;
 
-/// Graphviz DOT of `t`.
+/// Graphviz DOT of the pseudo bond graph of `t` (see [`crate::bond::bond_graph`] for the
+/// true one, with junctions and causality).
 pub fn to_dot(t: &TopologyInfo) -> String {
     let mut s = String::new();
     let _ = writeln!(s, "digraph \"{}\" {{", t.name);

@@ -15,5 +15,6 @@ pub use model::{
 };
 pub use observe::{Observation, ObserveError};
 pub use topology_info::{
-    ConductionInfo, FaceInfo, LinkInfo, PortInfo, TopologyInfo, VesselInfo, WallInfo,
+    BodyElementsInfo, ConductionInfo, FaceInfo, LinkInfo, PortInfo, TopologyInfo, VesselInfo,
+    WallInfo,
 };

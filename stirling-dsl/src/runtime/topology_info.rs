@@ -1,4 +1,4 @@
-//! A static description of a declared topology, for the bond-graph (DOT) view and docs.
+//! A static description of a declared topology, for the bond graph ([`crate::bond`]) and docs.
 
 /// A heat port.
 #[derive(Clone, Copy, Debug)]
@@ -61,8 +61,24 @@ pub struct LinkInfo {
     pub chain: bool,
 }
 
+/// The mechanical elements of a body, as declared (`"0"` where absent): what the bond graph
+/// attaches to the body's 1-junction.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct BodyElementsInfo {
+    /// The moving mass (`I`).
+    pub mass: &'static str,
+    /// The spring rate (`C`).
+    pub spring: &'static str,
+    /// The viscous damping (`R`).
+    pub damper: &'static str,
+    /// The quadratic damping (`R`, force `c v |v|`).
+    pub quad_damper: &'static str,
+    /// Any further force (`MSe`).
+    pub force: &'static str,
+}
+
 /// A declared topology.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Copy, Debug, Default)]
 pub struct TopologyInfo {
     pub name: &'static str,
     pub doc: &'static str,
@@ -75,4 +91,12 @@ pub struct TopologyInfo {
     pub walls: &'static [WallInfo],
     /// Conduction links between walls, or a wall and a fixed temperature.
     pub conductions: &'static [ConductionInfo],
+    /// The elements of each body, in body order (for the bond graph); empty when unknown
+    /// (the graph then labels them by the body's name).
+    pub body_elements: &'static [BodyElementsInfo],
+    /// The damping coefficient of each coupling, in coupling order; empty when unknown.
+    pub coupling_dampers: &'static [&'static str],
+    /// The given pressure of each space (the vessels with `is_cv == false`), in their order;
+    /// empty when unknown.
+    pub space_pressures: &'static [&'static str],
 }
