@@ -22,6 +22,12 @@ pub struct NativeModel {
 }
 
 impl NativeModel {
+    /// The bond graph of the model.
+    pub fn bond(&self) -> Res<stirling_dsl::bond::CausalGraph> {
+        stirling_dsl::bond::bond_graph(self.model.as_ref())
+            .map_err(|e| Failure::new(Kind::Model, e.to_string()))
+    }
+
     pub fn dyn_model(&self) -> &dyn Model {
         self.model.as_ref()
     }
@@ -203,9 +209,15 @@ impl NativeModel {
         Ok(self.model.equations(self::style(style)?))
     }
 
-    /// The topology as Graphviz DOT (the bond-graph view of `stirling info --graph`).
-    fn dot(&self) -> String {
-        stirling_dsl::to_dot(self.model.topology())
+    /// The bond graph as Graphviz DOT (junctions, causal strokes, half-arrows), as
+    /// `stirling info --graph` writes it.
+    fn dot(&self) -> Res<String> {
+        Ok(self.bond()?.to_dot())
+    }
+
+    /// The bond graph drawn as SVG (no Graphviz needed), as `stirling info --graph --svg`.
+    fn bond_svg(&self) -> Res<String> {
+        Ok(self.bond()?.to_svg())
     }
 
     /// The parameter vector: `base` (default: the defaults) with `values` by name, validated.

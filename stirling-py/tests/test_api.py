@@ -140,3 +140,12 @@ def test_the_stub_names_every_native_function_and_class():
     public = {n for n in dir(_native) if not n.startswith("_")}
     assert public == declared, (public ^ declared)
     assert (Path(stirling.__file__).with_name("py.typed")).exists()
+
+
+def test_the_bond_graph_is_drawn_with_junctions_and_strokes():
+    m = stirling.load("cv1")
+    dot = m.dot()
+    assert "digraph" in dot and "arrowhead" in dot
+    svg = m.bond_svg()
+    assert svg.lstrip().startswith("<svg") or "<svg" in svg[:200]
+    assert "I: md" in svg and "TF" in svg

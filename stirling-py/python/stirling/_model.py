@@ -218,8 +218,13 @@ class Model:
         return self._m.equations(style)
 
     def dot(self) -> str:
-        """The topology as Graphviz DOT (the bond-graph view)."""
+        """The bond graph as Graphviz DOT: 0- and 1-junctions, causal strokes, half-arrows
+        (as ``stirling info --graph`` writes it; docs/bond-graphs.md)."""
         return self._m.dot()
+
+    def bond_svg(self) -> str:
+        """The bond graph drawn as SVG, no Graphviz needed (``stirling info --graph --svg``)."""
+        return self._m.bond_svg()
 
     # ------------------------------------------------------------------ the equations
 
