@@ -125,9 +125,9 @@ pub mod topology;
 pub use closure::Closure;
 pub use expr::{Arena, Id, Style, Sym};
 pub use runtime::{
-    to_dot, BodyElementsInfo, BodyInfo, ConductionInfo, EffectSite, FaceInfo, JacSink, JacValues,
-    JacWrite, LinkInfo, Model, ModelError, Observation, ObserveError, ParamInfo, PortInfo,
-    PowerTerms, SensorInfo, StateInfo, StateKind, TopologyInfo, VesselInfo, WallInfo,
+    BodyElementsInfo, BodyInfo, ConductionInfo, EffectSite, FaceInfo, JacSink, JacValues, JacWrite,
+    LinkInfo, Model, ModelError, Observation, ObserveError, ParamInfo, PortInfo, PowerTerms,
+    SensorInfo, StateInfo, StateKind, TopologyInfo, VesselInfo, WallInfo,
 };
 pub use topology::{assemble, Topology};
 

@@ -1,13 +1,11 @@
 //! What generated models implement and what the analyses use.
 
-mod dot;
 mod error;
 mod jac_sink;
 mod model;
 mod observe;
 mod topology_info;
 
-pub use dot::to_dot;
 pub use error::ModelError;
 pub use jac_sink::{JacSink, JacValues, JacWrite};
 pub use model::{
