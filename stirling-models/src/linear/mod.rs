@@ -175,6 +175,9 @@ pub struct Linearization {
     pub open_loop: OpenLoop,
     /// The grid the margins were bracketed on.
     pub grid: Vec<f64>,
+    /// `L(jw)` on the grid, evaluated once (each value is a solve with the shifted Jacobian:
+    /// at n = 10,000 sections the Bode data of `--json` doubled the run when evaluated again).
+    pub grid_values: Vec<nalgebra::Complex<f64>>,
     pub margins: Margins,
 }
 
@@ -206,11 +209,17 @@ pub fn linearize(
         opts.per_decade
     };
     let grid = bode::frequency_grid(&all, per_decade);
-    let margins = margins::margins(&|w| open_loop.at(w), &grid);
+    let grid_values: Vec<nalgebra::Complex<f64>> = grid.iter().map(|&w| open_loop.at(w)).collect();
+    let on_grid = |w: f64| match grid.binary_search_by(|g| g.total_cmp(&w)) {
+        Ok(k) => grid_values[k],
+        Err(_) => open_loop.at(w),
+    };
+    let margins = margins::margins(&on_grid, &grid);
     Ok(Linearization {
         dynamics,
         open_loop,
         grid,
+        grid_values,
         margins,
     })
 }
@@ -283,12 +292,20 @@ fn sparse_open_loop(
 impl Linearization {
     /// Bode data of `L(jw)` on the analysis grid.
     pub fn bode(&self) -> Bode {
-        bode::bode(&|w| self.open_loop.at(w), &self.grid)
+        bode::bode(&|w| self.on_grid(w), &self.grid)
     }
 
     /// Nyquist data of `L(jw)` on the analysis grid.
     pub fn nyquist(&self) -> Nyquist {
-        bode::nyquist(&|w| self.open_loop.at(w), &self.grid)
+        bode::nyquist(&|w| self.on_grid(w), &self.grid)
+    }
+
+    /// `L(jw)`: the stored value on the grid, else evaluated.
+    fn on_grid(&self, w: f64) -> nalgebra::Complex<f64> {
+        match self.grid.binary_search_by(|g| g.total_cmp(&w)) {
+            Ok(k) if k < self.grid_values.len() => self.grid_values[k],
+            _ => self.open_loop.at(w),
+        }
     }
 
     /// The serializable summary.
