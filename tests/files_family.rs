@@ -1,0 +1,234 @@
+//! Every family member declared in a file (`examples/engines/*.stirling`), loaded and
+//! compiled at run time, is the macro's model: the same states, parameters and sensors, and
+//! the same right-hand side, Jacobian, parameter Jacobian, sensor outputs, forces, energy and
+//! power to 1e-12 relative at random states and parameters, for n = 1, 2, 10, 100 and both
+//! closures; the compiled Jacobians agree with finite differences.
+
+mod common;
+
+use std::path::Path;
+
+use common::{fd_jacobian, fd_steps, random_state, rng, Spread};
+use rand::Rng;
+use stirling::dsl::{Closure, Model};
+use stirling::models::effects::{NSectionExtFx, NSectionFx};
+use stirling::models::family::{Cv1, Cv2, NSection, Schmidt};
+use stirling::models::files;
+
+type Build = fn(usize, Closure) -> Box<dyn Model>;
+
+/// The family members and their files, with the section counts to test.
+fn members() -> Vec<(&'static str, Build, &'static [usize])> {
+    const SCALAR: &[usize] = &[1];
+    const ARRAY: &[usize] = &[1, 2, 10, 100];
+    vec![
+        (
+            "schmidt",
+            |n, c| Box::new(Schmidt::new(n, c).unwrap()),
+            SCALAR,
+        ),
+        ("cv1", |n, c| Box::new(Cv1::new(n, c).unwrap()), SCALAR),
+        ("cv2", |n, c| Box::new(Cv2::new(n, c).unwrap()), SCALAR),
+        (
+            "nsection",
+            |n, c| Box::new(NSection::new(n, c).unwrap()),
+            ARRAY,
+        ),
+        (
+            "nsection_fx",
+            |n, c| Box::new(NSectionFx::new(n, c).unwrap()),
+            ARRAY,
+        ),
+        (
+            "nsection_ext",
+            |n, c| Box::new(NSectionExtFx::new(n, c).unwrap()),
+            ARRAY,
+        ),
+    ]
+}
+
+fn file(name: &str) -> std::path::PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("examples/engines")
+        .join(format!("{name}.stirling"))
+}
+
+/// `max |a - b| / max(|a|, |b|)` over the entries (0 where both are 0).
+fn rel(a: &[f64], b: &[f64]) -> f64 {
+    assert_eq!(a.len(), b.len());
+    a.iter()
+        .zip(b)
+        .map(|(x, y)| {
+            let m = x.abs().max(y.abs());
+            if m == 0.0 {
+                0.0
+            } else {
+                (x - y).abs() / m
+            }
+        })
+        .fold(0.0, f64::max)
+}
+
+/// The same description: name, states, parameters, sensors, effect sites, free parameters.
+fn same_description(a: &dyn Model, b: &dyn Model) {
+    assert_eq!(a.name(), b.name());
+    assert_eq!(a.n_states(), b.n_states());
+    assert_eq!(a.states(), b.states());
+    assert_eq!(a.params(), b.params());
+    assert_eq!(a.bodies(), b.bodies());
+    assert_eq!(a.sensors(), b.sensors());
+    assert_eq!(a.effect_sites(), b.effect_sites());
+    assert_eq!(a.declared_free(), b.declared_free());
+    assert_eq!(a.vessel_names(), b.vessel_names());
+    assert_eq!(a.has_array(), b.has_array());
+    assert_eq!(format!("{:?}", a.topology()), format!("{:?}", b.topology()));
+    for style in [stirling::dsl::Style::Text, stirling::dsl::Style::Latex] {
+        assert_eq!(a.equations(style), b.equations(style));
+    }
+}
+
+/// Every numeric output of the two models at `(p, x)`: the largest relative difference.
+fn compare_at(a: &dyn Model, b: &dyn Model, p: &[f64], x: &[f64]) -> f64 {
+    let n = a.n_states();
+    let mut w = 0.0f64;
+    let (mut fa, mut fb) = (vec![0.0; n], vec![0.0; n]);
+    a.rhs(p, x, 0.0, &mut fa);
+    b.rhs(p, x, 0.0, &mut fb);
+    w = w.max(rel(&fa, &fb));
+    w = w.max(rel(
+        &a.jacobian_dense(p, x, 0.0),
+        &b.jacobian_dense(p, x, 0.0),
+    ));
+    w = w.max(rel(
+        &a.param_jacobian_dense(p, x, 0.0),
+        &b.param_jacobian_dense(p, x, 0.0),
+    ));
+    let nb = a.bodies().len();
+    let (mut ga, mut gb) = (vec![0.0; nb], vec![0.0; nb]);
+    a.pressure_forces(p, x, &mut ga);
+    b.pressure_forces(p, x, &mut gb);
+    w = w.max(rel(&ga, &gb));
+    for k in 0..nb {
+        let (mut da, mut db) = (vec![0.0; n], vec![0.0; n]);
+        a.pressure_force_gradient(k, p, x, &mut da);
+        b.pressure_force_gradient(k, p, x, &mut db);
+        w = w.max(rel(&da, &db));
+    }
+    w = w.max(rel(
+        &[a.energy(p, x), a.gas_mass(p, x)],
+        &[b.energy(p, x), b.gas_mass(p, x)],
+    ));
+    let (pa, pb) = (a.power(p, x), b.power(p, x));
+    eprintln!("power {:?} {:?}", pa, pb);
+    let nv0 = a.vessel_names().len();
+    let (mut ta, mut tb) = (vec![0.0; nv0], vec![0.0; nv0]);
+    a.temperatures(p, x, &mut ta); b.temperatures(p, x, &mut tb);
+    eprintln!("temps {:e}", rel(&ta, &tb));
+    for i in 0..nv0 { if ta[i] != tb[i] { eprintln!("  T[{i}] {:e} {:e}", ta[i], tb[i]); } }
+    w = w.max(rel(
+        &[pa.heat, pa.boundary, pa.mechanical],
+        &[pb.heat, pb.boundary, pb.mechanical],
+    ));
+    let nv = a.vessel_names().len();
+    let (mut pra, mut vola, mut prb, mut volb) =
+        (vec![0.0; nv], vec![0.0; nv], vec![0.0; nv], vec![0.0; nv]);
+    a.pv(p, x, &mut pra, &mut vola);
+    b.pv(p, x, &mut prb, &mut volb);
+    w = w.max(rel(&pra, &prb)).max(rel(&vola, &volb));
+    w.max(sensors(a, b, p, x))
+}
+
+/// Every declared sensor's output and gradient, read at `x`.
+fn sensors(a: &dyn Model, b: &dyn Model, p: &[f64], x: &[f64]) -> f64 {
+    let mut w = 0.0f64;
+    for (k, s) in a.sensors().iter().enumerate() {
+        let names = a.state_names();
+        let Some(v) = s
+            .reads
+            .iter()
+            .map(|r| names.iter().position(|m| m == r).map(|i| x[i]))
+            .collect::<Option<Vec<f64>>>()
+        else {
+            continue;
+        };
+        let (mut dva, mut dvb) = (vec![0.0; v.len()], vec![0.0; v.len()]);
+        let (mut dpa, mut dpb) = (vec![0.0; p.len()], vec![0.0; p.len()]);
+        let ya = a.sensor_output(k, p, &v, &mut dva, &mut dpa);
+        let yb = b.sensor_output(k, p, &v, &mut dvb, &mut dpb);
+        w = w
+            .max(rel(&[ya], &[yb]))
+            .max(rel(&dva, &dvb))
+            .max(rel(&dpa, &dpb));
+    }
+    w
+}
+
+#[test]
+fn family_files_are_the_macro_models() {
+    let mut worst = 0.0f64;
+    for (name, build, ns) in members() {
+        for &closure in &[Closure::Full, Closure::Frozen] {
+            for &n in ns {
+                let a = files::build(&file(name), n, closure).unwrap_or_else(|e| panic!("{e}"));
+                let b = build(n, closure);
+                same_description(a.as_ref(), b.as_ref());
+                let mut r = rng(n as u64 * 7 + 3);
+                let mut w = 0.0f64;
+                for k in 0..4 {
+                    let mut p = b.default_params();
+                    if k > 0 {
+                        p.iter_mut()
+                            .for_each(|v| *v *= 1.0 + 0.1 * r.gen_range(-1.0..1.0));
+                    }
+                    let spread = if k % 2 == 0 {
+                        Spread::Wide
+                    } else {
+                        Spread::Balanced
+                    };
+                    let x = random_state(b.as_ref(), &p, spread, &mut r);
+                    let (mut ia, mut ib) = (vec![0.0; x.len()], vec![0.0; x.len()]);
+                    a.equilibrium_guess(&p, &mut ia);
+                    b.equilibrium_guess(&p, &mut ib);
+                    w = w.max(rel(&ia, &ib));
+                    w = w.max(compare_at(a.as_ref(), b.as_ref(), &p, &x));
+                }
+                assert!(
+                    w <= 1e-12,
+                    "{name} n = {n} {closure}: relative difference {w:e}"
+                );
+                worst = worst.max(w);
+            }
+        }
+    }
+    println!("largest relative difference, file vs macro: {worst:e}");
+}
+
+/// The compiled Jacobian against Ridders' finite differences of the compiled right-hand side.
+#[test]
+fn compiled_jacobians_match_finite_differences() {
+    for (name, _, ns) in members() {
+        for &n in ns.iter().filter(|&&n| n <= 10) {
+            let m = files::build(&file(name), n, Closure::Full).unwrap();
+            let p = m.default_params();
+            let mut r = rng(11 + n as u64);
+            let x = random_state(m.as_ref(), &p, Spread::Wide, &mut r);
+            let k = m.n_states();
+            let f = |x: &[f64], out: &mut [f64]| m.rhs(&p, x, 0.0, out);
+            let fd = fd_jacobian(&f, &x, k, &fd_steps(m.as_ref(), &p, &x));
+            let jac = m.jacobian_dense(&p, &x, 0.0);
+            let scales = common::state_scales(m.as_ref(), &p);
+            for c in 0..k {
+                for row in 0..k {
+                    // entries scaled by the states' typical sizes: `J_ij s_j / s_i`
+                    let s = scales[c] / scales[row];
+                    let (a, b) = (jac[row + k * c] * s, fd[row + k * c] * s);
+                    let tol = 1e-6 * (1.0 + a.abs().max(b.abs()));
+                    assert!(
+                        (a - b).abs() <= tol,
+                        "{name} n = {n}: J[{row},{c}] = {a:e}, finite differences {b:e}"
+                    );
+                }
+            }
+        }
+    }
+}
