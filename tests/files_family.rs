@@ -266,3 +266,51 @@ fn compiled_jacobians_match_finite_differences() {
         }
     }
 }
+
+/// A model compiled with its parameters folded in (`CompiledModel::folded`) is the model:
+/// every output equal at that parameter vector, on tapes with fewer instructions; at another
+/// vector it computes with the parameters as inputs (a changed parameter is never ignored).
+#[test]
+fn folded_parameters_give_the_same_model() {
+    for (name, _, ns) in members() {
+        let def = files::definition(&file(name)).unwrap();
+        for &n in ns.iter().filter(|&&n| n != 1 || ns.len() == 1) {
+            let m = def.model(n, Closure::Full).unwrap();
+            let mut r = rng(n as u64 + 101);
+            let mut p = m.default_params();
+            p.iter_mut()
+                .for_each(|v| *v *= 1.0 + 0.1 * r.gen_range(-1.0..1.0));
+            let folded = m.folded(&p);
+            let (rhs, jac) = m.tape_sizes();
+            let (frhs, fjac) = folded.tape_sizes_at(&p);
+            assert!(
+                frhs < rhs && fjac < jac,
+                "{name} n = {n}: folded tapes {frhs}, {fjac} against {rhs}, {jac}"
+            );
+            let mut w = Worst(0.0, "");
+            for spread in [Spread::Wide, Spread::Balanced] {
+                let x = random_state(&m, &p, spread, &mut r);
+                compare_at(&folded, &m, &p, &x, &mut w);
+                let (mut ia, mut ib) = (vec![0.0; x.len()], vec![0.0; x.len()]);
+                folded.equilibrium_guess(&p, &mut ia);
+                m.equilibrium_guess(&p, &mut ib);
+                w.see("equilibrium guess", &ia, &ib);
+            }
+            assert!(
+                w.0 <= 1e-12,
+                "{name} n = {n}: folded differs by {:e} in the {}",
+                w.0,
+                w.1
+            );
+            // another vector: the parameters are inputs again
+            let mut q = p.clone();
+            q[m.param_index("Th").unwrap()] *= 1.2;
+            let x = random_state(&m, &q, Spread::Wide, &mut r);
+            let (mut fa, mut fb) = (vec![0.0; x.len()], vec![0.0; x.len()]);
+            folded.rhs(&q, &x, 0.0, &mut fa);
+            m.rhs(&q, &x, 0.0, &mut fb);
+            assert_eq!(fa, fb, "{name} n = {n}: at another vector");
+            println!("{name} n = {n}: rhs tape {rhs} -> {frhs}, jacobian {jac} -> {fjac}");
+        }
+    }
+}

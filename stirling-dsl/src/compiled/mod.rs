@@ -12,6 +12,7 @@
 //!   (`statics`).
 
 mod definition;
+mod fold;
 mod functions;
 mod instance;
 mod model;

@@ -29,6 +29,7 @@ pub enum CompileError {
 }
 
 /// Every function of one model, as tapes.
+#[derive(Clone)]
 struct Functions {
     rhs: Function,
     jac: Function,
@@ -52,6 +53,9 @@ pub struct CompiledModel {
     closure: Closure,
     n_states: usize,
     f: Functions,
+    /// The functions with one parameter vector folded in (`CompiledModel::folded`): used
+    /// when called with exactly that vector, the others otherwise.
+    folded: Option<(Vec<f64>, Functions)>,
 }
 
 impl std::fmt::Debug for CompiledModel {
@@ -120,6 +124,7 @@ impl Definition {
             closure,
             n_states: sys.blocks.len() - arrays + arrays * n,
             f,
+            folded: None,
         })
     }
 
@@ -165,22 +170,78 @@ impl CompiledModel {
         (self.f.rhs.tape.ops.len(), self.f.jac.tape.ops.len())
     }
 
+    /// This model with the parameters `p` folded in: every parameter expression of every
+    /// function computed once, at `p` (what a simulation or a sweep point can use; a fit
+    /// keeps the parameters as inputs). Called with `p` it gives bit for bit what this
+    /// model gives; called with any other vector it computes with the parameters as inputs,
+    /// so a changed parameter is never silently ignored.
+    pub fn folded(&self, p: &[f64]) -> CompiledModel {
+        let fold = |f: &Function| Function {
+            tape: f.tape.fold(p),
+            places: f.places.clone(),
+        };
+        let g = &self.f;
+        let folded = Functions {
+            rhs: fold(&g.rhs),
+            jac: fold(&g.jac),
+            rhs_jac: fold(&g.rhs_jac),
+            pjac: fold(&g.pjac),
+            init: fold(&g.init),
+            forces: fold(&g.forces),
+            force_grads: g.force_grads.iter().map(fold).collect(),
+            vessels: fold(&g.vessels),
+            mech: fold(&g.mech),
+            masses: fold(&g.masses),
+            walls: g.walls.as_ref().map(fold),
+            sensors: g.sensors.iter().map(|s| s.as_ref().map(fold)).collect(),
+        };
+        CompiledModel {
+            def: Arc::clone(&self.def),
+            n: self.n,
+            closure: self.closure,
+            n_states: self.n_states,
+            f: self.f.clone(),
+            folded: Some((p.to_vec(), folded)),
+        }
+    }
+
+    /// The parameter vector folded in, if any ([`CompiledModel::folded`]).
+    pub fn folded_params(&self) -> Option<&[f64]> {
+        self.folded.as_ref().map(|(q, _)| q.as_slice())
+    }
+
+    /// The functions to run at `p`: the folded ones at the folded vector.
+    #[inline]
+    fn fns(&self, p: &[f64]) -> &Functions {
+        match &self.folded {
+            Some((q, f)) if q.as_slice() == p => f,
+            _ => &self.f,
+        }
+    }
+
+    /// The number of instructions of the right-hand side and the Jacobian's tapes at `p`
+    /// (fewer where `p` is folded in).
+    pub fn tape_sizes_at(&self, p: &[f64]) -> (usize, usize) {
+        let f = self.fns(p);
+        (f.rhs.tape.ops.len(), f.jac.tape.ops.len())
+    }
+
     /// Each vessel element's `[P, V, E, Q, boundary, m, T]`, in order.
     fn each_vessel(&self, p: &[f64], x: &[f64], mut f: impl FnMut(usize, usize, f64)) {
-        run(&self.f.vessels, p, x, &[], |(k, t), v| f(k, t, v));
+        run(&self.fns(p).vessels, p, x, &[], |(k, t), v| f(k, t, v));
     }
 
     /// `[mechanical energy, mechanical power]`.
     fn mech(&self, p: &[f64], x: &[f64]) -> [f64; 2] {
         let mut m = [0.0; 2];
-        run(&self.f.mech, p, x, &[], |(k, _), v| m[k] = v);
+        run(&self.fns(p).mech, p, x, &[], |(k, _), v| m[k] = v);
         m
     }
 
     /// `[sum C Tw, heat from outside into the walls]` (zero without walls).
     fn walls(&self, p: &[f64], x: &[f64]) -> [f64; 2] {
         let mut w = [0.0; 2];
-        if let Some(f) = &self.f.walls {
+        if let Some(f) = &self.fns(p).walls {
             run(f, p, x, &[], |(k, _), v| w[k] = v);
         }
         w
@@ -254,15 +315,15 @@ impl Model for CompiledModel {
         v
     }
     fn rhs(&self, p: &[f64], x: &[f64], _t: f64, out: &mut [f64]) {
-        run(&self.f.rhs, p, x, &[], |(r, _), v| out[r] = v);
+        run(&self.fns(p).rhs, p, x, &[], |(r, _), v| out[r] = v);
     }
     fn jacobian(&self, p: &[f64], x: &[f64], _t: f64, sink: &mut JacSink) {
-        run(&self.f.jac, p, x, &[], |(r, c), v| sink.add(r, c, v));
+        run(&self.fns(p).jac, p, x, &[], |(r, c), v| sink.add(r, c, v));
     }
     fn rhs_and_jacobian(&self, p: &[f64], x: &[f64], _t: f64, out: &mut [f64], sink: &mut JacSink) {
-        let k = self.f.rhs.places.len();
+        let k = self.fns(p).rhs.places.len();
         let mut i = 0;
-        run(&self.f.rhs_jac, p, x, &[], |(r, c), v| {
+        run(&self.fns(p).rhs_jac, p, x, &[], |(r, c), v| {
             if i < k {
                 out[r] = v;
             } else {
@@ -273,7 +334,7 @@ impl Model for CompiledModel {
     }
     fn jacobian_values(&self, p: &[f64], x: &[f64], _t: f64, values: &mut [f64]) {
         let mut i = 0;
-        run(&self.f.jac, p, x, &[], |_, v| {
+        run(&self.fns(p).jac, p, x, &[], |_, v| {
             values[i] = v;
             i += 1;
         });
@@ -286,9 +347,9 @@ impl Model for CompiledModel {
         out: &mut [f64],
         values: &mut [f64],
     ) {
-        let k = self.f.rhs.places.len();
+        let k = self.fns(p).rhs.places.len();
         let mut i = 0;
-        run(&self.f.rhs_jac, p, x, &[], |(r, _), v| {
+        run(&self.fns(p).rhs_jac, p, x, &[], |(r, _), v| {
             if i < k {
                 out[r] = v;
             } else {
@@ -301,22 +362,22 @@ impl Model for CompiledModel {
         self.f.jac.places.clone()
     }
     fn param_jacobian(&self, p: &[f64], x: &[f64], _t: f64, sink: &mut JacSink) {
-        run(&self.f.pjac, p, x, &[], |(r, c), v| sink.add(r, c, v));
+        run(&self.fns(p).pjac, p, x, &[], |(r, c), v| sink.add(r, c, v));
     }
     fn pressure_forces(&self, p: &[f64], x: &[f64], out: &mut [f64]) {
-        run(&self.f.forces, p, x, &[], |(k, _), v| out[k] = v);
+        run(&self.fns(p).forces, p, x, &[], |(k, _), v| out[k] = v);
     }
     fn pressure_force_gradient(&self, k: usize, p: &[f64], x: &[f64], out: &mut [f64]) {
         out.iter_mut().for_each(|o| *o = 0.0);
-        if let Some(f) = self.f.force_grads.get(k) {
+        if let Some(f) = self.fns(p).force_grads.get(k) {
             run(f, p, x, &[], |(c, _), v| out[c] += v);
         }
     }
     fn body_masses(&self, p: &[f64], out: &mut [f64]) {
-        run(&self.f.masses, p, &[], &[], |(k, _), v| out[k] = v);
+        run(&self.fns(p).masses, p, &[], &[], |(k, _), v| out[k] = v);
     }
     fn equilibrium_guess(&self, p: &[f64], out: &mut [f64]) {
-        run(&self.f.init, p, &[], &[], |(r, _), v| out[r] = v);
+        run(&self.fns(p).init, p, &[], &[], |(r, _), v| out[r] = v);
     }
     fn pv(&self, p: &[f64], x: &[f64], pressure: &mut [f64], volume: &mut [f64]) {
         self.each_vessel(p, x, |k, t, v| match t {
@@ -350,7 +411,7 @@ impl Model for CompiledModel {
             }
         });
         let e = total + self.mech(p, x)[0];
-        match self.f.walls {
+        match self.fns(p).walls {
             Some(_) => e + self.walls(p, x)[0],
             None => e,
         }
@@ -362,7 +423,7 @@ impl Model for CompiledModel {
             4 => boundary += v,
             _ => {}
         });
-        if self.f.walls.is_some() {
+        if self.fns(p).walls.is_some() {
             heat += self.walls(p, x)[1];
         }
         PowerTerms {
@@ -381,7 +442,7 @@ impl Model for CompiledModel {
         self.def.statics.sensors
     }
     fn sensor_output(&self, k: usize, p: &[f64], v: &[f64], dv: &mut [f64], dp: &mut [f64]) -> f64 {
-        let Some(Some(f)) = self.f.sensors.get(k) else {
+        let Some(Some(f)) = self.fns(p).sensors.get(k) else {
             dv[0] = 1.0;
             return v[0];
         };
