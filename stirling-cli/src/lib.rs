@@ -113,6 +113,21 @@ where
     v
 }
 
+fn dispatch(command: Command) -> anyhow::Result<()> {
+    match command {
+        Command::Models { json } => cmd_models::run(json),
+        Command::Diagnose(a) => cmd_diagnose::run(&a),
+        Command::Rig(a) => cmd_rig::run(&a),
+        Command::Fit(a) => cmd_fit::run(&a),
+        Command::Linearize(a) => cmd_linearize::run(&a),
+        Command::Locus(a) => cmd_locus::run(&a),
+        Command::Simulate(a) => cmd_simulate::run(&a),
+        Command::Info(a) => cmd_info::run(&a),
+        Command::Sweep(a) => cmd_sweep::run(&a),
+        Command::SweepMerge(a) => cmd_sweep::merge(&a),
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::model_option;
@@ -135,20 +150,5 @@ mod tests {
         );
         assert_eq!(run("stirling info cv1"), "stirling info cv1");
         assert_eq!(run("stirling info --model"), "stirling info --model");
-    }
-}
-
-fn dispatch(command: Command) -> anyhow::Result<()> {
-    match command {
-        Command::Models { json } => cmd_models::run(json),
-        Command::Diagnose(a) => cmd_diagnose::run(&a),
-        Command::Rig(a) => cmd_rig::run(&a),
-        Command::Fit(a) => cmd_fit::run(&a),
-        Command::Linearize(a) => cmd_linearize::run(&a),
-        Command::Locus(a) => cmd_locus::run(&a),
-        Command::Simulate(a) => cmd_simulate::run(&a),
-        Command::Info(a) => cmd_info::run(&a),
-        Command::Sweep(a) => cmd_sweep::run(&a),
-        Command::SweepMerge(a) => cmd_sweep::merge(&a),
     }
 }

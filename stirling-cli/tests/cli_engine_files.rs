@@ -97,6 +97,10 @@ fn info_linearize_and_simulate_take_the_file() {
     for needle in ["P_bounce", "c_alt", "Kv", "emf", "p_bounce", "Fc_piston"] {
         assert!(info.contains(needle), "missing `{needle}` in\n{info}");
     }
+    // the bond graph of the file's topology, the closed bounce space in it
+    let dot = ok(&["info", &file, "--n", "2", "--graph"]);
+    assert!(dot.starts_with("digraph \"alternator_file\""), "{dot}");
+    assert!(dot.contains("bounce"), "{dot}");
     // the poles from the command line are the file's model's through the Rust API
     let lin = json(&["linearize", &file, "--n", "2", "--json"]);
     assert_eq!(lin["model"], "alternator_file");

@@ -3,11 +3,12 @@
 //! each function of the [`crate::Model`] trait becomes a register tape at the `n` and closure
 //! asked for.
 //!
-//! - [`Definition`]: the topology assembled for both closures, its outputs chosen and
-//!   differentiated by the emitted code's own functions (`plan`);
-//! - [`CompiledModel`]: a definition at `n` and a closure; every expression instantiated at
-//!   its place with the emitted code's value numbering (`instance`), laid out as a [`Tape`]
-//!   (`functions`) and run by a tight interpreter loop;
+//! - [`Definition`](crate::compiled::Definition): the topology assembled for both closures,
+//!   its outputs chosen and differentiated by the emitted code's own functions (`plan`);
+//! - [`CompiledModel`](crate::compiled::CompiledModel): a definition at `n` and a closure;
+//!   every expression instantiated at its place with the emitted code's value numbering
+//!   (`instance`), laid out as a [`Tape`](crate::compiled::Tape) (`functions`) and run by a
+//!   tight interpreter loop; on request with one parameter vector folded in (`fold`);
 //! - the descriptions the trait hands out as `&'static` are leaked once per definition
 //!   (`statics`).
 

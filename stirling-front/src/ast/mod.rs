@@ -232,7 +232,7 @@ pub enum Item {
 /// unit required).
 pub struct SensorAst {
     pub name: Ident,
-    /// What the sensor reads: a state's name as [`Model::states`] lists it (`x`, `P_cold`,
+    /// What the sensor reads: a state's name as [`stirling_dsl::Model::states`] lists it (`x`, `P_cold`,
     /// `Tw_head`), an array element (`P_regen[2]`) or an expression of states and parameters.
     pub expr: syn::Expr,
     pub unit: Option<LitStr>,

@@ -1,7 +1,7 @@
 //! Engines declared in a `.stirling` file, loaded at run time: the file is read, composed with
 //! what it `extends` (the family's bases by name, other files by path), checked and lowered by
 //! the macro's own front end (`stirling_front::load`), then assembled and compiled to tapes
-//! (`stirling_dsl::compiled`). The model is a [`Model`] like the family's: every analysis and
+//! (`stirling_dsl::compiled`). The model is a [`Model`](stirling_dsl::Model) like the family's: every analysis and
 //! command runs on it.
 //!
 //! A definition is loaded once per process and file (cached by its canonical path and
