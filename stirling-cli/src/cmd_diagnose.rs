@@ -18,7 +18,8 @@ const REPORT: [&str; 2] = ["report.md", "*.svg"];
 /// Arguments of `stirling diagnose`.
 #[derive(Args, Debug)]
 pub struct DiagnoseArgs {
-    /// Model with an augmented member: cv1, nsection or nsection_ext (aliases order5, order7, order8)
+    /// Model with an augmented member: cv1, nsection or nsection_ext (aliases order5, order7,
+    /// order8), or an engine file `engine.stirling` with its `effect` items (also --model FILE)
     pub model: Option<String>,
     /// Starting parameters: sections, file, overrides
     #[command(flatten)]

@@ -21,7 +21,8 @@ const FIGURES: [&str; 3] = ["stage1_*.svg", "stage2_*.svg", "free_run_*.svg"];
 /// Arguments of `stirling fit`.
 #[derive(Args, Debug)]
 pub struct FitArgs {
-    /// Model: cv1, cv2, nsection (aliases order5..order8)
+    /// Model: cv1, cv2, nsection (aliases order5..order8), or an engine file `engine.stirling`
+    /// (also given as --model FILE)
     pub model: String,
     /// Starting parameters: sections, file, overrides
     #[command(flatten)]

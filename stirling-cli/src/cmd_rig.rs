@@ -12,7 +12,7 @@ use crate::common::ranges;
 /// Arguments of `stirling rig`.
 #[derive(Args, Debug)]
 pub struct RigArgs {
-    /// Base model: cv1, nsection or nsection_ext (nsection with wall states and the orifice leak; aliases order5, order7, order8)
+    /// Base model: cv1, nsection or nsection_ext (nsection with wall states and the orifice leak; aliases order5, order7, order8), or an engine file `engine.stirling` (also --model FILE)
     pub model: String,
     /// Effect or effect parameter, e.g. --effect leak=2e-8 --effect xmax=0.004 (repeatable);
     /// effects: leak, coulomb, regen_quadratic, end_stops, sensor_lag, sensor_gain; on nsection_ext also matrix_capacity, heater_input, orifice_leak

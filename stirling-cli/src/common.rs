@@ -88,7 +88,8 @@ impl ParamArgs {
 /// Selects a model and its parameters.
 #[derive(Args, Debug, Clone)]
 pub struct ModelArgs {
-    /// Model: schmidt, cv1, cv2, nsection (aliases order4..order8)
+    /// Model: schmidt, cv1, cv2, nsection (aliases order4..order8), or an engine file
+    /// `engine.stirling` (also given as --model FILE)
     pub model: String,
     /// Inventory closure: full (mass states, default) or frozen (seed's order count)
     #[arg(long, default_value = "full")]

@@ -55,7 +55,7 @@ enum Command {
 /// (`stirling_models::user_models::register`), then calls this: `stirling fit`, `diagnose`,
 /// `info`, `linearize`, `simulate` ... then take their names.
 pub fn main() {
-    let cli = Cli::parse();
+    let cli = Cli::parse_from(model_option(std::env::args_os()));
     if let Err(e) = dispatch(cli.command) {
         // a reader that stopped early (`| head`) is the end of the output, not an error
         if common::is_stdout_closed(&e) {
@@ -74,7 +74,43 @@ where
     I: IntoIterator<Item = T>,
     T: Into<std::ffi::OsString> + Clone,
 {
-    dispatch(Cli::try_parse_from(args)?.command)
+    dispatch(Cli::try_parse_from(model_option(args))?.command)
+}
+
+/// `stirling CMD .. --model FILE ..` as `stirling CMD FILE ..`: every command that takes a
+/// model as its first argument takes it as `--model` too (`--model FILE`, `--model=FILE`).
+fn model_option<I, T>(args: I) -> Vec<std::ffi::OsString>
+where
+    I: IntoIterator<Item = T>,
+    T: Into<std::ffi::OsString> + Clone,
+{
+    let mut v: Vec<std::ffi::OsString> = args.into_iter().map(Into::into).collect();
+    let Some(k) = v
+        .iter()
+        .skip(2)
+        .position(|a| a == "--model" || a.to_str().is_some_and(|s| s.starts_with("--model=")))
+    else {
+        return v;
+    };
+    let k = k + 2;
+    let inline = v[k]
+        .to_str()
+        .and_then(|s| s.strip_prefix("--model="))
+        .map(std::ffi::OsString::from);
+    let value = match inline {
+        Some(value) => {
+            v.remove(k);
+            value
+        }
+        // a missing value is left for clap to report
+        None if k + 1 == v.len() => return v,
+        None => {
+            v.remove(k);
+            v.remove(k)
+        }
+    };
+    v.insert(2, value);
+    v
 }
 
 fn dispatch(command: Command) -> anyhow::Result<()> {
@@ -89,5 +125,30 @@ fn dispatch(command: Command) -> anyhow::Result<()> {
         Command::Info(a) => cmd_info::run(&a),
         Command::Sweep(a) => cmd_sweep::run(&a),
         Command::SweepMerge(a) => cmd_sweep::merge(&a),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::model_option;
+
+    fn run(args: &str) -> String {
+        let v = model_option(args.split(' '));
+        let s: Vec<_> = v.iter().map(|a| a.to_string_lossy().into_owned()).collect();
+        s.join(" ")
+    }
+
+    #[test]
+    fn model_option_becomes_the_first_argument() {
+        assert_eq!(
+            run("stirling info --n 2 --model e.stirling --json"),
+            "stirling info e.stirling --n 2 --json"
+        );
+        assert_eq!(
+            run("stirling fit --model=e.stirling --data d.csv"),
+            "stirling fit e.stirling --data d.csv"
+        );
+        assert_eq!(run("stirling info cv1"), "stirling info cv1");
+        assert_eq!(run("stirling info --model"), "stirling info --model");
     }
 }

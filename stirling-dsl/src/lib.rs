@@ -115,6 +115,9 @@ pub mod bond;
 mod closure;
 /// Rust emission of a whole model.
 pub mod codegen;
+/// Models compiled at run time from a lowered topology: the same equations as the macro's,
+/// as register tapes.
+pub mod compiled;
 /// The symbolic core.
 pub mod expr;
 /// What generated models implement and what the analyses use.

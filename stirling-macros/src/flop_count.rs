@@ -11,8 +11,8 @@
 
 use proc_macro2::{Delimiter, TokenStream, TokenTree};
 
-use crate::ast::ModelAst;
 use crate::expand::expand;
+use stirling_front::ast::ModelAst;
 
 /// `nsection` as one model (the engine base and the `nsection` gas of stirling-models).
 pub(crate) const NSECTION: &str = r#"

@@ -1,17 +1,12 @@
 //! # stirling-macros: the `stirling_model!` macro
 //!
-//! Compose (bases and `extends`, merged token by token) -> parse ([`ast`](self)) -> check
-//! and lower to a topology -> assemble and differentiate with `stirling_dsl` -> emit. The generated code refers to
-//! `::stirling_dsl`, so a crate using the macro depends on `stirling-dsl` too.
+//! A thin wrapper: the front end (`stirling_front`: compose, parse, check, lower to a
+//! topology) is shared with the run-time file loader; this crate turns a base into a
+//! `macro_rules!`, routes `extends` through it, and emits the lowered topology as Rust
+//! (`stirling_dsl::codegen`). The generated code refers to `::stirling_dsl`, so a crate
+//! using the macro depends on `stirling-dsl` too.
 
-mod ast;
-mod check;
-mod compose;
-mod effects;
 mod expand;
-mod expr;
-mod links;
-mod walls;
 
 use proc_macro::TokenStream;
 
@@ -41,8 +36,8 @@ use proc_macro::TokenStream;
 /// `modify <kind> <name> { fields }`, merged before the check.
 #[proc_macro]
 pub fn stirling_model(input: TokenStream) -> TokenStream {
-    compose::parse(input.into())
-        .and_then(compose::expand)
+    stirling_front::compose::parse(input.into())
+        .and_then(expand::declaration)
         .unwrap_or_else(syn::Error::into_compile_error)
         .into()
 }

@@ -3,8 +3,8 @@
 
 use proc_macro2::{TokenStream, TokenTree};
 
-use crate::ast::ModelAst;
 use crate::expand::expand;
+use stirling_front::ast::ModelAst;
 
 /// One gas space on one piston with one heat port, against a bounce space.
 const ONE_CV: &str = r#"

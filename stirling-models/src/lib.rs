@@ -145,7 +145,7 @@ pub mod sim;
 /// Design sweeps: poles, whether the engine runs, and its cycle over a parameter grid.
 pub mod sweep;
 
-pub use model::{bounds, effects, family, outside, params, registry, user_models};
+pub use model::{bounds, effects, family, files, outside, params, registry, user_models};
 pub use registry::{build, RegistryError, FAMILY};
 pub use stirling_dsl as dsl;
 /// The macro at this crate's root: the exported bases (`default_engine`, `nsection_engine`)

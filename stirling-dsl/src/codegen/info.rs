@@ -1,7 +1,7 @@
 //! Static descriptions emitted with a model: parameters, bodies, states, topology.
 
 use proc_macro2::TokenStream;
-use quote::quote;
+use quote::{format_ident, quote};
 
 use super::layout::Layout;
 use crate::expr::{Printer, Style};
@@ -75,25 +75,62 @@ fn wall_element_offset(topo: &Topology, w: usize) -> (usize, usize) {
     )
 }
 
+/// What the states of block `b` are: the kind's name, the unit, the meaning, and the
+/// element index of its first state as `(scalars before, arrays before)` (the body's number
+/// for a body's block) with whether it is a body's.
+pub(crate) fn block_meaning(
+    topo: &Topology,
+    kind: BlockKind,
+) -> (&'static str, &'static str, String, (usize, usize), bool) {
+    match kind {
+        BlockKind::Position(k) => (
+            "Position",
+            "m",
+            format!("position of the {}", topo.bodies[k].name),
+            (k, 0),
+            true,
+        ),
+        BlockKind::Velocity(k) => (
+            "Velocity",
+            "m/s",
+            format!("velocity of the {}", topo.bodies[k].name),
+            (k, 0),
+            true,
+        ),
+        BlockKind::Pressure(i) => (
+            "Pressure",
+            "Pa",
+            format!("gas pressure in CV {}", topo.cvs[i].name),
+            cv_element_offset(topo, i),
+            false,
+        ),
+        BlockKind::Mass(i) => (
+            "Mass",
+            "kg",
+            format!("gas mass in CV {}", topo.cvs[i].name),
+            cv_element_offset(topo, i),
+            false,
+        ),
+        BlockKind::WallTemperature(w) => (
+            "WallTemperature",
+            "K",
+            format!("temperature of wall {}", topo.walls[w].name),
+            wall_element_offset(topo, w),
+            false,
+        ),
+    }
+}
+
 /// Body of `fn states(&self) -> Vec<StateInfo>` for one closure.
 pub fn states(lay: &Layout, krate: &TokenStream) -> TokenStream {
     let topo = lay.topo;
     let pushes = lay.sys.blocks.iter().map(|b| {
-        let (kind, unit, what, elem) = match b.kind {
-            BlockKind::Position(k) => (quote!(Position), "m", format!("position of the {}", topo.bodies[k].name), Some(k)),
-            BlockKind::Velocity(k) => (quote!(Velocity), "m/s", format!("velocity of the {}", topo.bodies[k].name), Some(k)),
-            BlockKind::Pressure(i) => (quote!(Pressure), "Pa", format!("gas pressure in CV {}", topo.cvs[i].name), None),
-            BlockKind::Mass(i) => (quote!(Mass), "kg", format!("gas mass in CV {}", topo.cvs[i].name), None),
-            BlockKind::WallTemperature(w) => (quote!(WallTemperature), "K", format!("temperature of wall {}", topo.walls[w].name), None),
-        };
-        let (s, a) = match b.kind {
-            BlockKind::Pressure(i) | BlockKind::Mass(i) => cv_element_offset(topo, i),
-            BlockKind::WallTemperature(w) => wall_element_offset(topo, w),
-            _ => (0, 0),
-        };
-        let index = match elem {
-            Some(k) => quote!(#k),
-            None => quote!(#s + #a * n + j),
+        let (kind, unit, what, (s, a), body) = block_meaning(topo, b.kind);
+        let kind = format_ident!("{}", kind);
+        let index = if body {
+            quote!(#s)
+        } else {
+            quote!(#s + #a * n + j)
         };
         let name = &b.name;
         let (name_expr, meaning_expr, range) = if b.array {
@@ -134,62 +171,132 @@ pub fn vessel_names(topo: &Topology) -> TokenStream {
     }
 }
 
-/// The static `TopologyInfo`.
-pub fn topology(topo: &Topology, lay: &Layout, krate: &TokenStream) -> TokenStream {
+/// The strings of a `TopologyInfo`, as the emitted static and the run-time model
+/// (`crate::compiled`) both hold them.
+pub(crate) struct TopologyText {
+    /// `(name, is_cv, array, faces (body, coeff), ports (name, wall, wall_ref))`.
+    pub vessels: Vec<(
+        String,
+        bool,
+        bool,
+        Vec<(String, String)>,
+        Vec<(String, String, Option<String>)>,
+    )>,
+    /// `(from, to, resistance, chain)`.
+    pub links: Vec<(String, String, String, bool)>,
+    /// `(name, array, capacity, input)`.
+    pub walls: Vec<(String, bool, String, String)>,
+    /// `(from, to, conductance, chain, fixed)`.
+    pub conductions: Vec<(String, String, String, bool, [bool; 2])>,
+    pub couplings: Vec<(String, String)>,
+    /// What only the bond graph reads ([`bond_extras`]).
+    pub extras: bond_extras::ExtrasText,
+}
+
+/// The strings of the topology's description.
+pub(crate) fn topology_text(topo: &Topology, lay: &Layout) -> TopologyText {
     let namer = |s| lay.name(s);
     let p = Printer::new(&topo.arena, Style::Text, &namer);
     let body_name = |k: usize| topo.bodies[k].name.clone();
-    let face = |f: &crate::topology::FaceDecl| {
-        let (b, c) = (body_name(f.body), p.expr(f.coeff));
-        quote! { #krate::FaceInfo { body: #b, coeff: #c } }
-    };
+    let face = |f: &crate::topology::FaceDecl| (body_name(f.body), p.expr(f.coeff));
     let mut vessels = Vec::new();
     for c in &topo.cvs {
-        let faces = c.faces.iter().map(face);
-        let ports = c.ports.iter().map(|pt| {
-            let (n, w) = (&pt.name, p.expr(pt.wall));
-            let r = match pt.wall_ref {
-                Some(k) => {
-                    let name = &topo.walls[k].name;
-                    quote!(Some(#name))
-                }
+        let faces = c.faces.iter().map(face).collect();
+        let ports = c
+            .ports
+            .iter()
+            .map(|pt| {
+                let r = pt.wall_ref.map(|k| topo.walls[k].name.clone());
+                (pt.name.clone(), p.expr(pt.wall), r)
+            })
+            .collect();
+        vessels.push((c.name.clone(), true, c.array, faces, ports));
+    }
+    for s in &topo.spaces {
+        let faces = s.faces.iter().map(face).collect();
+        vessels.push((s.name.clone(), false, false, faces, Vec::new()));
+    }
+    let links = topo
+        .links
+        .iter()
+        .map(|l| {
+            let end = |e: &crate::topology::End| match e.vessel {
+                Vessel::Cv(i) => crate::topology::frame::rename(
+                    &format!("{}{}", topo.cvs[i].name, at_text(e.at)),
+                    crate::topology::frame::Place::Own,
+                ),
+                Vessel::Space(s) => topo.spaces[s].name.clone(),
+                Vessel::Wall(w) => topo.walls[w].name.clone(),
+            };
+            let chain = l.is_chain() || l.is_per_section();
+            (end(&l.from), end(&l.to), p.expr(l.resistance), chain)
+        })
+        .collect();
+    let walls = topo
+        .walls
+        .iter()
+        .map(|w| (w.name.clone(), w.array, p.expr(w.capacity), p.expr(w.input)))
+        .collect();
+    let end = |e: &crate::topology::HeatEnd| match e {
+        crate::topology::HeatEnd::Wall(e) => match e.vessel {
+            Vessel::Wall(w) => (format!("{}{}", topo.walls[w].name, at_text(e.at)), false),
+            // a conduction end is a wall (the check refuses anything else)
+            _ => (String::new(), false),
+        },
+        crate::topology::HeatEnd::Fixed(t) => (p.expr(*t), true),
+    };
+    let conductions = topo
+        .conductions
+        .iter()
+        .map(|c| {
+            let ((f, ff), (t, tf)) = (end(&c.from), end(&c.to));
+            (f, t, p.expr(c.conductance), c.is_chain(), [ff, tf])
+        })
+        .collect();
+    let couplings = topo
+        .couplings
+        .iter()
+        .map(|c| (body_name(c.a), body_name(c.b)))
+        .collect();
+    TopologyText {
+        vessels,
+        links,
+        walls,
+        conductions,
+        couplings,
+        extras: bond_extras::texts(topo, &p),
+    }
+}
+
+/// The static `TopologyInfo`.
+pub fn topology(topo: &Topology, lay: &Layout, krate: &TokenStream) -> TokenStream {
+    let t = topology_text(topo, lay);
+    let vessels = t.vessels.iter().map(|(name, is_cv, array, faces, ports)| {
+        let faces = faces
+            .iter()
+            .map(|(b, c)| quote! { #krate::FaceInfo { body: #b, coeff: #c } });
+        let ports = ports.iter().map(|(n, w, r)| {
+            let r = match r {
+                Some(name) => quote!(Some(#name)),
                 None => quote!(None),
             };
             quote! { #krate::PortInfo { name: #n, wall: #w, wall_ref: #r } }
         });
-        let (name, array) = (&c.name, c.array);
-        vessels.push(quote! { #krate::VesselInfo { name: #name, is_cv: true, array: #array, faces: &[#(#faces),*], ports: &[#(#ports),*] } });
-    }
-    for s in &topo.spaces {
-        let faces = s.faces.iter().map(face);
-        let name = &s.name;
-        vessels.push(quote! { #krate::VesselInfo { name: #name, is_cv: false, array: false, faces: &[#(#faces),*], ports: &[] } });
-    }
-    let links = topo.links.iter().map(|l| {
-        let end = |e: &crate::topology::End| match e.vessel {
-            Vessel::Cv(i) => crate::topology::frame::rename(
-                &format!("{}{}", topo.cvs[i].name, at_text(e.at)),
-                crate::topology::frame::Place::Own,
-            ),
-            Vessel::Space(s) => topo.spaces[s].name.clone(),
-            Vessel::Wall(w) => topo.walls[w].name.clone(),
-        };
-        let (f, t, r, chain) = (
-            end(&l.from),
-            end(&l.to),
-            p.expr(l.resistance),
-            l.is_chain() || l.is_per_section(),
-        );
-        quote! { #krate::LinkInfo { from: #f, to: #t, resistance: #r, chain: #chain } }
+        quote! { #krate::VesselInfo { name: #name, is_cv: #is_cv, array: #array, faces: &[#(#faces),*], ports: &[#(#ports),*] } }
     });
-    let (walls, conductions) = wall_infos(topo, &p, krate);
+    let links = t.links.iter().map(|(f, to, r, chain)| {
+        quote! { #krate::LinkInfo { from: #f, to: #to, resistance: #r, chain: #chain } }
+    });
+    let walls = t.walls.iter().map(|(name, array, c, q)| {
+        quote! { #krate::WallInfo { name: #name, array: #array, capacity: #c, input: #q } }
+    });
+    let conductions = t.conductions.iter().map(|(f, to, g, chain, [ff, tf])| {
+        quote! { #krate::ConductionInfo { from: #f, to: #to, conductance: #g, chain: #chain, fixed: [#ff, #tf] } }
+    });
     let bodies = topo.bodies.iter().map(|b| &b.name);
-    let couplings = topo.couplings.iter().map(|c| {
-        let (a, b) = (body_name(c.a), body_name(c.b));
-        quote! { (#a, #b) }
-    });
+    let couplings = t.couplings.iter().map(|(a, b)| quote! { (#a, #b) });
     let (name, doc) = (&topo.name, &topo.doc);
-    let extras = bond_extras::fields(topo, &p, krate);
+    let extras = bond_extras::fields(&t.extras, krate);
     quote! {
         #krate::TopologyInfo {
             name: #name, doc: #doc, bodies: &[#(#bodies),*], couplings: &[#(#couplings),*],
@@ -197,32 +304,6 @@ pub fn topology(topo: &Topology, lay: &Layout, krate: &TokenStream) -> TokenStre
             walls: &[#(#walls),*], conductions: &[#(#conductions),*], #extras
         }
     }
-}
-
-/// The `WallInfo`s and `ConductionInfo`s of `topo`.
-fn wall_infos(
-    topo: &Topology,
-    p: &Printer,
-    krate: &TokenStream,
-) -> (Vec<TokenStream>, Vec<TokenStream>) {
-    let walls = topo.walls.iter().map(|w| {
-        let (name, array) = (&w.name, w.array);
-        let (c, q) = (p.expr(w.capacity), p.expr(w.input));
-        quote! { #krate::WallInfo { name: #name, array: #array, capacity: #c, input: #q } }
-    });
-    let end = |e: &crate::topology::HeatEnd| match e {
-        crate::topology::HeatEnd::Wall(e) => match e.vessel {
-            Vessel::Wall(w) => (format!("{}{}", topo.walls[w].name, at_text(e.at)), false),
-            _ => unreachable!("a conduction end is a wall"),
-        },
-        crate::topology::HeatEnd::Fixed(t) => (p.expr(*t), true),
-    };
-    let conductions = topo.conductions.iter().map(|c| {
-        let ((f, ff), (t, tf)) = (end(&c.from), end(&c.to));
-        let (g, chain) = (p.expr(c.conductance), c.is_chain());
-        quote! { #krate::ConductionInfo { from: #f, to: #t, conductance: #g, chain: #chain, fixed: [#ff, #tf] } }
-    });
-    (walls.collect(), conductions.collect())
 }
 
 fn at_text(at: crate::expr::At) -> String {

@@ -1,15 +1,15 @@
 //! Rust emission of a whole model: the struct, its parameter struct and the
 //! [`crate::Model`] implementation, for both inventory closures.
 
-mod canon;
-mod equations;
+pub(crate) mod canon;
+pub(crate) mod equations;
 mod functions;
-mod info;
+pub(crate) mod info;
 mod layout;
-mod rows;
+pub(crate) mod rows;
 mod sections;
-mod sensors;
-mod sums;
+pub(crate) mod sensors;
+pub(crate) mod sums;
 mod terms;
 
 use proc_macro2::{Ident, Span, TokenStream};

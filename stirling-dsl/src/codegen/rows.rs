@@ -59,7 +59,14 @@ pub fn rows_body(
             let ids: Vec<Id> = scalar.iter().map(|&(_, id)| id).collect();
             super::sums::gradients(arena, lay, &ids, what, private)
         });
-        entries_s.extend(entries(arena, lay, &scalar, what, false, grads.as_ref()));
+        entries_s.extend(entries(
+            arena,
+            lay,
+            &scalar,
+            what,
+            false,
+            grads.as_ref().map(|g| &g.grads),
+        ));
         if let Some(g) = &grads {
             head.extend(g.code.clone());
             let rows: Vec<(TokenStream, Id)> = scalar
@@ -86,14 +93,54 @@ fn entries(
     rows: &[(usize, Id)],
     what: Output,
     in_loop: bool,
-    sums: Option<&super::sums::SumGradients>,
+    sums: Option<&super::sums::SumGrads>,
 ) -> Vec<Entry> {
+    let at = if in_loop { At::Rel(0) } else { At::Scalar };
+    outputs(arena, rows, what, sums)
+        .into_iter()
+        .map(|o| Entry {
+            id: o.id,
+            row: lay.index(lay.sys.blocks[o.block].sym, at),
+            col: o.col.map(|s| match s {
+                Sym::State(cb, cat) => lay.index(cb, cat),
+                Sym::Param(k) => {
+                    let k = Literal::u32_unsuffixed(k);
+                    quote!(#k)
+                }
+                _ => unreachable!("outputs gives state and parameter columns only"),
+            }),
+        })
+        .collect()
+}
+
+/// One output of a row: its value (`col` `None`) or a nonzero derivative in column `col`
+/// (a state or a parameter symbol).
+pub struct RowOutput {
+    /// The row's block, by its position in state order.
+    pub block: usize,
+    pub col: Option<Sym>,
+    pub id: Id,
+}
+
+/// The outputs of `rows` (block position, expression) for `what`: the values, or the nonzero
+/// derivatives in their columns, the sums' chain rule included for the columns that do not
+/// change with the section (`sums`: the scalar rows' [`super::sums::SumGrads`]). Shared by
+/// the emitted code and the run-time tape (`crate::compiled`), so both hold the same
+/// expressions.
+pub fn outputs(
+    arena: &mut Arena,
+    rows: &[(usize, Id)],
+    what: Output,
+    sums: Option<&super::sums::SumGrads>,
+) -> Vec<RowOutput> {
     let mut out = Vec::new();
-    for &(b, id) in rows {
-        let at = if in_loop { At::Rel(0) } else { At::Scalar };
-        let row = lay.index(lay.sys.blocks[b].sym, at);
+    for &(block, id) in rows {
         if what == Output::Value {
-            out.push(Entry { id, row, col: None });
+            out.push(RowOutput {
+                block,
+                col: None,
+                id,
+            });
             continue;
         }
         let cols = match sums {
@@ -101,24 +148,21 @@ fn entries(
             None => arena.symbols(id),
         };
         for s in cols {
-            let col = match (what, s) {
-                (Output::StateJacobian, Sym::State(cb, cat)) => lay.index(cb, cat),
-                (Output::ParamJacobian, Sym::Param(k)) => {
-                    let k = Literal::u32_unsuffixed(k);
-                    quote!(#k)
-                }
+            match (what, s) {
+                (Output::StateJacobian, Sym::State(..))
+                | (Output::ParamJacobian, Sym::Param(_)) => {}
                 _ => continue,
-            };
+            }
             let mut d = arena.diff(id, s);
             if let Some(g) = sums {
                 // the sections' part through the sums: `df/dS_k dS_k/ds`
                 d = g.total(arena, id, s, d);
             }
             if arena.as_const(d) != Some(0.0) {
-                out.push(Entry {
+                out.push(RowOutput {
+                    block,
+                    col: Some(s),
                     id: d,
-                    row: row.clone(),
-                    col: Some(col),
                 });
             }
         }

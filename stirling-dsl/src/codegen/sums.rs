@@ -72,15 +72,24 @@ fn sum_loop(
     }
 }
 
-/// The derivatives of the sums along the columns that do not change with the section.
+/// The derivatives of the sums along the columns that do not change with the section, and
+/// the loop that accumulates them.
 pub struct SumGradients {
     /// The loop that accumulates them (`__sum{K}` after the sums themselves).
     pub code: TokenStream,
-    /// `(k, column, dS_k/dcolumn as the symbol Sum(K))`.
-    grads: Vec<(u32, Sym, Id)>,
+    pub grads: SumGrads,
 }
 
-impl SumGradients {
+/// The derivatives of the sums along the columns that do not change with the section: each a
+/// sum of its own, `Sym::Sum(K)` over a template of [`SumGrads::templates`].
+pub struct SumGrads {
+    /// `(k, column, dS_k/dcolumn as the symbol Sum(K))`.
+    grads: Vec<(u32, Sym, Id)>,
+    /// The templates of the new sums, `Sym::Sum(first + i)` for `templates[i]`.
+    pub templates: Vec<Id>,
+}
+
+impl SumGrads {
     /// `dS_k/ds` (the symbol of its accumulator), if nonzero.
     fn get(&self, k: u32, s: Sym) -> Option<Id> {
         let found = self.grads.iter().find(|g| g.0 == k && g.1 == s);
@@ -139,6 +148,25 @@ pub fn gradients(
     what: Output,
     private: &TokenStream,
 ) -> SumGradients {
+    let first = lay.sys.sums.len();
+    let grads = gradient_sums(arena, &lay.sys.sums, rows, what, first);
+    let code = if grads.templates.is_empty() {
+        TokenStream::new()
+    } else {
+        sum_loop(arena, lay, &grads.templates, first, private)
+    };
+    SumGradients { code, grads }
+}
+
+/// The sums' derivatives along the fixed columns of `what` for the sums (templates `sums`)
+/// that `rows` use, numbered as sums from `first` on.
+pub fn gradient_sums(
+    arena: &mut Arena,
+    sums: &[Id],
+    rows: &[Id],
+    what: Output,
+    first: usize,
+) -> SumGrads {
     let mut used: Vec<u32> = Vec::new();
     for &r in rows {
         for k in sums_of(arena, r) {
@@ -148,10 +176,9 @@ pub fn gradients(
         }
     }
     used.sort_unstable();
-    let first = lay.sys.sums.len();
     let (mut templates, mut grads) = (Vec::new(), Vec::new());
     for k in used {
-        let template = lay.sys.sums[k as usize];
+        let template = sums[k as usize];
         for s in arena.symbols(template) {
             if !fixed_column(what, s) {
                 continue;
@@ -165,12 +192,7 @@ pub fn gradients(
             grads.push((k, s, sym));
         }
     }
-    let code = if templates.is_empty() {
-        TokenStream::new()
-    } else {
-        sum_loop(arena, lay, &templates, first, private)
-    };
-    SumGradients { code, grads }
+    SumGrads { grads, templates }
 }
 
 /// The chain-rule entries of the scalar rows `(row index, expression)` in the columns of the
@@ -187,16 +209,47 @@ pub fn jacobian(
         return code;
     }
     for (row, id) in rows {
-        for k in sums_of(arena, *id) {
-            let d = arena.diff(*id, Sym::Sum(k));
-            if arena.as_const(d) == Some(0.0) {
-                continue;
-            }
-            let template = lay.sys.sums[k as usize];
-            code.extend(one_sum(arena, lay, row, d, template, private));
+        for c in chains(arena, &lay.sys.sums, *id) {
+            code.extend(one_sum(arena, lay, row, &c, private));
         }
     }
     code
+}
+
+/// A scalar row's dependence on the sections through sum `S_k`: the entries `d * ds(j)` in
+/// the columns `cols` at every section `j`.
+pub struct Chain {
+    /// `df/dS_k`, in the row's frame.
+    pub d: Id,
+    /// The columns of the sections (`Sym::State(block, At::Rel(r))`) with `ds_k(j)/dcol`, in
+    /// the array's frame.
+    pub cols: Vec<(Sym, Id)>,
+}
+
+/// The chains of the scalar row `id` through the sums (templates `sums`), in sum order.
+pub fn chains(arena: &mut Arena, sums: &[Id], id: Id) -> Vec<Chain> {
+    let mut out = Vec::new();
+    for k in sums_of(arena, id) {
+        let d = arena.diff(id, Sym::Sum(k));
+        if arena.as_const(d) == Some(0.0) {
+            continue;
+        }
+        let template = sums[k as usize];
+        let mut cols = Vec::new();
+        for s in arena.symbols(template) {
+            if !matches!(s, Sym::State(_, At::Rel(_))) {
+                continue;
+            }
+            let ds = arena.diff(template, s);
+            if arena.as_const(ds) != Some(0.0) {
+                cols.push((s, ds));
+            }
+        }
+        if !cols.is_empty() {
+            out.push(Chain { d, cols });
+        }
+    }
+    out
 }
 
 /// `{ let __d = df/dS; for j in 0..n { sink.add(row, col(j), __d * ds(j)/dcol); .. } }`.
@@ -204,23 +257,16 @@ fn one_sum(
     arena: &mut Arena,
     lay: &Layout,
     row: &TokenStream,
-    d: Id,
-    template: Id,
+    c: &Chain,
     private: &TokenStream,
 ) -> TokenStream {
-    let (mut cols, mut roots) = (Vec::new(), vec![d]);
-    for s in arena.symbols(template) {
-        let Sym::State(b, at @ At::Rel(_)) = s else {
-            continue;
-        };
-        let ds = arena.diff(template, s);
-        if arena.as_const(ds) != Some(0.0) {
+    let mut cols = Vec::new();
+    let mut roots = vec![c.d];
+    for &(s, ds) in &c.cols {
+        if let Sym::State(b, at) = s {
             cols.push(lay.index(b, at));
             roots.push(ds);
         }
-    }
-    if cols.is_empty() {
-        return TokenStream::new();
     }
     let leaf = |s: Sym| lay.leaf(s);
     let (arena, roots) = reciprocal_form(arena, &roots);

@@ -15,6 +15,8 @@ pub mod family;
 pub mod bounds;
 /// Effects the nominal models leave out, as DSL-declared model augmentations.
 pub mod effects;
+/// Engines declared in `.stirling` files, loaded and compiled at run time.
+pub mod files;
 /// Causes outside the effect library: truth models for the rig and the self-check only.
 pub mod outside;
 /// Parameter files, overrides and validation.

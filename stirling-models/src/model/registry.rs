@@ -34,6 +34,9 @@ pub enum RegistryError {
     UnknownModel(String),
     #[error("model `{model}`: {why}")]
     User { model: String, why: String },
+    /// An engine file that does not load or build (its messages at `path:line:column`).
+    #[error("{0}")]
+    File(String),
     #[error("model `{model}` has no regenerator sections: --n {n} does not apply (omit --n)")]
     NotAnArray { model: String, n: usize },
     #[error("--n must be at least 1, found {0}")]
@@ -46,12 +49,17 @@ pub enum RegistryError {
     },
 }
 
-/// Build a family member; `n` is `None` when not given (default 1 section for `nsection`).
+/// Build a family member, a registered model or the model of an engine file (a name ending
+/// in `.stirling`, [`crate::files`]); `n` is `None` when not given (default 1 section for
+/// `nsection` and a file's arrays).
 pub fn build(
     name: &str,
     n: Option<usize>,
     closure: Closure,
 ) -> Result<Box<dyn Model>, RegistryError> {
+    if crate::files::is_file(name) {
+        return file_model(name, n, closure);
+    }
     let (canonical, fixed_n) = match name {
         "order4" => ("schmidt", None),
         "order5" => ("cv1", None),
@@ -99,6 +107,20 @@ pub fn build(
         _ => return user_model(name, n, closure),
     };
     Ok(boxed)
+}
+
+/// The model of the engine file `name` at `n` (1 when not given).
+fn file_model(
+    name: &str,
+    n: Option<usize>,
+    closure: Closure,
+) -> Result<Box<dyn Model>, RegistryError> {
+    if n == Some(0) {
+        return Err(RegistryError::ZeroSections(0));
+    }
+    let path = std::path::Path::new(name);
+    crate::files::build(path, n.unwrap_or(1), closure)
+        .map_err(|e| RegistryError::File(e.to_string()))
 }
 
 /// A registered user model ([`crate::model::user_models`]).

@@ -277,8 +277,11 @@ fn truth(cfg: &RigConfig, model: &dyn Model, p: &[f64], fx: EffectSettings) -> T
 /// Run the rig.
 pub fn run(cfg: &RigConfig) -> Result<RigOutput, RigError> {
     validate(cfg)?;
-    // a registered model's rig reads its declared sensors; the family's, the seed's four
-    if crate::model::user_models::find(&cfg.model).is_none() {
+    // a registered model's or an engine file's rig reads its declared sensors; the
+    // family's, the seed's four
+    let declared =
+        crate::model::user_models::find(&cfg.model).is_some() || crate::files::is_file(&cfg.model);
+    if !declared {
         check_seed_channels(&cfg.channels)?;
     }
     let (model, fx, p) = engine(cfg)?;
@@ -324,13 +327,13 @@ fn check_seed_channels(channels: &[String]) -> Result<(), RigError> {
 }
 
 /// A channel's meaning and unit, for the CSV header comment.
-fn describe(channel: &str) -> &'static str {
+fn describe(channel: &str) -> String {
     match channel {
-        "p" => "p cold-side pressure [Pa]",
-        "p_hot" => "p_hot hot-side pressure [Pa]",
-        "x" => "x displacer [m]",
-        "y" => "y piston [m]",
-        _ => "unknown",
+        "p" => "p cold-side pressure [Pa]".into(),
+        "p_hot" => "p_hot hot-side pressure [Pa]".into(),
+        "x" => "x displacer [m]".into(),
+        "y" => "y piston [m]".into(),
+        other => format!("{other} (a sensor the model declares)"),
     }
 }
 

@@ -263,6 +263,11 @@ pub fn augmented(
     n: Option<usize>,
     closure: Closure,
 ) -> Result<Box<dyn Model>, EffectError> {
+    if crate::files::is_file(base) {
+        // an engine file declares its effects itself: it is its own augmented member
+        return crate::registry::build(base, n, closure)
+            .map_err(|e| EffectError::Model(e.to_string()));
+    }
     if let Some(u) = crate::model::user_models::find(base) {
         // a model registered without an augmented member carries no model effect
         let build = u.augmented.unwrap_or(u.build);

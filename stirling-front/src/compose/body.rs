@@ -1,7 +1,6 @@
 //! A body's tokens split into keyed entries (items, parameters one by one).
 
 use proc_macro2::{Span, TokenStream, TokenTree};
-use quote::ToTokens;
 use syn::parse::{ParseStream, Parser};
 use syn::Ident;
 
@@ -51,15 +50,8 @@ pub(super) fn entry(input: ParseStream) -> syn::Result<Entry> {
     Ok(Entry::Item(Chunk { key, span, tokens }))
 }
 
-pub(crate) fn end_str(e: &EndAst) -> String {
-    match &e.index {
-        Some(i) => format!("{}[{}]", e.name, i.to_token_stream()),
-        None => e.name.to_string(),
-    }
-}
-
 pub(super) fn link_key(from: &EndAst, to: &EndAst) -> Key {
-    Key::Link(end_str(from), end_str(to))
+    Key::Link(from.text(), to.text())
 }
 
 /// Split a group's tokens at its top-level commas (empty pieces dropped).

@@ -15,9 +15,11 @@ use crate::expr::{convert, Scope};
 mod declare;
 mod fields;
 mod flow;
+mod links;
 mod mechanics;
 mod sensors;
 mod vessels;
+mod walls;
 
 /// Collects errors so that all are reported at once.
 #[derive(Default)]

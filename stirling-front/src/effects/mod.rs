@@ -21,15 +21,14 @@
 //! parsed model before the check, so a term is checked like one written by hand.
 
 mod kinds;
-mod parse;
 mod ports;
-
-pub use parse::{EffectAst, Site};
 
 use stirling_dsl::topology::EffectSiteDecl;
 use syn::{Expr, Ident};
 
-use crate::ast::{BodyAst, EndAst, Field, Item, LinkAst, ModelAst, ParamAst};
+use crate::ast::{
+    ends, BodyAst, EffectAst, EndAst, Field, Item, LinkAst, ModelAst, ParamAst, Site,
+};
 use kinds::{Kind, Where, KINDS};
 
 /// Apply every `effect` item of `ast` and return the sites. A link an effect adds takes the
@@ -236,14 +235,13 @@ fn on_link(
     kind: &Kind,
     fields: fn(&[Ident]) -> Vec<(&'static str, Expr)>,
     e: &EffectAst,
-    (from, to): (&crate::ast::EndAst, &crate::ast::EndAst),
+    (from, to): (&EndAst, &EndAst),
 ) -> syn::Result<Vec<Ident>> {
-    let end = crate::compose::end_str;
     let link = ast.items.iter_mut().find_map(|it| match it {
-        Item::Link(l) if end(&l.from) == end(from) && end(&l.to) == end(to) => Some(l),
+        Item::Link(l) if l.from.text() == from.text() && l.to.text() == to.text() => Some(l),
         _ => None,
     });
-    let site = parse::ends(from, to);
+    let site = ends(from, to);
     let Some(link) = link else {
         let msg = format!("effect `{}` on link `{site}`: no link `{site}` (its ends as the link item writes them)", kind.name);
         return Err(syn::Error::new(from.name.span(), msg));

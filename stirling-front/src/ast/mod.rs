@@ -34,7 +34,12 @@
 //! }
 //! ```
 
+mod effect;
+
+pub use effect::{EffectAst, Site};
+
 use proc_macro2::Span;
+use quote::ToTokens;
 use syn::parse::{Parse, ParseStream};
 use syn::punctuated::Punctuated;
 use syn::{braced, bracketed, parenthesized, Attribute, Expr, Ident, LitStr, Token, Visibility};
@@ -157,6 +162,21 @@ pub struct EndAst {
     pub index: Option<Expr>,
 }
 
+impl EndAst {
+    /// As written: `hot`, `regen[j + 1]` (the key of a link and of an effect's site).
+    pub fn text(&self) -> String {
+        match &self.index {
+            Some(i) => format!("{}[{}]", self.name, i.to_token_stream()),
+            None => self.name.to_string(),
+        }
+    }
+}
+
+/// `from -> to` with the ends as written.
+pub fn ends(from: &EndAst, to: &EndAst) -> String {
+    format!("{} -> {}", from.text(), to.text())
+}
+
 impl Parse for EndAst {
     fn parse(input: ParseStream) -> syn::Result<Self> {
         let name = input.parse()?;
@@ -204,7 +224,7 @@ pub enum Item {
     /// `free a, b, c;`: the parameters a fit frees by default.
     Free(Span, Vec<Ident>),
     /// `effect coulomb on piston;`: an effect at its null (applied before the check).
-    Effect(crate::effects::EffectAst),
+    Effect(EffectAst),
 }
 
 /// `sensor name: STATE "unit";`, `sensor name: STATE[k] "unit";` (unit optional: the
@@ -212,7 +232,7 @@ pub enum Item {
 /// unit required).
 pub struct SensorAst {
     pub name: Ident,
-    /// What the sensor reads: a state's name as [`Model::states`] lists it (`x`, `P_cold`,
+    /// What the sensor reads: a state's name as [`stirling_dsl::Model::states`] lists it (`x`, `P_cold`,
     /// `Tw_head`), an array element (`P_regen[2]`) or an expression of states and parameters.
     pub expr: syn::Expr,
     pub unit: Option<LitStr>,
@@ -265,7 +285,7 @@ impl Parse for ModelAst {
     }
 }
 
-pub(crate) fn item(input: ParseStream) -> syn::Result<Item> {
+pub fn item(input: ParseStream) -> syn::Result<Item> {
     if input.peek(Token![let]) {
         input.parse::<Token![let]>()?;
         let name = input.parse()?;

@@ -7,7 +7,7 @@ use syn::parse::{Parse, ParseStream};
 use syn::punctuated::Punctuated;
 use syn::{Ident, Token};
 
-use crate::ast::EndAst;
+use super::{ends, EndAst};
 
 /// Where an effect acts.
 pub enum Site {
@@ -90,10 +90,4 @@ impl Site {
             Site::Sensor(name) => format!("sensor {name}"),
         }
     }
-}
-
-/// `from -> to` with the ends as written.
-pub fn ends(from: &EndAst, to: &EndAst) -> String {
-    let end = crate::compose::end_str;
-    format!("{} -> {}", end(from), end(to))
 }

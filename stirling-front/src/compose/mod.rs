@@ -14,12 +14,13 @@
 //! }
 //! ```
 //!
-//! A base declares no model: it expands to a `macro_rules!` of its name (`#[macro_export]`
-//! when `pub`) whose body holds the base's item tokens. `model X extends path { .. }` expands
-//! to `path! { <the whole declaration> }`; the base macro calls `stirling_model!` back with
-//! `@base name { <items> }` in front, and this module merges the two bodies, token by token,
-//! before the merged model is parsed, checked and expanded like any other. Nothing happens at
-//! run time: an extended model is an ordinary declaration by the time it is lowered.
+//! How a base's items reach the merge is the caller's business: the `stirling_model!` macro
+//! turns a base into a `macro_rules!` that calls the macro back with `@base name { <items> }`
+//! in front of the derived declaration; the file loader ([`crate::load`]) reads the base's
+//! file (or a built-in base's text) and hands its items over directly. Either way [`merge`]
+//! merges the two bodies, token by token, before the merged model is parsed ([`model`]),
+//! checked and lowered like any other: an extended model is an ordinary declaration by the
+//! time it is lowered.
 //!
 //! The merge keeps the base's item order (a replaced or modified item stays where it was,
 //! so the states keep their order) and appends added items at the end. A base's `name` is
@@ -28,14 +29,13 @@
 //! `space`), the `gas` item, and links by their two ends.
 
 use proc_macro2::{Span, TokenStream};
-use quote::{quote, quote_spanned};
+use quote::{quote, ToTokens};
 use syn::parse::{ParseStream, Parser};
-use syn::{Attribute, Ident, Token, Visibility};
+use syn::{Attribute, Ident, LitStr, Token, Visibility};
 
 use crate::ast::ModelAst;
 
 mod body;
-pub(crate) use body::end_str;
 mod find;
 mod items;
 mod merge;
@@ -43,26 +43,53 @@ mod modify;
 mod ops;
 
 use items::Entry;
+
+/// What a declaration extends.
+pub enum Extends {
+    /// A base by name or path (`default_engine`, `stirling::models::default_engine`).
+    Path(syn::Path),
+    /// Another file, by a path relative to the declaring file (`"gamma_base.stirling"`): read
+    /// by the file loader only.
+    File(LitStr),
+}
+
 /// The top-level declaration.
 pub struct Decl {
     /// `@base name { items }` put in front by a base macro.
-    base: Option<(Ident, TokenStream)>,
-    attrs: Vec<Attribute>,
-    vis: Visibility,
+    pub base: Option<(Ident, TokenStream)>,
+    pub attrs: Vec<Attribute>,
+    pub vis: Visibility,
     /// `model` or `base`.
-    kind: Ident,
-    ident: Ident,
-    extends: Option<syn::Path>,
-    body: TokenStream,
+    pub kind: Ident,
+    pub ident: Ident,
+    pub extends: Option<Extends>,
+    pub body: TokenStream,
     /// The declaration as written (without the `@base` part), forwarded to the base macro.
-    written: TokenStream,
+    pub written: TokenStream,
+}
+
+impl Decl {
+    /// Whether it declares a base (`base name { .. }`) rather than a model.
+    pub fn is_base(&self) -> bool {
+        self.kind == "base"
+    }
+}
+
+/// The items of a body (its own, or a base's merged with a derived body's changes), in order.
+pub struct Items(Vec<Entry>);
+
+impl ToTokens for Items {
+    fn to_tokens(&self, out: &mut TokenStream) {
+        self.0.iter().for_each(|e| e.to_tokens(out));
+    }
 }
 
 pub(super) fn is_ident(input: ParseStream, word: &str) -> bool {
     input.fork().parse::<Ident>().is_ok_and(|i| i == word)
 }
 
-/// Parse a declaration: `[@base name { .. }] /// doc  vis (model|base) Name [extends path] { .. }`.
+/// Parse a declaration: `[@base name { .. }] /// doc  vis (model|base) Name [extends path] { .. }`
+/// (`extends "file.stirling"` in a file).
 pub fn parse(tokens: TokenStream) -> syn::Result<Decl> {
     let parser = |input: ParseStream| -> syn::Result<Decl> {
         let base = if input.peek(Token![@]) {
@@ -91,7 +118,11 @@ pub fn parse(tokens: TokenStream) -> syn::Result<Decl> {
         let ident = input.parse()?;
         let extends = if is_ident(input, "extends") {
             input.parse::<Ident>()?;
-            Some(input.call(syn::Path::parse_mod_style)?)
+            Some(if input.peek(LitStr) {
+                Extends::File(input.parse()?)
+            } else {
+                Extends::Path(input.call(syn::Path::parse_mod_style)?)
+            })
         } else {
             None
         };
@@ -112,72 +143,27 @@ pub fn parse(tokens: TokenStream) -> syn::Result<Decl> {
     parser.parse2(tokens)
 }
 
-/// Expand a declaration: a model, a base's macro, or the call into a base's macro.
-pub fn expand(decl: Decl) -> syn::Result<TokenStream> {
-    let items = match (&decl.extends, &decl.base) {
-        // `extends` not yet resolved: let the base macro put its items in front
-        (Some(path), None) => {
-            let written = &decl.written;
-            let bang = quote_spanned!(path_span(path)=> !);
-            return Ok(quote!(#path #bang { #written }));
-        }
-        (Some(_), Some((base, items))) => merge::merge(base, items.clone(), decl.body.clone())?,
-        (None, Some((base, _))) => {
-            return Err(syn::Error::new(
-                base.span(),
-                "`@base` is put in front by a base's macro for a declaration with `extends`",
-            ))
-        }
-        (None, None) if decl.kind == "model" => {
-            return crate::expand::expand(syn::parse2(decl.written)?);
-        }
-        (None, None) => body::chunks(decl.body.clone())?,
-    };
-    let Decl {
-        attrs,
-        vis,
-        kind,
-        ident,
-        ..
-    } = decl;
-    if kind == "base" {
-        return Ok(base_macro(&attrs, &vis, &ident, &items));
-    }
-    let model = quote!(#(#attrs)* #vis model #ident { #(#items)* });
-    let ast: ModelAst = syn::parse2(model)?;
-    crate::expand::expand(ast)
+/// The items of a body that extends nothing, keyed for a merge.
+pub fn items(body: TokenStream) -> syn::Result<Items> {
+    body::chunks(body).map(Items)
 }
 
-fn path_span(path: &syn::Path) -> Span {
+/// The items of `base` (its body `base_items`, without its `name`) with the changes of the
+/// derived body `body` applied (errors collected, all reported at once).
+pub fn merge(base: &Ident, base_items: TokenStream, body: TokenStream) -> syn::Result<Items> {
+    merge::merge(base, base_items, body).map(Items)
+}
+
+/// The model `Name` of `items`, parsed.
+pub fn model(decl: &Decl, items: &Items) -> syn::Result<ModelAst> {
+    let (attrs, vis, ident) = (&decl.attrs, &decl.vis, &decl.ident);
+    syn::parse2(quote!(#(#attrs)* #vis model #ident { #items }))
+}
+
+/// The span of a path's last segment (where an unknown base is reported).
+pub fn path_span(path: &syn::Path) -> Span {
     path.segments
         .last()
         .map(|s| s.ident.span())
         .unwrap_or_else(Span::call_site)
-}
-
-/// `macro_rules! name` re-emitting the base's items in front of whatever it is given.
-fn base_macro(
-    attrs: &[Attribute],
-    vis: &Visibility,
-    ident: &Ident,
-    items: &[Entry],
-) -> TokenStream {
-    let exported = matches!(vis, Visibility::Public(_));
-    // An exported base calls back through its own crate's root (`$crate::stirling_model`, so
-    // a crate exporting a base re-exports the macro at its root); a crate-local one through
-    // the name in scope where it is extended.
-    let (export, callback) = if exported {
-        (quote!(#[macro_export]), quote!($crate::stirling_model))
-    } else {
-        (quote!(#[allow(unused_macros)]), quote!(stirling_model))
-    };
-    quote! {
-        #(#attrs)*
-        #export
-        macro_rules! #ident {
-            ($($rest:tt)*) => {
-                #callback! { @base #ident { #(#items)* } $($rest)* }
-            };
-        }
-    }
 }

@@ -1,0 +1,125 @@
+//! Parameters folded into a tape: every `Op::P(k)` becomes the number `p[k]`, every
+//! instruction whose operands are all numbers becomes its value (computed with the
+//! interpreter's own arithmetic, so a folded tape gives bit for bit what the tape gives at
+//! `p`), and the instructions no output reaches any more are dropped.
+
+use super::tape::{Op, Tape};
+
+/// The operands of an instruction (none for a leaf).
+fn operands(op: &Op) -> ([u32; 2], usize) {
+    match *op {
+        Op::X(_) | Op::P(_) | Op::V(_) | Op::K(_) => ([0, 0], 0),
+        Op::Neg(a) | Op::Powi(a, _) | Op::Func(_, a) => ([a, 0], 1),
+        Op::Add(a, b) | Op::Sub(a, b) | Op::Mul(a, b) | Op::Div(a, b) | Op::Powf(a, b) => {
+            ([a, b], 2)
+        }
+    }
+}
+
+/// `op` with its operands renumbered by `to`.
+fn renumber(op: Op, to: &[u32]) -> Op {
+    let r = |k: u32| to[k as usize];
+    match op {
+        Op::Add(a, b) => Op::Add(r(a), r(b)),
+        Op::Sub(a, b) => Op::Sub(r(a), r(b)),
+        Op::Mul(a, b) => Op::Mul(r(a), r(b)),
+        Op::Div(a, b) => Op::Div(r(a), r(b)),
+        Op::Powf(a, b) => Op::Powf(r(a), r(b)),
+        Op::Neg(a) => Op::Neg(r(a)),
+        Op::Powi(a, k) => Op::Powi(r(a), k),
+        Op::Func(f, a) => Op::Func(f, r(a)),
+        leaf => leaf,
+    }
+}
+
+/// The value of `op` if its operands are numbers (`known[k]`: register `k`'s number).
+fn constant(op: &Op, p: &[f64], known: &[Option<f64>]) -> Option<f64> {
+    let g = |k: u32| known[k as usize];
+    Some(match *op {
+        Op::X(_) | Op::V(_) => return None,
+        Op::P(k) => *p.get(k as usize)?,
+        Op::K(c) => c,
+        Op::Add(a, b) => g(a)? + g(b)?,
+        Op::Sub(a, b) => g(a)? - g(b)?,
+        Op::Mul(a, b) => g(a)? * g(b)?,
+        Op::Div(a, b) => g(a)? / g(b)?,
+        Op::Neg(a) => -g(a)?,
+        Op::Powi(a, k) => g(a)?.powi(k),
+        Op::Powf(a, b) => g(a)?.powf(g(b)?),
+        Op::Func(f, a) => f.apply(g(a)?),
+    })
+}
+
+impl Tape {
+    /// This tape with the parameters `p` folded in (a parameter index outside `p` stays an
+    /// input).
+    pub fn fold(&self, p: &[f64]) -> Tape {
+        let mut known = Vec::with_capacity(self.ops.len());
+        let folded: Vec<Op> = self
+            .ops
+            .iter()
+            .map(|op| {
+                let c = constant(op, p, &known);
+                known.push(c);
+                c.map_or(*op, Op::K)
+            })
+            .collect();
+        // keep what the outputs reach
+        let mut live = vec![false; folded.len()];
+        for &o in &self.outputs {
+            live[o as usize] = true;
+        }
+        for k in (0..folded.len()).rev() {
+            if live[k] {
+                let (args, count) = operands(&folded[k]);
+                for &a in &args[..count] {
+                    live[a as usize] = true;
+                }
+            }
+        }
+        let mut to = vec![u32::MAX; folded.len()];
+        let mut ops = Vec::new();
+        for (k, op) in folded.into_iter().enumerate() {
+            if live[k] {
+                to[k] = ops.len() as u32;
+                ops.push(renumber(op, &to));
+            }
+        }
+        let outputs = self.outputs.iter().map(|&o| to[o as usize]).collect();
+        Tape { ops, outputs }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// `(p0 * x0 + p1) / p0`: folded, two of its instructions are numbers.
+    #[test]
+    fn folds_parameters_and_what_they_reach() {
+        let t = Tape {
+            ops: vec![
+                Op::P(0),
+                Op::X(0),
+                Op::Mul(0, 1),
+                Op::P(1),
+                Op::Add(2, 3),
+                Op::Add(0, 3),
+                Op::Div(4, 5),
+            ],
+            outputs: vec![6, 5],
+        };
+        let p = [2.0, 3.0];
+        let f = t.fold(&p);
+        assert!(f.ops.iter().all(|o| !matches!(o, Op::P(_))), "{:?}", f.ops);
+        assert!(f.ops.len() < t.ops.len());
+        let (mut a, mut b) = (Vec::new(), Vec::new());
+        for x in [0.5, -7.0, 1e9] {
+            t.run(&p, &[x], &[], &mut a);
+            f.run(&[], &[x], &[], &mut b);
+            for k in 0..2 {
+                assert_eq!(t.output(&a, k).to_bits(), f.output(&b, k).to_bits());
+            }
+        }
+    }
+}

@@ -1,0 +1,252 @@
+//! The functions of one model at `n`, each instantiated ([`Instance`]) and laid out as a
+//! [`Tape`] with what its outputs mean: the right-hand side (an output per state), the
+//! Jacobians (an output per entry, with its position), the forces, the vessels' terms, ...
+//! Each function follows the emitted code's of the same name (`crate::codegen::functions`).
+
+use super::instance::{variant, Instance, InstanceError, Place};
+use super::plan::{Plan, Rows, SensorPlan};
+use super::tape::Tape;
+use crate::codegen::rows::RowOutput;
+use crate::expr::{Id, Sym};
+use crate::topology::Topology;
+
+/// A tape and where each output goes: `(row, column)` for a Jacobian entry, `(row, 0)` for a
+/// value.
+#[derive(Clone, Debug, Default)]
+pub struct Function {
+    pub tape: Tape,
+    pub places: Vec<(usize, usize)>,
+}
+
+/// Collects the roots of one function and where they go.
+struct Outputs<'i, 'a> {
+    inst: &'i mut Instance<'a>,
+    roots: Vec<Id>,
+    places: Vec<(usize, usize)>,
+}
+
+impl<'i, 'a> Outputs<'i, 'a> {
+    fn new(inst: &'i mut Instance<'a>) -> Self {
+        Outputs {
+            inst,
+            roots: Vec::new(),
+            places: Vec::new(),
+        }
+    }
+
+    fn push(
+        &mut self,
+        id: Id,
+        place: Place,
+        recip: bool,
+        at: (usize, usize),
+    ) -> Result<(), InstanceError> {
+        let r = self.inst.get(id, place, recip)?;
+        self.roots.push(r);
+        self.places.push(at);
+        Ok(())
+    }
+
+    fn finish(self) -> Function {
+        Function {
+            tape: Tape::new(&self.inst.out, &self.roots),
+            places: self.places,
+        }
+    }
+}
+
+/// A row output's position: `(state row, column)`; a value's column is 0.
+fn position(
+    inst: &Instance,
+    plan: &Plan,
+    o: &RowOutput,
+    place: Place,
+) -> Result<(usize, usize), InstanceError> {
+    let b = &plan.sys.blocks[o.block];
+    let at = match place {
+        Place::Scalar => crate::expr::At::Scalar,
+        _ => crate::expr::At::Rel(0),
+    };
+    let row = inst.index(b.sym, at, place)?;
+    let col = match o.col {
+        None => 0,
+        Some(Sym::State(cb, cat)) => inst.index(cb, cat, place)?,
+        Some(Sym::Param(k)) => k as usize,
+        Some(other) => return Err(InstanceError::Misplaced(other)),
+    };
+    Ok((row, col))
+}
+
+/// The outputs of `rows` (a division as the rows' value numbering writes it).
+fn rows_into(out: &mut Outputs, plan: &Plan, rows: &Rows) -> Result<(), InstanceError> {
+    for o in &rows.scalar {
+        let at = position(out.inst, plan, o, Place::Scalar)?;
+        out.push(o.id, Place::Scalar, true, at)?;
+    }
+    for (b, chain) in &rows.chains {
+        let row = out.inst.index(
+            plan.sys.blocks[*b].sym,
+            crate::expr::At::Scalar,
+            Place::Scalar,
+        )?;
+        let d = out.inst.get(chain.d, Place::Scalar, true)?;
+        for j in 0..out.inst.n() as u32 {
+            for &(col, ds) in &chain.cols {
+                let Sym::State(cb, cat) = col else {
+                    continue;
+                };
+                let place = Place::Loop { j };
+                let c = out.inst.index(cb, cat, place)?;
+                let v = out.inst.get(ds, place, true)?;
+                let e = out.inst.out.mul(d, v);
+                out.roots.push(e);
+                out.places.push((row, c));
+            }
+        }
+    }
+    let n = out.inst.n();
+    for j in 0..n {
+        let v = variant(j, n);
+        let place = Place::Row { v, j: j as u32 };
+        for o in &rows.arrays[v as usize] {
+            let at = position(out.inst, plan, o, place)?;
+            out.push(o.id, place, true, at)?;
+        }
+    }
+    Ok(())
+}
+
+/// A function of the rows: `rhs`, `jac`, `pjac`, `init`, or several at once.
+pub(crate) fn rows(
+    inst: &mut Instance,
+    plan: &Plan,
+    which: &[&Rows],
+) -> Result<Function, InstanceError> {
+    let mut out = Outputs::new(inst);
+    for r in which {
+        rows_into(&mut out, plan, r)?;
+    }
+    Ok(out.finish())
+}
+
+/// Values at one place, in order (`(k, 0)` for the `k`-th).
+fn values(inst: &mut Instance, ids: &[Id], place: Place) -> Result<Function, InstanceError> {
+    let mut out = Outputs::new(inst);
+    for (k, &id) in ids.iter().enumerate() {
+        out.push(id, place, false, (k, 0))?;
+    }
+    Ok(out.finish())
+}
+
+/// The pressure force on every body.
+pub(crate) fn forces(inst: &mut Instance, plan: &Plan) -> Result<Function, InstanceError> {
+    values(inst, &plan.sys.forces, Place::Scalar)
+}
+
+/// The gradient of body `k`'s pressure force: `(column, 0)` per entry.
+pub(crate) fn force_grad(
+    inst: &mut Instance,
+    plan: &Plan,
+    k: usize,
+) -> Result<Function, InstanceError> {
+    let mut out = Outputs::new(inst);
+    for &(s, d) in &plan.force_grads[k] {
+        if let Sym::State(b, at) = s {
+            let c = out.inst.index(b, at, Place::Scalar)?;
+            out.push(d, Place::Scalar, false, (c, 0))?;
+        }
+    }
+    Ok(out.finish())
+}
+
+/// `[P, V, E, Q, boundary, m, T]` of every vessel element (CV elements, then spaces).
+pub(crate) fn vessels(inst: &mut Instance, plan: &Plan) -> Result<Function, InstanceError> {
+    let mut out = Outputs::new(inst);
+    let mut k = 0;
+    for v in &plan.sys.vessels {
+        let terms = [
+            v.pressure,
+            v.volume,
+            v.energy,
+            v.heat,
+            v.boundary,
+            v.mass,
+            v.temperature,
+        ];
+        let places: Vec<Place> = if v.array {
+            (0..out.inst.n() as u32)
+                .map(|j| Place::Loop { j })
+                .collect()
+        } else {
+            vec![Place::Scalar]
+        };
+        for place in places {
+            for (t, &id) in terms.iter().enumerate() {
+                out.push(id, place, false, (k, t))?;
+            }
+            k += 1;
+        }
+    }
+    Ok(out.finish())
+}
+
+/// `[mechanical energy, mechanical power]`.
+pub(crate) fn mech(inst: &mut Instance, plan: &Plan) -> Result<Function, InstanceError> {
+    values(
+        inst,
+        &[plan.sys.mech_energy, plan.sys.mech_power],
+        Place::Scalar,
+    )
+}
+
+/// The declared mass of every body.
+pub(crate) fn masses(inst: &mut Instance, topo: &Topology) -> Result<Function, InstanceError> {
+    let ids: Vec<Id> = topo.bodies.iter().map(|b| b.mass).collect();
+    values(inst, &ids, Place::Scalar)
+}
+
+/// `[sum C Tw, heat from outside into the walls]`, accumulated in the emitted code's order.
+pub(crate) fn walls(inst: &mut Instance, plan: &Plan) -> Result<Function, InstanceError> {
+    let sys = &plan.sys;
+    let mut e = inst.out.num(0.0);
+    let mut q = inst.out.num(0.0);
+    let heat0 = inst.get(sys.wall_boundary_heat, Place::Scalar, false)?;
+    q = inst.out.add(q, heat0);
+    let scalar: Vec<_> = sys.walls.iter().filter(|w| !w.array).collect();
+    for w in &scalar {
+        let v = inst.get(w.energy, Place::Scalar, false)?;
+        e = inst.out.add(e, v);
+    }
+    for w in &scalar {
+        let v = inst.get(w.heat, Place::Scalar, false)?;
+        q = inst.out.add(q, v);
+    }
+    for w in sys.walls.iter().filter(|w| w.array) {
+        let heated = inst.src_const(w.heat) != Some(0.0);
+        for j in 0..inst.n() as u32 {
+            let v = inst.get(w.energy, Place::Loop { j }, false)?;
+            e = inst.out.add(e, v);
+            if heated {
+                let v = inst.get(w.heat, Place::Loop { j }, false)?;
+                q = inst.out.add(q, v);
+            }
+        }
+    }
+    Ok(Function {
+        tape: Tape::new(&inst.out, &[e, q]),
+        places: vec![(0, 0), (1, 0)],
+    })
+}
+
+/// An expression sensor's `[value, d/dv.., d/dp..]` (the parameters' columns in `places`).
+pub(crate) fn sensor(inst: &mut Instance, s: &SensorPlan) -> Result<Function, InstanceError> {
+    let mut out = Outputs::new(inst);
+    out.push(s.value, Place::Scalar, false, (0, 0))?;
+    for (i, &d) in s.dv.iter().enumerate() {
+        out.push(d, Place::Scalar, false, (1, i))?;
+    }
+    for &(k, d) in &s.dp {
+        out.push(d, Place::Scalar, false, (2, k))?;
+    }
+    Ok(out.finish())
+}

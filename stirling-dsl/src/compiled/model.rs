@@ -1,0 +1,463 @@
+//! [`CompiledModel`]: a [`Definition`] at one `n` and closure, its functions laid out as
+//! tapes, behind the same [`Model`] trait as the macro's models.
+
+use std::cell::RefCell;
+use std::sync::Arc;
+
+use super::definition::{slot, Definition};
+use super::functions::{self, Function};
+use super::instance::{Instance, InstanceError};
+use crate::expr::Style;
+use crate::runtime::{
+    BodyInfo, EffectSite, JacSink, Model, ModelError, ParamInfo, PowerTerms, SensorInfo, StateInfo,
+    StateKind, TopologyInfo,
+};
+use crate::Closure;
+
+/// Why a compiled model cannot be built.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+pub enum CompileError {
+    #[error(transparent)]
+    Sections(#[from] ModelError),
+    /// A flaw of the assembly (never of the declaration): reported rather than a panic.
+    #[error("model `{model}`: {source}")]
+    Internal {
+        model: &'static str,
+        #[source]
+        source: InstanceError,
+    },
+}
+
+/// Every function of one model, as tapes.
+#[derive(Clone)]
+struct Functions {
+    rhs: Function,
+    jac: Function,
+    rhs_jac: Function,
+    pjac: Function,
+    init: Function,
+    forces: Function,
+    force_grads: Vec<Function>,
+    vessels: Function,
+    mech: Function,
+    masses: Function,
+    walls: Option<Function>,
+    sensors: Vec<Option<Function>>,
+}
+
+/// A model declared at run time, at one `n` and closure: each function of the [`Model`]
+/// trait a register tape run by an interpreter (`crate::compiled::tape`).
+pub struct CompiledModel {
+    def: Arc<Definition>,
+    n: usize,
+    closure: Closure,
+    n_states: usize,
+    f: Functions,
+    /// The functions with one parameter vector folded in (`CompiledModel::folded`): used
+    /// when called with exactly that vector, the others otherwise.
+    folded: Option<(Vec<f64>, Functions)>,
+}
+
+impl std::fmt::Debug for CompiledModel {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("CompiledModel")
+            .field("name", &self.def.name())
+            .field("n", &self.n)
+            .field("closure", &self.closure)
+            .finish_non_exhaustive()
+    }
+}
+
+thread_local! {
+    /// The registers of the tape being run (one buffer per thread, reused).
+    static REGS: RefCell<Vec<f64>> = const { RefCell::new(Vec::new()) };
+}
+
+/// Run `f`'s tape and hand each output with its place to `each`.
+fn run(f: &Function, p: &[f64], x: &[f64], v: &[f64], mut each: impl FnMut((usize, usize), f64)) {
+    REGS.with(|r| {
+        let mut regs = r.borrow_mut();
+        f.tape.run(p, x, v, &mut regs);
+        for (k, &at) in f.places.iter().enumerate() {
+            each(at, f.tape.output(&regs, k));
+        }
+    });
+}
+
+impl Definition {
+    /// The model at `n` sections (1 for a topology without array) and `closure`.
+    pub fn model(
+        self: &Arc<Self>,
+        n: usize,
+        closure: Closure,
+    ) -> Result<CompiledModel, CompileError> {
+        let name = self.name();
+        if n == 0 {
+            let why = "an array needs at least one section";
+            return Err(ModelError::Sections {
+                model: name,
+                n,
+                why,
+            }
+            .into());
+        }
+        if !self.has_array() && n != 1 {
+            let why = "this topology has no array of CVs, so n must be 1";
+            return Err(ModelError::Sections {
+                model: name,
+                n,
+                why,
+            }
+            .into());
+        }
+        let f = self
+            .functions(n, closure)
+            .map_err(|source| CompileError::Internal {
+                model: name,
+                source,
+            })?;
+        let sys = &self.plans[slot(closure)].sys;
+        let arrays = sys.blocks.iter().filter(|b| b.array).count();
+        Ok(CompiledModel {
+            def: Arc::clone(self),
+            n,
+            closure,
+            n_states: sys.blocks.len() - arrays + arrays * n,
+            f,
+            folded: None,
+        })
+    }
+
+    fn functions(&self, n: usize, closure: Closure) -> Result<Functions, InstanceError> {
+        let plan = &self.plans[slot(closure)];
+        let mut inst = Instance::new(&self.topo.arena, &plan.sys, &plan.sums, n, None);
+        let i = &mut inst;
+        let force_grads = (0..plan.force_grads.len())
+            .map(|k| functions::force_grad(i, plan, k))
+            .collect::<Result<_, _>>()?;
+        let sensors = self
+            .sensors
+            .iter()
+            .map(|s| s.as_ref().map(|s| functions::sensor(i, s)).transpose())
+            .collect::<Result<_, _>>()?;
+        Ok(Functions {
+            rhs: functions::rows(i, plan, &[&plan.rhs])?,
+            jac: functions::rows(i, plan, &[&plan.jac])?,
+            rhs_jac: functions::rows(i, plan, &[&plan.rhs, &plan.jac])?,
+            pjac: functions::rows(i, plan, &[&plan.pjac])?,
+            init: functions::rows(i, plan, &[&plan.init])?,
+            forces: functions::forces(i, plan)?,
+            force_grads,
+            vessels: functions::vessels(i, plan)?,
+            mech: functions::mech(i, plan)?,
+            masses: functions::masses(i, &self.topo)?,
+            walls: (!self.topo.walls.is_empty())
+                .then(|| functions::walls(i, plan))
+                .transpose()?,
+            sensors,
+        })
+    }
+}
+
+impl CompiledModel {
+    /// The definition it was built from.
+    pub fn definition(&self) -> &Arc<Definition> {
+        &self.def
+    }
+
+    /// The number of instructions of the right-hand side and of the Jacobian's tapes.
+    pub fn tape_sizes(&self) -> (usize, usize) {
+        (self.f.rhs.tape.ops.len(), self.f.jac.tape.ops.len())
+    }
+
+    /// This model with the parameters `p` folded in: every parameter expression of every
+    /// function computed once, at `p` (what a simulation or a sweep point can use; a fit
+    /// keeps the parameters as inputs). Called with `p` it gives bit for bit what this
+    /// model gives; called with any other vector it computes with the parameters as inputs,
+    /// so a changed parameter is never silently ignored.
+    pub fn folded(&self, p: &[f64]) -> CompiledModel {
+        let fold = |f: &Function| Function {
+            tape: f.tape.fold(p),
+            places: f.places.clone(),
+        };
+        let g = &self.f;
+        let folded = Functions {
+            rhs: fold(&g.rhs),
+            jac: fold(&g.jac),
+            rhs_jac: fold(&g.rhs_jac),
+            pjac: fold(&g.pjac),
+            init: fold(&g.init),
+            forces: fold(&g.forces),
+            force_grads: g.force_grads.iter().map(fold).collect(),
+            vessels: fold(&g.vessels),
+            mech: fold(&g.mech),
+            masses: fold(&g.masses),
+            walls: g.walls.as_ref().map(fold),
+            sensors: g.sensors.iter().map(|s| s.as_ref().map(fold)).collect(),
+        };
+        CompiledModel {
+            def: Arc::clone(&self.def),
+            n: self.n,
+            closure: self.closure,
+            n_states: self.n_states,
+            f: self.f.clone(),
+            folded: Some((p.to_vec(), folded)),
+        }
+    }
+
+    /// The parameter vector folded in, if any ([`CompiledModel::folded`]).
+    pub fn folded_params(&self) -> Option<&[f64]> {
+        self.folded.as_ref().map(|(q, _)| q.as_slice())
+    }
+
+    /// The functions to run at `p`: the folded ones at the folded vector.
+    #[inline]
+    fn fns(&self, p: &[f64]) -> &Functions {
+        match &self.folded {
+            Some((q, f)) if q.as_slice() == p => f,
+            _ => &self.f,
+        }
+    }
+
+    /// The number of instructions of the right-hand side and the Jacobian's tapes at `p`
+    /// (fewer where `p` is folded in).
+    pub fn tape_sizes_at(&self, p: &[f64]) -> (usize, usize) {
+        let f = self.fns(p);
+        (f.rhs.tape.ops.len(), f.jac.tape.ops.len())
+    }
+
+    /// Each vessel element's `[P, V, E, Q, boundary, m, T]`, in order.
+    fn each_vessel(&self, p: &[f64], x: &[f64], mut f: impl FnMut(usize, usize, f64)) {
+        run(&self.fns(p).vessels, p, x, &[], |(k, t), v| f(k, t, v));
+    }
+
+    /// `[mechanical energy, mechanical power]`.
+    fn mech(&self, p: &[f64], x: &[f64]) -> [f64; 2] {
+        let mut m = [0.0; 2];
+        run(&self.fns(p).mech, p, x, &[], |(k, _), v| m[k] = v);
+        m
+    }
+
+    /// `[sum C Tw, heat from outside into the walls]` (zero without walls).
+    fn walls(&self, p: &[f64], x: &[f64]) -> [f64; 2] {
+        let mut w = [0.0; 2];
+        if let Some(f) = &self.fns(p).walls {
+            run(f, p, x, &[], |(k, _), v| w[k] = v);
+        }
+        w
+    }
+}
+
+impl Model for CompiledModel {
+    fn name(&self) -> &'static str {
+        self.def.name()
+    }
+    fn n(&self) -> usize {
+        self.n
+    }
+    fn closure(&self) -> Closure {
+        self.closure
+    }
+    fn has_array(&self) -> bool {
+        self.def.has_array()
+    }
+    fn params(&self) -> &'static [ParamInfo] {
+        self.def.statics.params
+    }
+    fn bodies(&self) -> &'static [BodyInfo] {
+        self.def.statics.bodies
+    }
+    fn n_states(&self) -> usize {
+        self.n_states
+    }
+    fn states(&self) -> Vec<StateInfo> {
+        let topo = &self.def.topo;
+        let mut v = Vec::new();
+        for b in &self.def.plans[slot(self.closure)].sys.blocks {
+            let (kind, unit, what, (s, a), body) =
+                crate::codegen::info::block_meaning(topo, b.kind);
+            let count = if b.array { self.n } else { 1 };
+            for j in 0..count {
+                let index = if body { s } else { s + a * self.n + j };
+                let kind = match kind {
+                    "Position" => StateKind::Position(index),
+                    "Velocity" => StateKind::Velocity(index),
+                    "Pressure" => StateKind::Pressure(index),
+                    "Mass" => StateKind::Mass(index),
+                    _ => StateKind::WallTemperature(index),
+                };
+                let (name, meaning) = if b.array {
+                    (format!("{}[{j}]", b.name), format!("{what}[{j}]"))
+                } else {
+                    (b.name.clone(), what.clone())
+                };
+                v.push(StateInfo {
+                    name,
+                    kind,
+                    unit,
+                    meaning,
+                });
+            }
+        }
+        v
+    }
+    fn vessel_names(&self) -> Vec<String> {
+        let topo = &self.def.topo;
+        let mut v = Vec::new();
+        for c in &topo.cvs {
+            if c.array {
+                v.extend((0..self.n).map(|j| format!("{}[{j}]", c.name)));
+            } else {
+                v.push(c.name.clone());
+            }
+        }
+        v.extend(topo.spaces.iter().map(|s| s.name.clone()));
+        v
+    }
+    fn rhs(&self, p: &[f64], x: &[f64], _t: f64, out: &mut [f64]) {
+        run(&self.fns(p).rhs, p, x, &[], |(r, _), v| out[r] = v);
+    }
+    fn jacobian(&self, p: &[f64], x: &[f64], _t: f64, sink: &mut JacSink) {
+        run(&self.fns(p).jac, p, x, &[], |(r, c), v| sink.add(r, c, v));
+    }
+    fn rhs_and_jacobian(&self, p: &[f64], x: &[f64], _t: f64, out: &mut [f64], sink: &mut JacSink) {
+        let k = self.fns(p).rhs.places.len();
+        let mut i = 0;
+        run(&self.fns(p).rhs_jac, p, x, &[], |(r, c), v| {
+            if i < k {
+                out[r] = v;
+            } else {
+                sink.add(r, c, v);
+            }
+            i += 1;
+        });
+    }
+    fn jacobian_values(&self, p: &[f64], x: &[f64], _t: f64, values: &mut [f64]) {
+        let mut i = 0;
+        run(&self.fns(p).jac, p, x, &[], |_, v| {
+            values[i] = v;
+            i += 1;
+        });
+    }
+    fn rhs_and_jacobian_values(
+        &self,
+        p: &[f64],
+        x: &[f64],
+        _t: f64,
+        out: &mut [f64],
+        values: &mut [f64],
+    ) {
+        let k = self.fns(p).rhs.places.len();
+        let mut i = 0;
+        run(&self.fns(p).rhs_jac, p, x, &[], |(r, _), v| {
+            if i < k {
+                out[r] = v;
+            } else {
+                values[i - k] = v;
+            }
+            i += 1;
+        });
+    }
+    fn jacobian_pattern(&self, _p: &[f64]) -> Vec<(usize, usize)> {
+        self.f.jac.places.clone()
+    }
+    fn param_jacobian(&self, p: &[f64], x: &[f64], _t: f64, sink: &mut JacSink) {
+        run(&self.fns(p).pjac, p, x, &[], |(r, c), v| sink.add(r, c, v));
+    }
+    fn pressure_forces(&self, p: &[f64], x: &[f64], out: &mut [f64]) {
+        run(&self.fns(p).forces, p, x, &[], |(k, _), v| out[k] = v);
+    }
+    fn pressure_force_gradient(&self, k: usize, p: &[f64], x: &[f64], out: &mut [f64]) {
+        out.iter_mut().for_each(|o| *o = 0.0);
+        if let Some(f) = self.fns(p).force_grads.get(k) {
+            run(f, p, x, &[], |(c, _), v| out[c] += v);
+        }
+    }
+    fn body_masses(&self, p: &[f64], out: &mut [f64]) {
+        run(&self.fns(p).masses, p, &[], &[], |(k, _), v| out[k] = v);
+    }
+    fn equilibrium_guess(&self, p: &[f64], out: &mut [f64]) {
+        run(&self.fns(p).init, p, &[], &[], |(r, _), v| out[r] = v);
+    }
+    fn pv(&self, p: &[f64], x: &[f64], pressure: &mut [f64], volume: &mut [f64]) {
+        self.each_vessel(p, x, |k, t, v| match t {
+            0 => pressure[k] = v,
+            1 => volume[k] = v,
+            _ => {}
+        });
+    }
+    fn temperatures(&self, p: &[f64], x: &[f64], out: &mut [f64]) {
+        let len = out.len();
+        self.each_vessel(p, x, |k, t, v| {
+            if t == 6 && k < len {
+                out[k] = v;
+            }
+        });
+    }
+    fn gas_mass(&self, p: &[f64], x: &[f64]) -> f64 {
+        let mut total = 0.0;
+        self.each_vessel(p, x, |_, t, v| {
+            if t == 5 {
+                total += v;
+            }
+        });
+        total
+    }
+    fn energy(&self, p: &[f64], x: &[f64]) -> f64 {
+        let mut total = 0.0;
+        self.each_vessel(p, x, |_, t, v| {
+            if t == 2 {
+                total += v;
+            }
+        });
+        let e = total + self.mech(p, x)[0];
+        match self.fns(p).walls {
+            Some(_) => e + self.walls(p, x)[0],
+            None => e,
+        }
+    }
+    fn power(&self, p: &[f64], x: &[f64]) -> PowerTerms {
+        let (mut heat, mut boundary) = (0.0, 0.0);
+        self.each_vessel(p, x, |_, t, v| match t {
+            3 => heat += v,
+            4 => boundary += v,
+            _ => {}
+        });
+        if self.fns(p).walls.is_some() {
+            heat += self.walls(p, x)[1];
+        }
+        PowerTerms {
+            heat,
+            boundary,
+            mechanical: self.mech(p, x)[1],
+        }
+    }
+    fn equations(&self, style: Style) -> String {
+        self.def.equations(self.closure, style)
+    }
+    fn topology(&self) -> &'static TopologyInfo {
+        self.def.statics.topology
+    }
+    fn sensors(&self) -> &'static [SensorInfo] {
+        self.def.statics.sensors
+    }
+    fn sensor_output(&self, k: usize, p: &[f64], v: &[f64], dv: &mut [f64], dp: &mut [f64]) -> f64 {
+        let Some(Some(f)) = self.fns(p).sensors.get(k) else {
+            dv[0] = 1.0;
+            return v[0];
+        };
+        let mut value = 0.0;
+        run(f, p, &[], v, |(what, i), d| match what {
+            0 => value = d,
+            1 => dv[i] = d,
+            _ => dp[i] = d,
+        });
+        value
+    }
+    fn effect_sites(&self) -> &'static [EffectSite] {
+        self.def.statics.effect_sites
+    }
+    fn declared_free(&self) -> &'static [&'static str] {
+        self.def.statics.free
+    }
+}
