@@ -9,7 +9,7 @@
 //! the least a fit accepts, it misses a sine by about 5 % of its amplitude, and by far less at
 //! usual rates); the scale is the median absolute deviation of those differences over the
 //! channel, so the sensor's noise and the interpolation's own error set it. A sample more
-//! than [`OUTLIER_SIGMAS`] scales off is an outlier: the largest first, replaced, and the test
+//! than [`OUTLIER_SIGMAS`](crate::data::outliers::OUTLIER_SIGMAS) scales off is an outlier: the largest first, replaced, and the test
 //! repeated (one corrupt sample also moves its neighbours' interpolations).
 
 use super::Measured;

@@ -7,7 +7,7 @@
 //! diagnosis's candidates, a sweep's points). An analysis that records a failed simulation and
 //! carries on (a sweep point, a diagnosis candidate) meets the request again at its next
 //! simulation, so it winds down within a step of each; the caller that made the request
-//! [`clear`]s it before the next piece of work.
+//! [`clear`](crate::sim::interrupt::clear)s it before the next piece of work.
 
 use std::sync::atomic::{AtomicBool, Ordering};
 
