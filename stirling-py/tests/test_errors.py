@@ -5,6 +5,7 @@ import math
 
 import numpy as np
 import pytest
+from pathlib import Path
 
 import stirling
 from stirling.errors import ModelError, OptionError, ParameterError, RecordError, StirlingError
@@ -26,8 +27,20 @@ def test_unknown_model_and_bad_sections():
         stirling.load("order8", n=3)
     with pytest.raises(ModelError, match="closure"):
         stirling.load("cv1", closure="frozenish")
-    with pytest.raises(ModelError, match=r"\.stirling"):
+    with pytest.raises(ModelError, match=r"engine\.stirling"):
         stirling.load("engine.stirling")
+
+
+def test_an_engine_file_loads_and_its_mistakes_are_placed(tmp_path):
+    root = Path(__file__).resolve().parents[2]
+    cv1 = stirling.load(str(root / "examples" / "engines" / "cv1.stirling"))
+    fam = stirling.load("cv1")
+    assert cv1.n_states == fam.n_states
+    assert abs(cv1.linearize().margins.gain_db - fam.linearize().margins.gain_db) < 1e-9
+    bad = tmp_path / "typo.stirling"
+    bad.write_text("model Typo extends default_engine {\n    name \"typo\";\n    sensor q: nope \"Pa\";\n}\n")
+    with pytest.raises(ModelError, match=r"typo\.stirling:3:"):
+        stirling.load(str(bad))
 
 
 def test_unknown_parameter_lists_the_valid_ones(cv1):

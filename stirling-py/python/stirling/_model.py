@@ -94,17 +94,13 @@ def load(
     count); ``params`` sets parameters by name over the defaults (checked: an unknown name or a
     value that is not physical raises :class:`~stirling.errors.ParameterError`).
 
-    Engine files (``.stirling``) are read here once the front end that parses them lands; a
-    path ending in ``.stirling`` is refused with a message until then.
+    A path ending in ``.stirling`` loads an engine declared in a file (docs/custom-topologies.md):
+    read, checked and compiled at run time; a mistake raises :class:`~stirling.errors.ModelError`
+    with its ``file:line:column``.
     """
     name = os.fspath(name_or_path)
     if not isinstance(name, str):
         raise ModelError(f"a model is named by a string, got {name_or_path!r}")
-    if name.endswith(".stirling"):
-        raise ModelError(
-            f"{name}: engine files (.stirling) are not readable by this build yet; "
-            "load a model of the family or a registered engine by name"
-        )
     if n is not None and (isinstance(n, bool) or not isinstance(n, (int, np.integer)) or n < 1):
         raise ModelError(f"n must be a whole number of sections >= 1, got {n!r}")
     if closure not in ("full", "frozen"):
