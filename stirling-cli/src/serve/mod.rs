@@ -47,7 +47,10 @@ pub fn answer(request: Request) {
     } else {
         Reply::error(405, "only GET is served")
     };
-    let mut response = Response::from_string(reply.body).with_status_code(reply.status);
+    // a plain Content-Length body (no chunking), the simplest for any client
+    let mut response = Response::from_string(reply.body)
+        .with_status_code(reply.status)
+        .with_chunked_threshold(usize::MAX);
     if let Ok(h) = Header::from_bytes("Content-Type", reply.content_type) {
         response.add_header(h);
     }
