@@ -20,7 +20,7 @@ function el(svg, name, attrs, text) {
 function buildSliders() {
   for (const [name, def, lo, hi] of SLIDERS) {
     const l = document.createElement("label");
-    l.innerHTML = `${name} <input id="s_${name}" type="range" min="${lo}" max="${hi}" step="${(hi - lo) / 200}" value="${def}"> <span id="v_${name}">${def}</span>`;
+    l.innerHTML = `${name} <input id="s_${name}" type="range" min="${lo}" max="${hi}" step="any" value="${def}"> <span id="v_${name}">${def}</span>`;
     $("sliders").appendChild(l);
   }
   document.querySelectorAll("input,select").forEach((i) => i.addEventListener("change", update));
@@ -34,7 +34,6 @@ function query() {
   let q = `model=${m}`;
   if (m === "nsection") q += `&n=${$("n").value}`;
   for (const [name] of SLIDERS) {
-    // schmidt has no masses' damping law of its own but takes the same names; unknown ones are refused
     q += `&${name}=${$("s_" + name).value}`;
   }
   return q;
@@ -71,7 +70,8 @@ function axes(svg, w, h, label) {
 }
 
 function fmtPole(p) {
-  return `${p.re.toFixed(6).padStart(14)} ${(p.im >= 0 ? "+" : "-") + Math.abs(p.im).toFixed(6)}j`;
+  const neg = p.im < 0 || Object.is(p.im, -0);
+  return `${p.re.toFixed(6).padStart(14)} ${(neg ? "-" : "+") + Math.abs(p.im).toFixed(6)}j`;
 }
 
 function drawLinear(d) {
@@ -146,5 +146,16 @@ function drawCycle(c) {
   anim = requestAnimationFrame(step);
 }
 
+// a URL fragment `#model=cv2&Th=700` sets the controls before the first update
+function fromFragment() {
+  for (const pair of location.hash.slice(1).split("&")) {
+    const [k, v] = pair.split("=");
+    if (k === "model") $("model").value = v;
+    else if (k === "n") $("n").value = v;
+    else if ($("s_" + k)) { $("s_" + k).value = v; $("v_" + k).textContent = v; }
+  }
+}
+
 buildSliders();
+fromFragment();
 update();
