@@ -8,9 +8,11 @@ mod cmd_linearize;
 mod cmd_locus;
 mod cmd_models;
 mod cmd_rig;
+mod cmd_serve;
 mod cmd_simulate;
 mod cmd_sweep;
 mod common;
+mod serve;
 
 use clap::{Parser, Subcommand};
 
@@ -40,6 +42,8 @@ enum Command {
     Linearize(cmd_linearize::LinearizeArgs),
     /// Root locus: the poles over a parameter range
     Locus(cmd_locus::LocusArgs),
+    /// The interactive teaching page on localhost: bond graph, poles, Bode, limit cycle
+    Serve(cmd_serve::ServeArgs),
     /// Simulate a model (stiff BDF); --limit-cycle refines the periodic orbit by shooting
     Simulate(cmd_simulate::SimulateArgs),
     /// States, parameters and generated equations of a model, or its bond graph (--graph)
@@ -121,6 +125,7 @@ fn dispatch(command: Command) -> anyhow::Result<()> {
         Command::Fit(a) => cmd_fit::run(&a),
         Command::Linearize(a) => cmd_linearize::run(&a),
         Command::Locus(a) => cmd_locus::run(&a),
+        Command::Serve(a) => cmd_serve::run(&a),
         Command::Simulate(a) => cmd_simulate::run(&a),
         Command::Info(a) => cmd_info::run(&a),
         Command::Sweep(a) => cmd_sweep::run(&a),
