@@ -184,6 +184,25 @@ impl Definition {
 }
 
 impl Functions {
+    /// Every function.
+    fn all(&self) -> impl Iterator<Item = &Function> {
+        let one = [
+            &self.rhs,
+            &self.jac,
+            &self.rhs_jac,
+            &self.pjac,
+            &self.init,
+            &self.forces,
+            &self.vessels,
+            &self.mech,
+            &self.masses,
+        ];
+        one.into_iter()
+            .chain(&self.force_grads)
+            .chain(&self.walls)
+            .chain(self.sensors.iter().flatten())
+    }
+
     /// Every function mapped by `g`.
     fn map(&self, g: impl Fn(&Function) -> Function) -> Functions {
         Functions {
@@ -255,6 +274,17 @@ impl CompiledModel {
             jit: None,
             ..self
         }
+    }
+
+    /// How many of the tapes run as native code so far (each is compiled on its first call;
+    /// one the JIT could not compile does not count).
+    pub fn native_tapes(&self) -> usize {
+        let count = |g: &Functions| {
+            g.all()
+                .filter(|f| matches!(f.code.get(), Some(Some(_))))
+                .count()
+        };
+        count(&self.f) + self.folded.as_ref().map_or(0, |(_, g)| count(g))
     }
 
     /// Whether a JIT compiles the tapes ([`Self::with_jit`]).
