@@ -5,11 +5,11 @@ use cranelift_codegen::ir::condcodes::FloatCC;
 use cranelift_codegen::ir::{types, AbiParam, FuncRef, InstBuilder, MemFlagsData, Value};
 use cranelift_frontend::{FunctionBuilder, FunctionBuilderContext};
 use cranelift_jit::JITModule;
-use cranelift_module::{Linkage, Module, ModuleError};
+use cranelift_module::{Linkage, Module};
 use stirling_dsl::compiled::{Op, Tape};
 use stirling_dsl::expr::Func;
 
-use crate::shims;
+use crate::{shims, JitError};
 
 /// The shims a function calls, declared in it once each.
 struct Imports {
@@ -22,7 +22,7 @@ pub(crate) fn function(
     module: &mut JITModule,
     func: &mut cranelift_codegen::ir::Function,
     tape: &Tape,
-) -> Result<(), ModuleError> {
+) -> Result<(), JitError> {
     let mut fctx = FunctionBuilderContext::new();
     let mut imports = Imports {
         funcs: Vec::new(),
@@ -75,8 +75,8 @@ fn offset(i: u32) -> i32 {
 }
 
 /// An import the tape needs was not declared (a flaw of this crate, reported as an error).
-fn missing() -> ModuleError {
-    ModuleError::Undeclared("a shim of stirling-jit".into())
+fn missing() -> JitError {
+    JitError::Codegen("a shim of stirling-jit was not declared".into())
 }
 
 /// Declare the shims the tape calls (only those).
@@ -85,7 +85,7 @@ fn declare_imports(
     func: &mut cranelift_codegen::ir::Function,
     tape: &Tape,
     imports: &mut Imports,
-) -> Result<(), ModuleError> {
+) -> Result<(), JitError> {
     let sig = |arity: usize| {
         let mut s = module.make_signature();
         for _ in 0..arity {
@@ -129,7 +129,7 @@ fn func_value(
     imports: &Imports,
     f: Func,
     a: Value,
-) -> Result<Value, ModuleError> {
+) -> Result<Value, JitError> {
     Ok(match f {
         Func::Abs => b.ins().fabs(a),
         Func::Sqrt => b.ins().sqrt(a),
