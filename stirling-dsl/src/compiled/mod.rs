@@ -8,8 +8,8 @@
 //! - [`CompiledModel`](crate::compiled::CompiledModel): a definition at `n` and a closure;
 //!   every expression instantiated at its place with the emitted code's value numbering
 //!   (`instance`), laid out as a [`Tape`](crate::compiled::Tape) (`functions`) and run by a
-//!   tight interpreter loop, or by native code a [`Jit`] compiled from it ([`Runner`]); on
-//!   request with one parameter vector folded in (`fold`);
+//!   tight interpreter loop, or by native code a [`Jit`](crate::compiled::Jit) compiled
+//!   from it; on request with one parameter vector folded in (`fold`);
 //! - the descriptions the trait hands out as `&'static` are leaked once per definition
 //!   (`statics`).
 
