@@ -1,8 +1,9 @@
 //! Engines from files, timed: the load and compile time of `examples/engines/nsection.stirling`
 //! (read, compose, check, lower, assemble, differentiate, lay out the tapes at `n`), and the
 //! right-hand side with the sparse Jacobian (`Model::rhs_and_jacobian_values`) of the macro's
-//! `nsection`, the file's tape and the tape with the parameters folded in, at
-//! n = 2, 10, 100, 1000.
+//! `nsection`, the file's tape (interpreted), the tape compiled to native code by the JIT
+//! (`stirling-jit`, with its compile time: the first call) and the JIT with the parameters
+//! folded in, at n = 2, 10, 100, 1000.
 //!
 //! Run: `cargo run --release --example files_speed` (`--json` for the numbers only).
 
@@ -12,6 +13,7 @@ use std::time::{Duration, Instant};
 use stirling::dsl::compiled::Definition;
 use stirling::dsl::{Closure, Model};
 use stirling::models::family::NSection;
+use stirling::models::files;
 
 /// A state near the equilibrium with the bodies displaced (every branch of the upwind
 /// switches taken somewhere).
@@ -54,6 +56,16 @@ fn time(m: &dyn Model, p: &[f64]) -> f64 {
         .fold(f64::INFINITY, f64::min)
 }
 
+/// The first RHS + Jacobian call: the JIT compiles the tape then.
+fn first_call(m: &dyn Model, p: &[f64]) -> Duration {
+    let x = state(m, p);
+    let mut f = vec![0.0; m.n_states()];
+    let mut v = vec![0.0; m.jacobian_pattern(p).len()];
+    let t = Instant::now();
+    m.rhs_and_jacobian_values(p, &x, 0.0, &mut f, &mut v);
+    t.elapsed()
+}
+
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let json = std::env::args().any(|a| a == "--json");
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/engines/nsection.stirling");
@@ -73,11 +85,17 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let build = t.elapsed();
         let mac = NSection::new(n, Closure::Full)?;
         let p = mac.default_params();
-        let folded = tape.folded(&p);
-        let (a, b, c) = (time(&mac, &p), time(&tape, &p), time(&folded, &p));
+        let jit = files::jit(def.model(n, Closure::Full)?);
+        let jit_compile = first_call(&jit, &p);
+        let folded = jit.folded(&p);
+        let folded_compile = first_call(&folded, &p);
+        let (a, b) = (time(&mac, &p), time(&tape, &p));
+        let (c, d) = (time(&jit, &p), time(&folded, &p));
         rows.push(serde_json::json!({
-            "n": n, "tape_build_ms": ms(build), "macro_ns": a, "tape_ns": b, "folded_ns": c,
-            "tape_over_macro": b / a, "folded_over_macro": c / a,
+            "n": n, "tape_build_ms": ms(build), "jit_compile_ms": ms(jit_compile),
+            "jit_folded_compile_ms": ms(folded_compile),
+            "macro_ns": a, "tape_ns": b, "jit_ns": c, "jit_folded_ns": d,
+            "tape_over_macro": b / a, "jit_over_macro": c / a, "jit_folded_over_macro": d / a,
         }));
     }
     let _ = m10;
@@ -98,18 +116,24 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         ms(compiled)
     );
     println!("RHS + Jacobian values per call (ns):");
-    println!("     n   macro    tape  folded  tape/macro  folded/macro  tapes built (ms)");
+    println!(
+        "     n    macro     tape      jit  jit fold  tape/mac  jit/mac  fold/mac  \
+         tapes (ms)  jit compile (ms)"
+    );
     for r in &rows {
         let f = |k: &str| r[k].as_f64().unwrap_or(f64::NAN);
         println!(
-            "{:>6} {:>7.0} {:>7.0} {:>7.0} {:>11.2} {:>13.2} {:>17.1}",
+            "{:>6} {:>8.0} {:>8.0} {:>8.0} {:>9.0} {:>9.2} {:>8.2} {:>9.2} {:>11.1} {:>17.1}",
             r["n"],
             f("macro_ns"),
             f("tape_ns"),
-            f("folded_ns"),
+            f("jit_ns"),
+            f("jit_folded_ns"),
             f("tape_over_macro"),
-            f("folded_over_macro"),
-            f("tape_build_ms")
+            f("jit_over_macro"),
+            f("jit_folded_over_macro"),
+            f("tape_build_ms"),
+            f("jit_compile_ms")
         );
     }
     Ok(())

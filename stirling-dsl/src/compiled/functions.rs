@@ -4,18 +4,54 @@
 //! Each function follows the emitted code's of the same name (`crate::codegen::functions`).
 
 use super::instance::{variant, Instance, InstanceError, Place};
+use std::sync::{Arc, OnceLock};
+
 use super::plan::{Plan, Rows, SensorPlan};
+use super::runner::{Jit, Runner};
 use super::tape::Tape;
 use crate::codegen::rows::RowOutput;
 use crate::expr::{Id, Sym};
 use crate::topology::Topology;
 
 /// A tape and where each output goes: `(row, column)` for a Jacobian entry, `(row, 0)` for a
-/// value.
+/// value; with a [`Jit`], the tape's native code, compiled on first use.
 #[derive(Clone, Debug, Default)]
 pub struct Function {
     pub tape: Tape,
     pub places: Vec<(usize, usize)>,
+    /// The JIT that compiles the tape, if any.
+    pub(crate) jit: Option<Jit>,
+    /// The compiled code (`None` inside: the JIT could not compile this tape).
+    pub(crate) code: OnceLock<Option<Arc<dyn Runner>>>,
+}
+
+impl Function {
+    /// The tape and its places, run by the interpreter.
+    pub(crate) fn new(tape: Tape, places: Vec<(usize, usize)>) -> Function {
+        Function {
+            tape,
+            places,
+            jit: None,
+            code: OnceLock::new(),
+        }
+    }
+
+    /// This function with `jit` to compile its tape (on first use).
+    pub(crate) fn with_jit(&self, jit: Option<Jit>) -> Function {
+        Function::new(self.tape.clone(), self.places.clone()).jit_set(jit)
+    }
+
+    fn jit_set(mut self, jit: Option<Jit>) -> Function {
+        self.jit = jit;
+        self
+    }
+
+    /// The native code of the tape: compiled by the JIT on the first call, `None` without a
+    /// JIT or where it could not compile the tape.
+    pub fn code(&self) -> Option<&Arc<dyn Runner>> {
+        let jit = self.jit?;
+        self.code.get_or_init(|| jit(&self.tape)).as_ref()
+    }
 }
 
 /// Collects the roots of one function and where they go.
@@ -48,10 +84,7 @@ impl<'i, 'a> Outputs<'i, 'a> {
     }
 
     fn finish(self) -> Function {
-        Function {
-            tape: Tape::new(&self.inst.out, &self.roots),
-            places: self.places,
-        }
+        Function::new(Tape::new(&self.inst.out, &self.roots), self.places)
     }
 }
 
@@ -232,10 +265,10 @@ pub(crate) fn walls(inst: &mut Instance, plan: &Plan) -> Result<Function, Instan
             }
         }
     }
-    Ok(Function {
-        tape: Tape::new(&inst.out, &[e, q]),
-        places: vec![(0, 0), (1, 0)],
-    })
+    Ok(Function::new(
+        Tape::new(&inst.out, &[e, q]),
+        vec![(0, 0), (1, 0)],
+    ))
 }
 
 /// An expression sensor's `[value, d/dv.., d/dp..]` (the parameters' columns in `places`).

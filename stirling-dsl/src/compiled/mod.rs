@@ -8,7 +8,8 @@
 //! - [`CompiledModel`](crate::compiled::CompiledModel): a definition at `n` and a closure;
 //!   every expression instantiated at its place with the emitted code's value numbering
 //!   (`instance`), laid out as a [`Tape`](crate::compiled::Tape) (`functions`) and run by a
-//!   tight interpreter loop; on request with one parameter vector folded in (`fold`);
+//!   tight interpreter loop, or by native code a [`Jit`](crate::compiled::Jit) compiled
+//!   from it; on request with one parameter vector folded in (`fold`);
 //! - the descriptions the trait hands out as `&'static` are leaked once per definition
 //!   (`statics`).
 
@@ -18,6 +19,7 @@ mod functions;
 mod instance;
 mod model;
 mod plan;
+mod runner;
 mod statics;
 mod tape;
 
@@ -25,4 +27,5 @@ pub use definition::Definition;
 pub use functions::Function;
 pub use instance::InstanceError;
 pub use model::{CompileError, CompiledModel};
+pub use runner::{Jit, Runner};
 pub use tape::{Op, Tape};

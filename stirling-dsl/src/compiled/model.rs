@@ -7,6 +7,7 @@ use std::sync::Arc;
 use super::definition::{slot, Definition};
 use super::functions::{self, Function};
 use super::instance::{Instance, InstanceError};
+use super::runner::Jit;
 use crate::expr::Style;
 use crate::runtime::{
     BodyInfo, EffectSite, JacSink, Model, ModelError, ParamInfo, PowerTerms, SensorInfo, StateInfo,
@@ -46,7 +47,8 @@ struct Functions {
 }
 
 /// A model declared at run time, at one `n` and closure: each function of the [`Model`]
-/// trait a register tape run by an interpreter (`crate::compiled::tape`).
+/// trait a register tape run by an interpreter (`crate::compiled::tape`), or as native code
+/// where a JIT is installed ([`CompiledModel::with_jit`]).
 pub struct CompiledModel {
     def: Arc<Definition>,
     n: usize,
@@ -56,6 +58,8 @@ pub struct CompiledModel {
     /// The functions with one parameter vector folded in (`CompiledModel::folded`): used
     /// when called with exactly that vector, the others otherwise.
     folded: Option<(Vec<f64>, Functions)>,
+    /// The JIT compiling every tape ([`CompiledModel::with_jit`]); the interpreter without.
+    jit: Option<Jit>,
 }
 
 impl std::fmt::Debug for CompiledModel {
@@ -71,10 +75,29 @@ impl std::fmt::Debug for CompiledModel {
 thread_local! {
     /// The registers of the tape being run (one buffer per thread, reused).
     static REGS: RefCell<Vec<f64>> = const { RefCell::new(Vec::new()) };
+    /// The outputs of the native code being run (one buffer per thread, reused).
+    static OUTS: RefCell<Vec<f64>> = const { RefCell::new(Vec::new()) };
 }
 
-/// Run `f`'s tape and hand each output with its place to `each`.
+/// Run `f` (its native code where a JIT compiled it, else the interpreter) and hand each
+/// output with its place to `each`.
 fn run(f: &Function, p: &[f64], x: &[f64], v: &[f64], mut each: impl FnMut((usize, usize), f64)) {
+    if let Some(code) = f.code() {
+        let ran = OUTS.with(|o| {
+            let mut out = o.borrow_mut();
+            out.resize(f.places.len(), 0.0);
+            if !code.run(x, p, v, &mut out) {
+                return false;
+            }
+            for (&at, &val) in f.places.iter().zip(out.iter()) {
+                each(at, val);
+            }
+            true
+        });
+        if ran {
+            return;
+        }
+    }
     REGS.with(|r| {
         let mut regs = r.borrow_mut();
         f.tape.run(p, x, v, &mut regs);
@@ -125,6 +148,7 @@ impl Definition {
             n_states: sys.blocks.len() - arrays + arrays * n,
             f,
             folded: None,
+            jit: None,
         })
     }
 
@@ -159,6 +183,45 @@ impl Definition {
     }
 }
 
+impl Functions {
+    /// Every function.
+    fn all(&self) -> impl Iterator<Item = &Function> {
+        let one = [
+            &self.rhs,
+            &self.jac,
+            &self.rhs_jac,
+            &self.pjac,
+            &self.init,
+            &self.forces,
+            &self.vessels,
+            &self.mech,
+            &self.masses,
+        ];
+        one.into_iter()
+            .chain(&self.force_grads)
+            .chain(&self.walls)
+            .chain(self.sensors.iter().flatten())
+    }
+
+    /// Every function mapped by `g`.
+    fn map(&self, g: impl Fn(&Function) -> Function) -> Functions {
+        Functions {
+            rhs: g(&self.rhs),
+            jac: g(&self.jac),
+            rhs_jac: g(&self.rhs_jac),
+            pjac: g(&self.pjac),
+            init: g(&self.init),
+            forces: g(&self.forces),
+            force_grads: self.force_grads.iter().map(&g).collect(),
+            vessels: g(&self.vessels),
+            mech: g(&self.mech),
+            masses: g(&self.masses),
+            walls: self.walls.as_ref().map(&g),
+            sensors: self.sensors.iter().map(|s| s.as_ref().map(&g)).collect(),
+        }
+    }
+}
+
 impl CompiledModel {
     /// The definition it was built from.
     pub fn definition(&self) -> &Arc<Definition> {
@@ -176,25 +239,10 @@ impl CompiledModel {
     /// model gives; called with any other vector it computes with the parameters as inputs,
     /// so a changed parameter is never silently ignored.
     pub fn folded(&self, p: &[f64]) -> CompiledModel {
-        let fold = |f: &Function| Function {
-            tape: f.tape.fold(p),
-            places: f.places.clone(),
-        };
-        let g = &self.f;
-        let folded = Functions {
-            rhs: fold(&g.rhs),
-            jac: fold(&g.jac),
-            rhs_jac: fold(&g.rhs_jac),
-            pjac: fold(&g.pjac),
-            init: fold(&g.init),
-            forces: fold(&g.forces),
-            force_grads: g.force_grads.iter().map(fold).collect(),
-            vessels: fold(&g.vessels),
-            mech: fold(&g.mech),
-            masses: fold(&g.masses),
-            walls: g.walls.as_ref().map(fold),
-            sensors: g.sensors.iter().map(|s| s.as_ref().map(fold)).collect(),
-        };
+        let jit = self.jit;
+        let folded = self
+            .f
+            .map(|f| Function::new(f.tape.fold(p), f.places.clone()).with_jit(jit));
         CompiledModel {
             def: Arc::clone(&self.def),
             n: self.n,
@@ -202,7 +250,46 @@ impl CompiledModel {
             n_states: self.n_states,
             f: self.f.clone(),
             folded: Some((p.to_vec(), folded)),
+            jit,
         }
+    }
+
+    /// This model with every tape (the folded ones too) run as native code `jit` compiles
+    /// from it on its first call; a tape the JIT cannot compile stays interpreted.
+    pub fn with_jit(self, jit: Jit) -> CompiledModel {
+        let j = Some(jit);
+        CompiledModel {
+            f: self.f.map(|f| f.with_jit(j)),
+            folded: self.folded.map(|(q, g)| (q, g.map(|f| f.with_jit(j)))),
+            jit: j,
+            ..self
+        }
+    }
+
+    /// This model run by the interpreter only (every tape, as without [`Self::with_jit`]).
+    pub fn interpreted(self) -> CompiledModel {
+        CompiledModel {
+            f: self.f.map(|f| f.with_jit(None)),
+            folded: self.folded.map(|(q, g)| (q, g.map(|f| f.with_jit(None)))),
+            jit: None,
+            ..self
+        }
+    }
+
+    /// How many of the tapes run as native code so far (each is compiled on its first call;
+    /// one the JIT could not compile does not count).
+    pub fn native_tapes(&self) -> usize {
+        let count = |g: &Functions| {
+            g.all()
+                .filter(|f| matches!(f.code.get(), Some(Some(_))))
+                .count()
+        };
+        count(&self.f) + self.folded.as_ref().map_or(0, |(_, g)| count(g))
+    }
+
+    /// Whether a JIT compiles the tapes ([`Self::with_jit`]).
+    pub fn has_jit(&self) -> bool {
+        self.jit.is_some()
     }
 
     /// The parameter vector folded in, if any ([`CompiledModel::folded`]).

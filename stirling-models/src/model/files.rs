@@ -13,7 +13,7 @@ use std::path::{Path, PathBuf};
 use std::sync::{Arc, Mutex, OnceLock};
 use std::time::SystemTime;
 
-use stirling_dsl::compiled::{CompileError, Definition};
+use stirling_dsl::compiled::{CompileError, CompiledModel, Definition};
 use stirling_dsl::{Closure, Model};
 use stirling_front::load::{load_file, BuiltinBase, LoadError};
 
@@ -100,8 +100,17 @@ fn load(path: &Path) -> Result<Arc<Definition>, FileError> {
     Ok(joined?)
 }
 
-/// The model of the file at `path` at `n` sections (1 without an array) and `closure`.
+/// The model of the file at `path` at `n` sections (1 without an array) and `closure`, run
+/// as native code where this build has the JIT ([`jit`]).
 pub fn build(path: &Path, n: usize, closure: Closure) -> Result<Box<dyn Model>, FileError> {
     let def = definition(path)?;
-    Ok(Box::new(def.model(n, closure)?))
+    Ok(Box::new(jit(def.model(n, closure)?)))
+}
+
+/// `model` with its tapes compiled to native code (the `jit` feature, on by default:
+/// `stirling-jit`); unchanged, run by the interpreter, without it.
+pub fn jit(model: CompiledModel) -> CompiledModel {
+    #[cfg(feature = "jit")]
+    let model = model.with_jit(stirling_jit::jit);
+    model
 }
