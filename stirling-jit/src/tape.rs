@@ -153,7 +153,7 @@ impl Runner for JitTape {
 pub const MAX_JIT_OPS: usize = 60_000;
 
 /// The [`Jit`](stirling_dsl::compiled::Jit) of this crate: `tape` compiled, or `None` where
-/// it cannot be or is longer than [`MAX_JIT_OPS`] (the interpreter runs it then).
+/// it cannot be or is longer than `MAX_JIT_OPS` (the interpreter runs it then).
 pub fn jit(tape: &Tape) -> Option<Arc<dyn Runner>> {
     if tape.ops.len() > MAX_JIT_OPS {
         return None;
