@@ -94,10 +94,14 @@ fn channel_outliers(name: &str, t: &[f64], y: &mut [f64]) -> Vec<Outlier> {
     out
 }
 
-/// Every channel's outliers (the record untouched).
+/// Every channel's outliers (the record untouched; one channel copied at a time, not the
+/// whole record).
 pub fn find(m: &Measured) -> Vec<Outlier> {
-    let mut copy = m.clone();
-    repair(&mut copy)
+    m.channels()
+        .iter()
+        .filter_map(|c| m.channel(c).map(|y| (c, y.to_vec())))
+        .flat_map(|(c, mut y)| channel_outliers(c, &m.t, &mut y))
+        .collect()
 }
 
 /// Replace every channel's outliers by their neighbours' interpolation; the outliers found.
