@@ -1,7 +1,8 @@
 //! Answers that would look right and are not are refused with the cause (issue 38, "wrong
 //! answers with exit 0"): an equilibrium outside the physical range (a bounce pressure of
 //! 100 bar puts the gas volume below zero), a parameter freed twice (its interval would come
-//! from a rank-deficient problem), an effect named twice among the diagnosis's candidates.
+//! from a rank-deficient problem), an effect named twice among the diagnosis's candidates, a
+//! parameter set 1e8 times beyond its default (`kd` = 1e30).
 
 mod support;
 
@@ -37,6 +38,20 @@ fn a_nonphysical_equilibrium_is_an_error_naming_the_quantity() {
             &["equilibrium is not physical", "volume of `gas`", "-1.37"],
         );
     }
+}
+
+#[test]
+fn a_parameter_off_its_scale_is_refused_not_linearized() {
+    // kd = 1e30 N/m would put a pole at 3.5e15 rad/s beside the engine's 95 rad/s
+    for args in [
+        &["linearize", "cv1", "--set", "kd=1e30"][..],
+        &["simulate", "cv1", "--set", "kd=1e30", "--t-end", "0.1"][..],
+        &["linearize", "nsection", "--n", "2", "--set", "Rf=1e-9"][..],
+    ] {
+        fails_with(args, &["times its default", "check the value and its unit"]);
+    }
+    // within the factor: a stiff but resolvable spring is linearized as asked
+    support::succeeds(&["linearize", "cv1", "--set", "kd=6.5e9"]);
 }
 
 #[test]
