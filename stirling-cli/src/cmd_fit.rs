@@ -62,6 +62,12 @@ pub struct FitArgs {
     /// of the training block) before the free run
     #[arg(long, value_name = "CYCLES", allow_negative_numbers = true, value_parser = ranges::cycles)]
     pub multiple_shooting: Option<f64>,
+    /// Restart stage 1 (the mechanics driven by the measured pressure) from the measured body
+    /// states every this many cycles, e.g. 0.5: for engines whose bodies hit end stops or
+    /// other stiff contacts, where one run over the block can settle on another response of
+    /// the driven mechanics than the engine's (default: one run)
+    #[arg(long, value_name = "CYCLES", allow_negative_numbers = true, value_parser = ranges::restart_cycles)]
+    pub restart_cycles: Option<f64>,
 }
 
 pub fn run(a: &FitArgs) -> anyhow::Result<()> {
@@ -85,6 +91,7 @@ pub fn run(a: &FitArgs) -> anyhow::Result<()> {
             }),
         train,
         holdout,
+        restart_cycles: a.restart_cycles,
         ..Default::default()
     };
     let res = fit::identify(model.as_ref(), &p0, &data, &opts)?;

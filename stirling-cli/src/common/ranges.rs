@@ -108,6 +108,18 @@ pub fn cycles(s: &str) -> Parsed<f64> {
     Ok(v)
 }
 
+/// A restart interval in cycles: positive, at most 1000 (beyond that a record has no
+/// second segment and the option would do nothing).
+pub fn restart_cycles(s: &str) -> Parsed<f64> {
+    let v = number(s)?;
+    if !(v > 0.0 && v <= 1000.0) {
+        return Err(RangeError::Outside(
+            "must be above 0 and at most 1000 cycles",
+        ));
+    }
+    Ok(v)
+}
+
 /// A pair of counts `TUNE:EVAL` (whole numbers >= 0), as `--seeds 1:1`.
 pub fn split_counts(s: &str) -> Parsed<(usize, usize)> {
     let (a, b) = s.split_once(':').ok_or(RangeError::Outside(

@@ -105,6 +105,7 @@ pub fn stage<'a>(
         drift: 0,
         input_noise: vec![(0, noise_sigma(xm), rec.h), (1, noise_sigma(ym), rec.h)],
         derived: Vec::new(),
+        restarts: None,
         name: "stage 2 (gas driven by measured displacements)",
         model,
         p: p.to_vec(),

@@ -114,6 +114,39 @@ fn body_start(rec: &Record, x_off: [f64; 2]) -> Vec<f64> {
     ]
 }
 
+/// Restarts of stage 1 from the measured body states every `cycles` cycles of frequency `f0`
+/// (`None` without them, or without a cycle).
+fn restarts(
+    rec: &Record,
+    x_off: [f64; 2],
+    cycles: Option<f64>,
+    f0: f64,
+) -> Option<super::driven::Restarts> {
+    let every = (cycles? / (f0 * rec.dt)).round();
+    if !every.is_finite() || every < MIN_SEGMENT {
+        return None;
+    }
+    let (sx, sy) = rec.pos.as_ref()?;
+    let states = (0..sx.val.len())
+        .map(|k| {
+            vec![
+                sx.val[k] - x_off[0],
+                sx.der[k],
+                sy.val[k] - x_off[1],
+                sy.der[k],
+            ]
+        })
+        .collect();
+    Some(super::driven::Restarts {
+        every: every as usize,
+        states,
+    })
+}
+
+/// The fewest samples of a restarted segment: shorter ones see the smoothed start more than
+/// the model.
+const MIN_SEGMENT: f64 = 8.0;
+
 /// The fit variables: free parameters, the four body initial states `z0`, the position offsets.
 fn variables(model: &dyn Model, inp: &MechInputs, z0: &[f64], opts: &FitOptions) -> Vec<Var> {
     let x_off = inp.x_off;
@@ -194,6 +227,7 @@ pub fn stage<'a>(
         drift: drift_count(tr.1 - tr.0 + 1, dt, opts.drift_cut * f0),
         input_noise: input_noise(rec),
         derived: (measured..signals.len()).collect(),
+        restarts: restarts(rec, inp.x_off, opts.restart_cycles, f0),
         name: "stage 1 (mechanics driven by measured pressure)",
         model,
         p: inp.p.to_vec(),

@@ -107,6 +107,9 @@ pub struct FitOptions {
     /// Multiple-shooting refinement of the free parameters over the training block (off by
     /// default: it costs several times the two stages).
     pub multiple_shooting: Option<multiple_shooting::MsOptions>,
+    /// Stage 1 restarted from the measured body states every this many cycles
+    /// ([`driven::Restarts`]; `None`: one run over the block).
+    pub restart_cycles: Option<f64>,
 }
 
 impl Default for FitOptions {
@@ -129,6 +132,7 @@ impl Default for FitOptions {
             bounds: Vec::new(),
             free_run: Some(free_run::FreeRunOptions::default()),
             multiple_shooting: None,
+            restart_cycles: None,
         }
     }
 }
