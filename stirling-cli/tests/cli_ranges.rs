@@ -148,6 +148,10 @@ fn multiple_shooting_and_finite_values() {
         let fit = ["fit", "cv1", "--data", "r.csv", "--multiple-shooting", v];
         refused(&fit, "--multiple-shooting", v, "");
     }
+    for v in ["-1", "0", "1e9", "nan"] {
+        let fit = ["fit", "cv1", "--data", "r.csv", "--restart-cycles", v];
+        refused(&fit, "--restart-cycles", v, "");
+    }
     let locus = [
         "locus", "schmidt", "--param", "Th", "--from", "nan", "--to", "2",
     ];
