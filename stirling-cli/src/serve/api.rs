@@ -120,7 +120,7 @@ fn start(m: &dyn Model, p: &[f64]) -> Option<Vec<f64>> {
     Some(x)
 }
 
-fn json_reply(v: &serde_json::Value) -> Reply {
+pub(super) fn json_reply(v: &serde_json::Value) -> Reply {
     Reply {
         status: 200,
         content_type: "application/json",

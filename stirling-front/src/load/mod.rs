@@ -56,6 +56,19 @@ pub fn load_file(path: &Path, bases: &[BuiltinBase]) -> Result<Topology, LoadErr
 
 /// Load the model declared in `text`, shown in messages as `path` (a file it extends is
 /// found relative to `path`'s directory).
+///
+/// For a text from elsewhere (typed into a page, sent over a network) use [`load_detached`],
+/// which reads no file.
 pub fn load_str(path: &Path, text: &str, bases: &[BuiltinBase]) -> Result<Topology, LoadError> {
     resolve::Loader::new(bases).top_text(path, text)
+}
+
+/// Load the model declared in `text`, shown in messages as `name`, reading no file: it may
+/// extend the built-in `bases` only (`extends "file"` is an error at its token). The text of
+/// a page's editor is loaded so: whoever typed it cannot make the loader read the files of
+/// the machine it runs on.
+pub fn load_detached(name: &str, text: &str, bases: &[BuiltinBase]) -> Result<Topology, LoadError> {
+    resolve::Loader::new(bases)
+        .without_files()
+        .top_text(Path::new(name), text)
 }
