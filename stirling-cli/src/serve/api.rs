@@ -103,6 +103,7 @@ pub fn cycle(q: &Query) -> Reply {
         "x": column(StateKind::Position(0)),
         "y": column(StateKind::Position(1)),
         "vessels": lc.work.vessels,
+        "vessel_work_j": lc.work.per_vessel,
         "pv": sim::work::pv_loops(m, &p, &lc.orbit),
     }))
 }

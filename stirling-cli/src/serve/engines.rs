@@ -71,14 +71,15 @@ pub fn model(def: &Arc<Definition>, n: usize) -> Result<Box<dyn Model>, String> 
     Ok(Box::new(files::jit(m)))
 }
 
-/// Compile `text` and check that it builds at `n`: its id and the engine, or the refusal
-/// (every diagnostic with its line and column).
+/// Compile `text` and check that it builds at `n` (at 1 without an array): its id and the
+/// engine, or the refusal (every diagnostic with its line and column).
 pub fn compile(text: &str, n: usize) -> Result<(String, Arc<Definition>), Refused> {
     let id = id_of(text);
     let def = match find(&id) {
         Some(def) => def,
         None => load_bounded(text)?,
     };
+    let n = if def.has_array() { n } else { 1 };
     if let Err(e) = def.model(n, Closure::Full) {
         return Err(refused(422, &e.to_string(), Vec::new()));
     }
