@@ -195,11 +195,11 @@ function drawLinear(d) {
   el(svg, "text", { x: x1 - 4, y: y0 + 14, "text-anchor": "end", "font-size": 11, fill: "#b00" }, "unstable");
   for (const t of xt) {
     el(svg, "line", { x1: sx(t), x2: sx(t), y1: y0, y2: y1, stroke: t === 0 ? "#888" : "#e4e4e4" });
-    el(svg, "text", { x: sx(t), y: y1 + 13, "text-anchor": "middle", "font-size": 10 }, tickLabel(t));
+    if (t === 0 || Math.abs(sx(t) - sx(0)) >= 16) el(svg, "text", { x: sx(t), y: y1 + 13, "text-anchor": "middle", "font-size": 10 }, tickLabel(t));
   }
   for (const t of yt) {
     el(svg, "line", { x1: x0, x2: x1, y1: sy(t), y2: sy(t), stroke: t === 0 ? "#888" : "#e4e4e4" });
-    el(svg, "text", { x: x0 - 3, y: sy(t) + 3, "text-anchor": "end", "font-size": 10 }, tickLabel(t));
+    if (t === 0 || Math.abs(sy(t) - sy(0)) >= 11) el(svg, "text", { x: x0 - 3, y: sy(t) + 3, "text-anchor": "end", "font-size": 10 }, tickLabel(t));
   }
   axes(svg, W, H, "Re (1/s), symmetric log; Im (rad/s)   x closed loop, o loop broken");
   for (const p of r.loop.open_loop_poles) el(svg, "circle", { cx: sx(p.re), cy: sy(p.im), r: 5, fill: "none", stroke: "#06c", "stroke-width": 1.5 });
