@@ -1,7 +1,8 @@
 //! `stirling serve`: the interactive teaching page on localhost (docs/user-guide.md, "The
-//! interactive page"). One thread answers the requests in turn; every computation is bounded
-//! (n <= 50, limit cycle over at most 10 s of simulated time) and a bad request is a 400
-//! with a JSON error, never a panic of the server.
+//! interactive page"). One thread takes the requests; each is computed on a worker thread
+//! within a deadline, every computation is bounded (n <= 50, limit cycle over at most 10 s
+//! of simulated time, a declaration sent from the page at most 64 KiB and 20 s to compile),
+//! and a bad request is a 4xx with a JSON error, never a panic of the server.
 
 use std::net::IpAddr;
 

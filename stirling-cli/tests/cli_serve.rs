@@ -1,6 +1,8 @@
 //! `stirling serve`: the endpoints answer with the numbers the command line prints, follow a
-//! parameter change as `stirling linearize --set` does, and refuse bad requests with a 400
-//! and a message (plain HTTP/1.1 over a TcpStream; the server on a free port).
+//! parameter change as `stirling linearize --set` does, compile an engine declaration sent
+//! from the page to the model `stirling linearize` makes of the same text in a file, and
+//! refuse bad requests and bad declarations with a message (a declaration's at its line and
+//! column), never a crash (plain HTTP/1.1 over a TcpStream; the server on a free port).
 
 use std::io::{BufRead, BufReader, Read, Write};
 use std::net::TcpStream;
@@ -44,13 +46,25 @@ fn start() -> Server {
 
 /// `GET path`: status and body.
 fn get(s: &Server, path: &str) -> (u16, String) {
+    request(s, "GET", path, b"")
+}
+
+/// `POST path` with `body`: status and body.
+fn post(s: &Server, path: &str, body: &[u8]) -> (u16, String) {
+    request(s, "POST", path, body)
+}
+
+fn request(s: &Server, method: &str, path: &str, body: &[u8]) -> (u16, String) {
     let mut c = TcpStream::connect(&s.addr).expect("connect");
     write!(
         c,
-        "GET {path} HTTP/1.1\r\nHost: {}\r\nConnection: close\r\n\r\n",
-        s.addr
+        "{method} {path} HTTP/1.1\r\nHost: {}\r\nContent-Length: {}\r\nConnection: close\r\n\r\n",
+        s.addr,
+        body.len()
     )
     .unwrap();
+    // a server that refuses a body before reading it may close early: read its answer anyway
+    let _ = c.write_all(body);
     let mut raw = String::new();
     c.read_to_string(&mut raw).expect("read");
     let (head, body) = raw.split_once("\r\n\r\n").expect("a header");
@@ -172,5 +186,214 @@ fn bad_requests_are_400_with_a_message() {
     }
     assert_eq!(get(&s, "/nowhere").0, 404);
     // the server is still up after all that
+    assert_eq!(get(&s, "/api/linear?model=cv1").0, 200);
+}
+
+/// cv2's declaration (the page's starting text for `cv2`) with `text` inserted before its
+/// last `}`, as a user types it into the editor.
+fn edited_cv2(text: &str) -> String {
+    let src = std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../examples/engines/cv2.stirling"
+    ))
+    .expect("cv2.stirling");
+    let end = src.rfind('}').expect("a closing brace");
+    format!("{}{text}\n{}", &src[..end], &src[end..])
+}
+
+/// `POST /api/compile`: the engine's id.
+fn compile(s: &Server, text: &str) -> String {
+    let (status, body) = post(s, "/api/compile", text.as_bytes());
+    assert_eq!(status, 200, "{body}");
+    let v: Value = serde_json::from_str(&body).expect("json");
+    v["id"].as_str().expect("id").to_owned()
+}
+
+/// A default replaced and a load damper added on the piston.
+const EDIT: &str = r#"    replace params { Th: 650.0 "K" }
+    params { /// a load on the piston
+        c_load: 2.0 "N s/m" }
+    modify body piston { force: -c_load * w }"#;
+
+#[test]
+fn an_edited_declaration_shows_the_poles_of_the_same_file() {
+    let s = start();
+    let text = edited_cv2(EDIT);
+    let file = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("serve_edited.stirling");
+    std::fs::write(&file, &text).unwrap();
+    let id = compile(&s, &text);
+    let edited = page_poles(&s, &format!("model=@{id}"));
+    assert_same(&edited, &cli_poles(&[file.to_str().unwrap()]));
+    assert_ne!(
+        format!("{edited:.3?}"),
+        format!("{:.3?}", page_poles(&s, "model=cv2")),
+        "the edit moves the poles"
+    );
+    // a slider on the edited engine is `--set` on the file
+    let kp = page_poles(&s, &format!("model=@{id}&kp=200&c_load=5"));
+    assert_same(
+        &kp,
+        &cli_poles(&[
+            file.to_str().unwrap(),
+            "--set",
+            "kp=200",
+            "--set",
+            "c_load=5",
+        ]),
+    );
+    let (status, body) = get(&s, &format!("/api/equations?model=@{id}"));
+    assert_eq!(status, 200, "{body}");
+    let v: Value = serde_json::from_str(&body).unwrap();
+    assert!(v["equations"].as_str().unwrap().contains("c_load"));
+    let th = v["params"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|p| p["name"] == "Th");
+    assert_eq!(th.unwrap()["default"].as_f64(), Some(650.0));
+    let (status, svg) = get(&s, &format!("/api/graph?model=@{id}"));
+    assert!(status == 200 && svg.starts_with("<svg"), "{svg}");
+    let (status, body) = get(&s, &format!("/api/cycle?model=@{id}"));
+    assert_eq!(status, 200, "{body}");
+    // the same text again is the same engine
+    assert_eq!(compile(&s, &text), id);
+}
+
+#[test]
+fn an_edited_array_engine_follows_n() {
+    let s = start();
+    let text = "model Mine extends nsection_engine {\n    name \"mine\";\n    replace params { kd: 800.0 \"N/m\" }\n}\n";
+    let (status, body) = post(&s, "/api/compile?n=3", text.as_bytes());
+    assert_eq!(status, 200, "{body}");
+    let v: Value = serde_json::from_str(&body).unwrap();
+    assert_eq!(v["has_array"], true);
+    let id = v["id"].as_str().unwrap();
+    assert_same(
+        &page_poles(&s, &format!("model=@{id}&n=3")),
+        &cli_poles(&["nsection", "--n", "3", "--set", "kd=800"]),
+    );
+}
+
+/// A refused declaration: the status, the message, and the first diagnostic's line.
+fn refused(s: &Server, body: &[u8]) -> (u16, String, Option<u64>) {
+    let (status, text) = post(s, "/api/compile", body);
+    let v: Value = serde_json::from_str(&text).unwrap_or_else(|_| panic!("JSON: {text}"));
+    let msg = v["error"].as_str().expect("error text").to_owned();
+    let line = v["diagnostics"][0]["line"].as_u64();
+    (status, msg, line)
+}
+
+#[test]
+fn bad_declarations_are_refused_at_their_place() {
+    let s = start();
+    let typo = edited_cv2("    sensor q: P_colt \"Pa\";");
+    let typo_line = typo.lines().position(|l| l.contains("P_colt")).unwrap() as u64 + 1;
+    let cases: Vec<(String, &str, Option<u64>)> = vec![
+        (typo, "no state `P_colt`", Some(typo_line)),
+        (
+            "model X extends \"/etc/passwd.stirling\" { name \"x\"; }".into(),
+            "not a file",
+            Some(1),
+        ),
+        (
+            "model X extends \"../examples/engines/cv2.stirling\" { name \"x\"; }".into(),
+            "not a file",
+            Some(1),
+        ),
+        ("".into(), "empty", None),
+        ("model X extends default_engine {".into(), "", Some(1)),
+        (
+            "model X extends nowhere { name \"x\"; }".into(),
+            "unknown base",
+            Some(1),
+        ),
+        (
+            format!(
+                "model X extends default_engine {{ let a = {}1{}; }}",
+                "(".repeat(5000),
+                ")".repeat(5000)
+            ),
+            "nested deeper",
+            Some(1),
+        ),
+        ("base b { }".into(), "declares no model", Some(1)),
+        ("\u{0}\u{1}\"".into(), "", None),
+        (
+            "model X extends default_engine { name \"x\"; cv a { volume: 1.0 / 0.0 } }".into(),
+            "",
+            None,
+        ),
+    ];
+    for (text, says, line) in cases {
+        let (status, msg, at) = refused(&s, text.as_bytes());
+        let short: String = text.chars().take(60).collect();
+        assert_eq!(status, 422, "{short}: {msg}");
+        assert!(msg.contains(says), "{short}: {msg}");
+        if line.is_some() {
+            assert_eq!(at, line, "{short}: {msg}");
+        }
+    }
+    let (status, msg, _) = refused(&s, &[0xff, 0xfe, b'm']);
+    assert_eq!(status, 400, "{msg}");
+    assert!(msg.contains("UTF-8"), "{msg}");
+    let big = "/".repeat(70 * 1024);
+    let (status, msg, _) = refused(&s, big.as_bytes());
+    assert_eq!(status, 413, "{msg}");
+    let (status, msg, _) = refused(&s, b"");
+    assert_eq!(status, 422, "{msg}");
+    for (path, code) in [
+        ("/api/compile?n=0", 400),
+        ("/api/compile?n=99", 400),
+        ("/api/linear", 405),
+    ] {
+        assert_eq!(post(&s, path, b"x").0, code, "{path}");
+    }
+    // the GET endpoints read no file and know only the engines compiled
+    for (q, says) in [
+        ("model=@0123456789abcdef", "no engine compiled"),
+        ("model=examples/engines/cv2.stirling", "reads no file"),
+    ] {
+        let (status, body) = get(&s, &format!("/api/linear?{q}"));
+        assert_eq!(status, 400, "{body}");
+        assert!(body.contains(says), "{body}");
+    }
+    // the server is still up, and still compiles
+    compile(&s, &edited_cv2(""));
+}
+
+/// Every prefix of an edited declaration (as typed, one cut every 7 characters) and every
+/// declaration with one character replaced is answered, never with a 500 or a crash.
+#[test]
+fn no_declaration_crashes_the_server() {
+    let s = start();
+    let text = edited_cv2(EDIT);
+    let chars: Vec<char> = text.chars().collect();
+    let mut texts: Vec<String> = (0..chars.len())
+        .step_by(7)
+        .map(|k| chars[..k].iter().collect())
+        .collect();
+    for (k, c) in (0..chars.len())
+        .step_by(11)
+        .zip("{}()[];:,.-*/\"#@!0e".chars().cycle())
+    {
+        let mut t = chars.clone();
+        t[k] = c;
+        texts.push(t.into_iter().collect());
+    }
+    for t in &texts {
+        let (status, body) = post(&s, "/api/compile", t.as_bytes());
+        assert!(status == 200 || status == 422, "{status}: {body}\n{t}");
+        if status == 200 {
+            let id = serde_json::from_str::<Value>(&body).unwrap()["id"]
+                .as_str()
+                .unwrap()
+                .to_owned();
+            let (status, body) = get(&s, &format!("/api/linear?model=@{id}"));
+            assert!(
+                status == 200 || status == 400 || status == 422,
+                "{status}: {body}\n{t}"
+            );
+        }
+    }
     assert_eq!(get(&s, "/api/linear?model=cv1").0, 200);
 }

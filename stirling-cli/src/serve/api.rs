@@ -103,6 +103,7 @@ pub fn cycle(q: &Query) -> Reply {
         "x": column(StateKind::Position(0)),
         "y": column(StateKind::Position(1)),
         "vessels": lc.work.vessels,
+        "vessel_work_j": lc.work.per_vessel,
         "pv": sim::work::pv_loops(m, &p, &lc.orbit),
     }))
 }
@@ -120,7 +121,7 @@ fn start(m: &dyn Model, p: &[f64]) -> Option<Vec<f64>> {
     Some(x)
 }
 
-fn json_reply(v: &serde_json::Value) -> Reply {
+pub(super) fn json_reply(v: &serde_json::Value) -> Reply {
     Reply {
         status: 200,
         content_type: "application/json",

@@ -1,6 +1,9 @@
-//! The query string of an endpoint: the model, its `n`, and parameter overrides, checked.
+//! The query string of an endpoint: the model (a family member, or `@ID` for an engine
+//! compiled from the page), its `n`, and parameter overrides, checked.
 
 use stirling_dsl::{Closure, Model};
+
+use super::engines;
 
 /// The largest `n` the page computes (the limit keeps a request short).
 pub const MAX_N: usize = 50;
@@ -36,15 +39,38 @@ impl Query {
     /// The model and its validated parameters (unknown model or parameter, unphysical value:
     /// the library's message).
     pub fn load(&self) -> Result<(Box<dyn Model>, Vec<f64>), String> {
-        let model = stirling_models::build(&self.model, self.n, Closure::Full)
-            .map_err(|e| e.to_string())?;
+        let model = self.model()?;
         let p = stirling_models::params::load(model.as_ref(), None, &self.sets)
             .map_err(|e| e.to_string())?;
         Ok((model, p))
     }
+
+    /// The model named: `@ID` an engine compiled from the page, else a family member (never
+    /// a file: the page reads none).
+    fn model(&self) -> Result<Box<dyn Model>, String> {
+        if let Some(id) = self.model.strip_prefix('@') {
+            let def = engines::find(id).ok_or_else(|| {
+                format!(
+                    "{GONE}: `@{id}` (the server keeps the last {} it compiled; compile it again)",
+                    engines::KEPT
+                )
+            })?;
+            return engines::model(&def, self.n.unwrap_or(1));
+        }
+        if stirling_models::files::is_file(&self.model) {
+            return Err(format!(
+                "`{}`: the page reads no file; send the declaration to /api/compile",
+                self.model
+            ));
+        }
+        stirling_models::build(&self.model, self.n, Closure::Full).map_err(|e| e.to_string())
+    }
 }
 
-fn parse_n(v: &str) -> Result<usize, String> {
+/// How the message of an engine the server no longer keeps begins (the page compiles again).
+pub const GONE: &str = "no engine compiled under this id";
+
+pub fn parse_n(v: &str) -> Result<usize, String> {
     match v.parse::<usize>() {
         Ok(n) if (1..=MAX_N).contains(&n) => Ok(n),
         _ => Err(format!(

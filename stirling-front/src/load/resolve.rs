@@ -27,6 +27,8 @@ pub(super) struct Loader<'b> {
     chain: Vec<Origin>,
     /// The path shown for messages without a place.
     top: String,
+    /// Whether `extends "file"` may read a file (not for a text that came from elsewhere).
+    files: bool,
 }
 
 /// Why a step failed: diagnostics already placed, or a `syn::Error` to place.
@@ -48,7 +50,14 @@ impl<'b> Loader<'b> {
             sources: Sources::default(),
             chain: Vec::new(),
             top: String::new(),
+            files: true,
         }
+    }
+
+    /// A loader that reads no file: `extends "file"` is refused at its token.
+    pub(super) fn without_files(mut self) -> Self {
+        self.files = false;
+        self
     }
 
     pub(super) fn top_file(self, path: &Path) -> Result<Topology, LoadError> {
@@ -161,6 +170,14 @@ impl<'b> Loader<'b> {
 
     /// Another file, relative to the file that names it.
     fn file(&self, lit: &syn::LitStr) -> Result<(Origin, String, String, Span), Fail> {
+        if !self.files {
+            let known: Vec<&str> = self.bases.iter().map(|b| b.name).collect();
+            let msg = format!(
+                "this declaration is not a file: it extends a built-in base by name ({}), not another file",
+                known.join(", ")
+            );
+            return Err(Fail::Syn(syn::Error::new(lit.span(), msg)));
+        }
         let dir = match self.chain.last() {
             Some(Origin::File(p)) => p.parent().map(Path::to_path_buf).unwrap_or_default(),
             _ => {

@@ -15,7 +15,7 @@ use std::time::SystemTime;
 
 use stirling_dsl::compiled::{CompileError, CompiledModel, Definition};
 use stirling_dsl::{Closure, Model};
-use stirling_front::load::{load_file, BuiltinBase, LoadError};
+use stirling_front::load::{load_detached, load_file, BuiltinBase, LoadError};
 
 /// The extension of an engine file.
 pub const EXTENSION: &str = "stirling";
@@ -85,6 +85,24 @@ pub fn definition(path: &Path) -> Result<Arc<Definition>, FileError> {
 /// Load and assemble on a thread of its own, with a stack deep enough for long expressions.
 fn load(path: &Path) -> Result<Arc<Definition>, FileError> {
     let owned = path.to_path_buf();
+    on_loader_thread(path, move || load_file(&owned, BASES))
+}
+
+/// The definition declared in `text` (shown in messages as `name`), reading no file: it
+/// extends the family's bases by name only (`stirling_front::load::load_detached`). Not
+/// cached: each call loads (and leaks its descriptions) anew.
+pub fn definition_of_text(name: &str, text: &str) -> Result<Arc<Definition>, FileError> {
+    let (name_owned, text) = (name.to_string(), text.to_string());
+    on_loader_thread(Path::new(name), move || {
+        load_detached(&name_owned, &text, BASES)
+    })
+}
+
+/// Run `load` and assemble its topology on a thread whose stack is [`LOADER_STACK`].
+fn on_loader_thread<F>(path: &Path, load: F) -> Result<Arc<Definition>, FileError>
+where
+    F: FnOnce() -> Result<stirling_dsl::Topology, LoadError> + Send + 'static,
+{
     let fail = |why: String| FileError::Loader {
         path: path.to_path_buf(),
         why,
@@ -92,7 +110,7 @@ fn load(path: &Path) -> Result<Arc<Definition>, FileError> {
     let handle = std::thread::Builder::new()
         .name("stirling-loader".into())
         .stack_size(LOADER_STACK)
-        .spawn(move || load_file(&owned, BASES).map(Definition::new))
+        .spawn(move || load().map(Definition::new))
         .map_err(|e| fail(e.to_string()))?;
     let joined = handle
         .join()
