@@ -82,6 +82,10 @@ pub struct Context<'a> {
     pub fits: std::sync::atomic::AtomicUsize,
     /// Where progress lines go (see [`super::DiagnoseOptions::progress`]).
     pub progress: Option<fn(&str)>,
+    /// Stage 1 restarts from the measured body states (the second pass for end stops,
+    /// [`super::restarted`]): each body's stops are screened on their own and fitted from
+    /// the reset start too.
+    pub restarted: bool,
 }
 
 impl Context<'_> {

@@ -45,6 +45,8 @@ mod pairs;
 pub mod rank;
 /// The Markdown report and its figures.
 pub mod report;
+/// The second pass for end stops, with stage 1 restarted.
+pub mod restarted;
 mod run;
 mod schedule;
 /// The robust score test of an effect at its null.

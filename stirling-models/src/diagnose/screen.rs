@@ -26,10 +26,58 @@ fn shape_grid(ctx: &Context, e: &EffectInfo) -> Vec<Vec<(&'static str, f64)>> {
     if travel.is_empty() {
         return vec![vec![]];
     }
+    if ctx.restarted {
+        return body_grid(&travel);
+    }
     TRAVEL_GRID
         .iter()
         .map(|f| travel.iter().map(|(q, a)| (*q, f * a)).collect())
         .collect()
+}
+
+/// Travels of a body's end stops on the restarted pass's grid, as fractions of its recorded
+/// excursion: stops that clip a record sit just inside the largest travel it shows.
+const BODY_TRAVELS: [f64; 2] = [0.9, 1.0];
+
+/// A travel this many times the recorded excursion: stops the record never reaches.
+const INERT_TRAVEL: f64 = 5.0;
+
+/// The restarted pass's grid: each body's stops at every travel of [`BODY_TRAVELS`] or out
+/// of its reach ([`INERT_TRAVEL`]), every body on its own (stops that clip the piston need
+/// not clip the displacer: one travel for both tests the displacer clipped where it ran
+/// free, and the score of such a setting points away from the stops); every body out of
+/// reach is the null, not a setting.
+fn body_grid(travel: &[(&'static str, f64)]) -> Vec<Vec<(&'static str, f64)>> {
+    let mut grid: Vec<Vec<(&'static str, f64)>> = vec![vec![]];
+    for &(q, a) in travel {
+        let options: Vec<f64> = std::iter::once(INERT_TRAVEL)
+            .chain(BODY_TRAVELS)
+            .map(|f| f * a)
+            .collect();
+        grid = grid
+            .into_iter()
+            .flat_map(|g| {
+                options.iter().map(move |&v| {
+                    let mut g = g.clone();
+                    g.push((q, v));
+                    g
+                })
+            })
+            .collect();
+    }
+    grid.retain(|g| {
+        g.iter()
+            .zip(travel)
+            .any(|((_, v), (_, a))| *v < INERT_TRAVEL * a)
+    });
+    grid
+}
+
+/// Whether an effect has end-stop travels (shape parameters screened on a grid).
+pub fn has_travel(e: &EffectInfo) -> bool {
+    e.params
+        .iter()
+        .any(|p| p.name == "xmax" || p.name == "ymax")
 }
 
 /// The score test of `joint` at its start.
