@@ -14,4 +14,4 @@ mod build;
 mod shims;
 mod tape;
 
-pub use tape::{jit, JitError, JitTape};
+pub use tape::{jit, JitError, JitTape, CHUNK_OPS};
