@@ -7,7 +7,7 @@ use std::collections::HashMap;
 use std::ops::Range;
 
 use cranelift_codegen::ir::condcodes::FloatCC;
-use cranelift_codegen::ir::{types, AbiParam, FuncRef, InstBuilder, MemFlagsData, Value};
+use cranelift_codegen::ir::{types, AbiParam, BlockArg, FuncRef, InstBuilder, MemFlagsData, Value};
 use cranelift_frontend::{FunctionBuilder, FunctionBuilderContext};
 use cranelift_jit::JITModule;
 use cranelift_module::{Linkage, Module};
@@ -34,6 +34,10 @@ pub(crate) struct Layout {
     /// `(register, output)` pairs, sorted by register: each output stored as its register
     /// is computed (no value kept alive to the end of the function for it).
     stores: Vec<(u32, u32)>,
+    /// The tape's numbers (`slot[r]` of an `Op::K` is its index here), read by the code
+    /// at `consts_addr` (the table's address, set once it no longer moves).
+    pub consts: Box<[f64]>,
+    pub consts_addr: usize,
 }
 
 impl Layout {
@@ -56,6 +60,15 @@ impl Layout {
                 }
             }
         }
+        let mut consts = Vec::new();
+        for (k, op) in tape.ops.iter().enumerate() {
+            if let Op::K(c) = *op {
+                slot[k] = consts.len() as u32;
+                consts.push(c);
+            }
+        }
+        let consts: Box<[f64]> = consts.into_boxed_slice();
+        let consts_addr = consts.as_ptr() as usize;
         let mut stores: Vec<(u32, u32)> = (0..tape.outputs.len() as u32)
             .map(|k| (tape.outputs[k as usize], k))
             .collect();
@@ -65,6 +78,8 @@ impl Layout {
             slot,
             slots: slots as usize,
             stores,
+            consts,
+            consts_addr,
         }
     }
 }
@@ -128,36 +143,47 @@ pub(crate) fn function(
     };
     let head = tape.head();
     let flags = MemFlagsData::trusted();
-    // the registers this function has: its own, and those of earlier functions it read
+    let ptr = module.target_config().pointer_type();
+    // the registers this function has: its own (none for a leaf), and those of earlier
+    // functions it read
     let mut regs: HashMap<u32, Value> = HashMap::new();
-    let mut own: Vec<Value> = Vec::with_capacity(range.len());
+    let mut own: Vec<Option<Value>> = Vec::with_capacity(range.len());
     let mut minus_zero: Option<Value> = None;
+    let consts = b.ins().iconst(ptr, layout.consts_addr as i64);
     let mut stores = layout
         .stores
         .partition_point(|&(r, _)| (r as usize) < range.start);
     for k in range.clone() {
+        // a leaf is loaded again at every use (a memory operand of its user): never kept in a
+        // register across the function, never spilled (the parameters are used everywhere)
         let mut r = |q: u32| -> Value {
             let q_us = q as usize;
+            if let Some(v) = leaf_value(&mut b, &args, consts, layout, q_us, &tape.ops[q_us]) {
+                return v;
+            }
             if q_us >= range.start {
-                return own[q_us - range.start];
+                if let Some(v) = own[q_us - range.start] {
+                    return v;
+                }
             }
             *regs.entry(q).or_insert_with(|| {
-                let op = &tape.ops[q_us];
-                match leaf_value(&mut b, &args, op) {
-                    Some(v) => v,
-                    None => {
-                        let at = offset(layout.slot[q_us]);
-                        b.ins().load(types::F64, flags, args.scratch, at)
-                    }
-                }
+                let at = offset(layout.slot[q_us]);
+                b.ins().load(types::F64, flags, args.scratch, at)
             })
         };
         let op = tape.ops[k];
         let val = match op {
-            Op::X(_) | Op::P(_) | Op::V(_) | Op::K(_) => match leaf_value(&mut b, &args, &op) {
-                Some(v) => v,
-                None => return Err(missing()),
-            },
+            Op::X(_) | Op::P(_) | Op::V(_) | Op::K(_) => {
+                let has_output = layout
+                    .stores
+                    .get(stores)
+                    .is_some_and(|&(g, _)| g as usize == k);
+                if !has_output {
+                    own.push(None);
+                    continue;
+                }
+                r(k as u32)
+            }
             Op::Add(a, c) => {
                 let (a, c) = (r(a), r(c));
                 b.ins().fadd(a, c)
@@ -197,8 +223,8 @@ pub(crate) fn function(
                 func_value(&mut b, &imports, f, a)?
             }
         };
-        own.push(val);
-        if layout.slot[k] != u32::MAX {
+        own.push(Some(val));
+        if !leaf(&op) && layout.slot[k] != u32::MAX {
             b.ins()
                 .store(flags, val, args.scratch, offset(layout.slot[k]));
         }
@@ -221,14 +247,25 @@ pub(crate) fn function(
     Ok(())
 }
 
-/// The value of a leaf instruction (`None` for any other).
-fn leaf_value(b: &mut FunctionBuilder, args: &Args, op: &Op) -> Option<Value> {
+/// The value of leaf instruction `k`, loaded (`None` for any other instruction). A number is
+/// loaded from the tape's table of numbers (`f64const` would be one value shared by every
+/// use, kept in a register or spilled for the whole function).
+fn leaf_value(
+    b: &mut FunctionBuilder,
+    args: &Args,
+    consts: Value,
+    layout: &Layout,
+    k: usize,
+    op: &Op,
+) -> Option<Value> {
     let flags = MemFlagsData::trusted();
     Some(match *op {
         Op::X(i) => b.ins().load(types::F64, flags, args.x, offset(i)),
         Op::P(k) => b.ins().load(types::F64, flags, args.p, offset(k)),
         Op::V(i) => b.ins().load(types::F64, flags, args.v, offset(i)),
-        Op::K(c) => b.ins().f64const(c),
+        Op::K(_) => b
+            .ins()
+            .load(types::F64, flags, consts, offset(layout.slot[k])),
         _ => return None,
     })
 }
@@ -297,6 +334,10 @@ fn func_value(
     Ok(match f {
         Func::Abs => b.ins().fabs(a),
         Func::Sqrt => b.ins().sqrt(a),
+        Func::Tanh => match imports.funcs.iter().find(|&&(g, _)| g == f) {
+            Some(&(_, r)) => tanh(b, r, a),
+            None => return Err(missing()),
+        },
         Func::Sign => {
             // sign(0) = sign(NaN) = 0, as `stirling_dsl::expr::sign`
             let zero = b.ins().f64const(0.0);
@@ -312,6 +353,33 @@ fn func_value(
             None => return Err(missing()),
         },
     })
+}
+
+/// `tanh(a)` as `stirling_dsl::expr::tanh` computes it (and as the macro's code inlines it):
+/// saturated, `|a| >= 22`, it is `+-1` (the usual case, away from a flow reversal), inline;
+/// else the shim is called in a cold block. A call makes the code spill every live `xmm`
+/// register around it (all caller-saved), so calling on every `tanh` cost the JIT a spill
+/// of everything at every link of every section.
+fn tanh(b: &mut FunctionBuilder, shim: FuncRef, a: Value) -> Value {
+    let abs = b.ins().fabs(a);
+    let limit = b.ins().f64const(22.0);
+    let saturated = b.ins().fcmp(FloatCC::GreaterThanOrEqual, abs, limit);
+    let (sat, slow, join) = (b.create_block(), b.create_block(), b.create_block());
+    b.append_block_param(join, types::F64);
+    b.ins().brif(saturated, sat, &[], slow, &[]);
+    b.seal_block(sat);
+    b.seal_block(slow);
+    b.switch_to_block(sat);
+    let one = b.ins().f64const(1.0);
+    let v = b.ins().fcopysign(one, a);
+    b.ins().jump(join, &[BlockArg::Value(v)]);
+    b.switch_to_block(slow);
+    b.set_cold_block(slow);
+    let v = call(b, shim, &[a]);
+    b.ins().jump(join, &[BlockArg::Value(v)]);
+    b.seal_block(join);
+    b.switch_to_block(join);
+    b.block_params(join)[0]
 }
 
 /// `a^k` by the multiplications `f64::powi` performs (compiler-rt's `__powidf2`: square and

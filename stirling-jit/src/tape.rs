@@ -43,6 +43,9 @@ pub struct JitTape {
     needs: [usize; 5],
     /// The length of the scratch array the functions pass registers through.
     scratch: usize,
+    /// The tape's numbers, which the code reads at their address (a boxed slice: its
+    /// elements never move, and live as long as the code).
+    _consts: Box<[f64]>,
 }
 
 impl std::fmt::Debug for JitTape {
@@ -84,7 +87,7 @@ impl JitTape {
     pub fn compile_chunked(tape: &Tape, chunk: usize) -> Result<JitTape, JitError> {
         let mut module = module()?;
         let ptr = module.target_config().pointer_type();
-        let layout = build::Layout::new(tape, chunk);
+        let mut layout = build::Layout::new(tape, chunk);
         let mut ids = Vec::with_capacity(layout.chunks.len());
         let mut ctx = module.make_context();
         for c in 0..layout.chunks.len() {
@@ -108,6 +111,7 @@ impl JitTape {
             code,
             needs: needs(tape),
             scratch: layout.slots,
+            _consts: std::mem::take(&mut layout.consts),
         })
     }
 
@@ -165,7 +169,9 @@ impl JitTape {
             // convention), and its module (a field of `self`) keeps the code alive. The code
             // reads `x[i]`, `p[k]`, `v[i]` only at indices the tape names and writes the
             // output buffers only at its outputs' indices; `run_split` checked every slice is
-            // at least that long (`needs`). The scratch array is read and written only at
+            // at least that long (`needs`); it reads the numbers of `self._consts` at the
+            // address they were compiled with (their heap block, never moved or freed
+            // before `self`). The scratch array is read and written only at
             // slots below `self.scratch` (`Layout`), its length with more than one function
             // (a single function never touches it). Every buffer is borrowed mutably, so no
             // one else sees the writes.
@@ -191,6 +197,9 @@ fn module() -> Result<JITModule, JitError> {
     set(&mut flags, "use_colocated_libcalls", "false")?;
     set(&mut flags, "is_pic", "false")?;
     set(&mut flags, "opt_level", "speed")?;
+    // the IR is checked by construction (and by the tests); the verifier cost ~5% of the
+    // compile time
+    set(&mut flags, "enable_verifier", "false")?;
     let isa = cranelift_native::builder()
         .map_err(|e| JitError::Host(e.to_string()))?
         .finish(settings::Flags::new(flags))
