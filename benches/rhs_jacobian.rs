@@ -11,6 +11,10 @@ use stirling::dsl::{Closure, JacSink, Model};
 use stirling::models::family::NSection;
 use stirling::stirling_model;
 
+#[path = "../examples/support/fairness.rs"]
+mod fairness;
+use fairness::fairness_state;
+
 stirling_model! {
     /// `nsection` with a regenerator matrix of heat capacity `Cm` (a wall array) conducting
     /// axially to the fixed heater and cooler temperatures.
@@ -28,21 +32,6 @@ stirling_model! {
         link Th -> matrix[0] { conductance: 2.0 * Gm * n }
         link matrix[n - 1] -> Tk { conductance: 2.0 * Gm * n }
     }
-}
-
-fn state(m: &dyn Model, p: &[f64]) -> Vec<f64> {
-    let mut x = vec![0.0; m.n_states()];
-    m.equilibrium_guess(p, &mut x);
-    x[0] = 3e-3;
-    x[1] = 0.2;
-    x[2] = -2e-3;
-    x[3] = -0.1;
-    for (i, s) in m.states().iter().enumerate() {
-        if s.unit == "Pa" {
-            x[i] *= 1.0 + 1e-3 * ((i % 7) as f64);
-        }
-    }
-    x
 }
 
 /// Forward differences, one RHS per column: the baseline an analytic Jacobian replaces.
@@ -77,7 +66,7 @@ fn bench(c: &mut Criterion) {
     for n in [10usize, 100, 1000] {
         let m = NSection::new(n, Closure::Full).expect("n >= 1");
         let p = m.default_params();
-        let x = state(&m, &p);
+        let x = fairness_state(&m, &p);
         rhs_and_jacobian(&mut g, "", &m, &p, &x, n);
         if n <= 100 {
             let mut f0 = vec![0.0; x.len()];
@@ -89,7 +78,7 @@ fn bench(c: &mut Criterion) {
         }
         let m = NSectionMatrix::new(n, Closure::Full).expect("n >= 1");
         let p = m.default_params();
-        let x = state(&m, &p);
+        let x = fairness_state(&m, &p);
         rhs_and_jacobian(&mut g, "_matrix", &m, &p, &x, n);
     }
     g.finish();

@@ -1,140 +1,199 @@
 //! Engines from files, timed: the load and compile time of `examples/engines/nsection.stirling`
-//! (read, compose, check, lower, assemble, differentiate, lay out the tapes at `n`), and the
-//! right-hand side with the sparse Jacobian (`Model::rhs_and_jacobian_values`) of the macro's
-//! `nsection`, the file's tape (interpreted), the tape compiled to native code by the JIT
-//! (`stirling-jit`, with its compile time: the first call) and the JIT with the parameters
-//! folded in, at n = 2, 10, 100, 1000.
+//! (read, compose, check, lower, assemble, differentiate, lay out the tapes at `n`, compile
+//! the right-hand side with the Jacobian to native code), and the right-hand side with the
+//! sparse Jacobian's values (`Model::rhs_and_jacobian_values`) of the macro's `nsection`, the
+//! file's tape interpreted, the tape compiled by the JIT (`stirling-jit`) and the JIT with the
+//! parameters folded in, at the benchmarks' fairness state (`examples/support/fairness.rs`,
+//! as `examples/bench_native.rs` and CasADi's side of `bench/`).
 //!
-//! Run: `cargo run --release --example files_speed` (`--json` for the numbers only).
+//! The kernels are timed in alternating rounds (macro, JIT, folded, three times; each keeps
+//! its fastest round's median), so that a busy machine slows them alike.
+//!
+//! Run: `cargo run --release --example files_speed [-- --ns 2,10,100,1000] [--json]`
+//! (`--json`: the numbers, with the state, right-hand side and Jacobian of the folded model
+//! for `bench/files_compare.py`'s check against CasADi).
+
+#[path = "support/fairness.rs"]
+mod fairness;
 
 use std::path::Path;
+use std::sync::Arc;
 use std::time::{Duration, Instant};
 
-use stirling::dsl::compiled::Definition;
+use fairness::{fairness_state, time_per_call};
+use serde_json::{json, Value};
+use stirling::dsl::compiled::{CompiledModel, Definition};
 use stirling::dsl::{Closure, Model};
 use stirling::models::family::NSection;
 use stirling::models::files;
 
-/// A state near the equilibrium with the bodies displaced (every branch of the upwind
-/// switches taken somewhere).
-fn state(m: &dyn Model, p: &[f64]) -> Vec<f64> {
-    let mut x = vec![0.0; m.n_states()];
-    m.equilibrium_guess(p, &mut x);
-    x[0] = 3e-3;
-    x[1] = 0.2;
-    x[2] = -2e-3;
-    x[3] = -0.1;
-    for (i, s) in m.states().iter().enumerate() {
-        if s.unit == "Pa" {
-            x[i] *= 1.0 + 1e-3 * ((i % 7) as f64);
-        }
-    }
-    x
-}
-
-/// Nanoseconds per call of RHS + Jacobian values, the best of five runs of ~0.2 s.
-fn time(m: &dyn Model, p: &[f64]) -> f64 {
-    let x = state(m, p);
+/// Seconds per call of RHS + Jacobian values at `x` (the median of batches of ~2 ms).
+fn time(m: &dyn Model, p: &[f64], x: &[f64]) -> f64 {
     let mut f = vec![0.0; m.n_states()];
     let mut v = vec![0.0; m.jacobian_pattern(p).len()];
-    let mut once = || m.rhs_and_jacobian_values(p, &x, 0.0, &mut f, &mut v);
-    let start = Instant::now();
-    let mut calls = 0u64;
-    while start.elapsed() < Duration::from_millis(50) {
-        once();
-        calls += 1;
-    }
-    let reps = calls.max(1) * 4;
-    (0..5)
-        .map(|_| {
-            let t = Instant::now();
-            for _ in 0..reps {
-                once();
-            }
-            t.elapsed().as_nanos() as f64 / reps as f64
-        })
-        .fold(f64::INFINITY, f64::min)
+    let once = || {
+        m.rhs_and_jacobian_values(
+            std::hint::black_box(p),
+            std::hint::black_box(x),
+            0.0,
+            &mut f,
+            &mut v,
+        )
+    };
+    time_per_call(once, 2e-3, 21, 0.6).0
 }
 
-/// The first RHS + Jacobian call: the JIT compiles the tape then.
-fn first_call(m: &dyn Model, p: &[f64]) -> Duration {
-    let x = state(m, p);
+/// The first RHS + Jacobian call (the JIT compiles the tape then).
+fn first_call(m: &dyn Model, p: &[f64], x: &[f64]) -> Duration {
     let mut f = vec![0.0; m.n_states()];
     let mut v = vec![0.0; m.jacobian_pattern(p).len()];
     let t = Instant::now();
-    m.rhs_and_jacobian_values(p, &x, 0.0, &mut f, &mut v);
+    m.rhs_and_jacobian_values(p, x, 0.0, &mut f, &mut v);
     t.elapsed()
 }
 
-fn main() -> Result<(), Box<dyn std::error::Error>> {
-    let json = std::env::args().any(|a| a == "--json");
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/engines/nsection.stirling");
-    // cold: the first load in this process
+fn ms(d: Duration) -> f64 {
+    d.as_secs_f64() * 1e3
+}
+
+/// The load of the file and everything up to a native RHS + Jacobian at `n`, cold (the first
+/// load in this process): each stage's milliseconds.
+fn load(path: &Path, n: usize) -> Result<(Arc<Definition>, Value), Box<dyn std::error::Error>> {
     let t = Instant::now();
-    let topo = stirling_front::load::load_file(&path, stirling::models::files::BASES)?;
+    let topo = stirling_front::load::load_file(path, files::BASES)?;
     let parsed = t.elapsed();
     let def = Definition::new(topo);
     let assembled = t.elapsed();
-    let m10 = def.model(10, Closure::Full)?;
-    let compiled = t.elapsed();
-    let ms = |d: Duration| d.as_secs_f64() * 1e3;
-    let mut rows = Vec::new();
-    for n in [2usize, 10, 100, 1000] {
-        let t = Instant::now();
-        let tape = def.model(n, Closure::Full)?;
-        let build = t.elapsed();
-        let mac = NSection::new(n, Closure::Full)?;
-        let p = mac.default_params();
-        let jit = files::jit(def.model(n, Closure::Full)?);
-        let jit_compile = first_call(&jit, &p);
-        let folded = jit.folded(&p);
-        let folded_compile = first_call(&folded, &p);
-        let (a, b) = (time(&mac, &p), time(&tape, &p));
-        let (c, d) = (time(&jit, &p), time(&folded, &p));
-        rows.push(serde_json::json!({
-            "n": n, "tape_build_ms": ms(build), "jit_compile_ms": ms(jit_compile),
-            "jit_folded_compile_ms": ms(folded_compile),
-            "macro_ns": a, "tape_ns": b, "jit_ns": c, "jit_folded_ns": d,
-            "tape_over_macro": b / a, "jit_over_macro": c / a, "jit_folded_over_macro": d / a,
-        }));
-    }
-    let _ = m10;
-    let out = serde_json::json!({
-        "load_ms": ms(parsed), "assemble_ms": ms(assembled - parsed),
-        "compile_n10_ms": ms(compiled - assembled), "total_n10_ms": ms(compiled), "rhs_jacobian": rows,
+    let m = files::jit(def.model(n, Closure::Full)?);
+    let taped = t.elapsed();
+    let p = m.default_params();
+    let x = vec![1.0; m.n_states()];
+    first_call(&m, &p, &x);
+    let native = t.elapsed();
+    let doc = json!({
+        "n": n,
+        "read_lower_ms": ms(parsed),
+        "assemble_differentiate_ms": ms(assembled - parsed),
+        "tapes_ms": ms(taped - assembled),
+        "jit_rhs_jacobian_ms": ms(native - taped),
+        "total_ms": ms(native),
     });
-    if json {
-        println!("{}", serde_json::to_string_pretty(&out)?);
-        return Ok(());
+    Ok((def, doc))
+}
+
+/// The state, RHS and Jacobian triplets of `m` at its fairness state.
+fn values(m: &CompiledModel, p: &[f64], x: &[f64]) -> Value {
+    let mut f = vec![0.0; m.n_states()];
+    m.rhs(p, x, 0.0, &mut f);
+    let jac: Vec<Value> = m
+        .jacobian_triplets(p, x, 0.0)
+        .into_iter()
+        .map(|(r, c, v)| json!([r, c, v]))
+        .collect();
+    json!({"x": x, "f": f, "jac": jac})
+}
+
+/// One `n`: build times and the kernels' seconds per call.
+fn row(def: &Arc<Definition>, n: usize) -> Result<Value, Box<dyn std::error::Error>> {
+    let t = Instant::now();
+    let tape = def.model(n, Closure::Full)?;
+    let build = t.elapsed();
+    let mac = NSection::new(n, Closure::Full)?;
+    let p = mac.default_params();
+    let x = fairness_state(&mac, &p);
+    let jit = files::jit(def.model(n, Closure::Full)?);
+    let jit_compile = first_call(&jit, &p, &x);
+    let folded = jit.folded(&p);
+    let folded_compile = first_call(&folded, &p, &x);
+    let mut best = [f64::INFINITY; 3];
+    for _ in 0..3 {
+        for (b, m) in best.iter_mut().zip([&mac as &dyn Model, &jit, &folded]) {
+            *b = b.min(time(m, &p, &x));
+        }
     }
+    let [a, c, d] = best;
+    let b = time(&tape, &p, &x);
+    let names: Vec<&str> = mac.params().iter().map(|q| q.name).collect();
+    let params: serde_json::Map<String, Value> = names
+        .iter()
+        .zip(&p)
+        .map(|(k, v)| (k.to_string(), json!(v)))
+        .collect();
+    let (rhs_ops, jac_ops) = tape.tape_sizes();
+    Ok(json!({
+        "n": n, "tape_build_ms": ms(build), "jit_compile_ms": ms(jit_compile),
+        "jit_folded_compile_ms": ms(folded_compile),
+        "tape_ops": {"rhs": rhs_ops, "jac": jac_ops,
+                     "rhs_jac": tape.rhs_jacobian_tape(&p).ops.len(),
+                     "rhs_jac_folded": folded.rhs_jacobian_tape(&p).ops.len()},
+        "macro_ns": a * 1e9, "tape_ns": b * 1e9, "jit_ns": c * 1e9, "jit_folded_ns": d * 1e9,
+        "tape_over_macro": b / a, "jit_over_macro": c / a, "jit_folded_over_macro": d / a,
+        "params": params, "folded_at_x": values(&folded, &p, &x),
+    }))
+}
+
+/// The `n`s of `--ns 2,10,...` (2, 10, 100, 1000 without).
+fn ns(args: &[String]) -> Result<Vec<usize>, Box<dyn std::error::Error>> {
+    match args.iter().position(|a| a == "--ns") {
+        None => Ok(vec![2, 10, 100, 1000]),
+        Some(i) => {
+            let list = args.get(i + 1).ok_or("--ns needs a list, e.g. 2,10,100")?;
+            Ok(list
+                .split(',')
+                .map(|s| s.trim().parse())
+                .collect::<Result<_, _>>()?)
+        }
+    }
+}
+
+fn print_table(load: &Value, rows: &[Value]) {
+    let f = |r: &Value, k: &str| r[k].as_f64().unwrap_or(f64::NAN);
     println!(
-        "nsection.stirling: read and lowered {:.1} ms, assembled and differentiated {:.1} ms, \
-         tapes at n = 10 {:.1} ms: {:.1} ms in all",
-        ms(parsed),
-        ms(assembled - parsed),
-        ms(compiled - assembled),
-        ms(compiled)
+        "nsection.stirling to a native RHS + Jacobian at n = {}: {:.1} ms (read and lower {:.1}, \
+         assemble and differentiate {:.1}, tapes {:.1}, JIT {:.1})",
+        load["n"],
+        f(load, "total_ms"),
+        f(load, "read_lower_ms"),
+        f(load, "assemble_differentiate_ms"),
+        f(load, "tapes_ms"),
+        f(load, "jit_rhs_jacobian_ms"),
     );
     println!("RHS + Jacobian values per call (ns):");
     println!(
         "     n    macro     tape      jit  jit fold  tape/mac  jit/mac  fold/mac  \
          tapes (ms)  jit compile (ms)"
     );
-    for r in &rows {
-        let f = |k: &str| r[k].as_f64().unwrap_or(f64::NAN);
+    for r in rows {
         println!(
             "{:>6} {:>8.0} {:>8.0} {:>8.0} {:>9.0} {:>9.2} {:>8.2} {:>9.2} {:>11.1} {:>17.1}",
             r["n"],
-            f("macro_ns"),
-            f("tape_ns"),
-            f("jit_ns"),
-            f("jit_folded_ns"),
-            f("tape_over_macro"),
-            f("jit_over_macro"),
-            f("jit_folded_over_macro"),
-            f("tape_build_ms"),
-            f("jit_compile_ms")
+            f(r, "macro_ns"),
+            f(r, "tape_ns"),
+            f(r, "jit_ns"),
+            f(r, "jit_folded_ns"),
+            f(r, "tape_over_macro"),
+            f(r, "jit_over_macro"),
+            f(r, "jit_folded_over_macro"),
+            f(r, "tape_build_ms"),
+            f(r, "jit_compile_ms")
         );
+    }
+}
+
+fn main() -> Result<(), Box<dyn std::error::Error>> {
+    let args: Vec<String> = std::env::args().collect();
+    let json = args.iter().any(|a| a == "--json");
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/engines/nsection.stirling");
+    let (def, load) = load(&path, 10)?;
+    let rows = ns(&args)?
+        .into_iter()
+        .map(|n| row(&def, n))
+        .collect::<Result<Vec<_>, _>>()?;
+    if json {
+        let out = json!({"load": load, "rhs_jacobian": rows});
+        println!("{}", serde_json::to_string(&out)?);
+    } else {
+        print_table(&load, &rows);
     }
     Ok(())
 }

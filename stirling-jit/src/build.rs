@@ -1,8 +1,13 @@
-//! The Cranelift IR of one tape: one SSA value per register, in one block, the inputs loaded
-//! from `x`, `p` and `v` and each output stored to `out`.
+//! The Cranelift IR of a tape: one SSA value per register, in one block per function, the
+//! inputs loaded from `x`, `p` and `v` and each output stored to its buffer as soon as it is
+//! computed. A long tape is cut into several functions ([`Layout`]) that pass the registers
+//! a later one reads through a scratch array.
+
+use std::collections::HashMap;
+use std::ops::Range;
 
 use cranelift_codegen::ir::condcodes::FloatCC;
-use cranelift_codegen::ir::{types, AbiParam, FuncRef, InstBuilder, MemFlagsData, Value};
+use cranelift_codegen::ir::{types, AbiParam, BlockArg, FuncRef, InstBuilder, MemFlagsData, Value};
 use cranelift_frontend::{FunctionBuilder, FunctionBuilderContext};
 use cranelift_jit::JITModule;
 use cranelift_module::{Linkage, Module};
@@ -17,56 +22,252 @@ struct Imports {
     powf: Option<FuncRef>,
 }
 
-/// Fill `ctx.func` (its signature set) with the code of `tape`.
+/// How a tape is cut into functions (Cranelift's compile time grows faster than linearly
+/// with one block, so a long tape is compiled as several): the ranges of instructions, and
+/// the slot in the scratch array of every register that a later function reads.
+pub(crate) struct Layout {
+    pub chunks: Vec<Range<usize>>,
+    /// `slot[r]`: where register `r` is kept for later functions (`u32::MAX`: nowhere).
+    slot: Vec<u32>,
+    /// The number of scratch slots.
+    pub slots: usize,
+    /// `(register, output)` pairs, sorted by register: each output stored as its register
+    /// is computed (no value kept alive to the end of the function for it).
+    stores: Vec<(u32, u32)>,
+    /// The tape's numbers (`slot[r]` of an `Op::K` is its index here), read by the code
+    /// at `consts_addr` (the table's address, set once it no longer moves).
+    pub consts: Box<[f64]>,
+    pub consts_addr: usize,
+}
+
+impl Layout {
+    /// Cut `tape` into functions of at most `chunk` instructions.
+    pub(crate) fn new(tape: &Tape, chunk: usize) -> Layout {
+        let len = tape.ops.len();
+        let chunk = chunk.max(1);
+        let chunks: Vec<Range<usize>> = (0..len.div_ceil(chunk).max(1))
+            .map(|c| c * chunk..((c + 1) * chunk).min(len))
+            .collect();
+        let mut slot = vec![u32::MAX; len];
+        let mut slots = 0u32;
+        for (k, op) in tape.ops.iter().enumerate() {
+            let (args, count) = operands(op);
+            for &a in &args[..count] {
+                let (a, first) = (a as usize, k - k % chunk);
+                if a < first && !leaf(&tape.ops[a]) && slot[a] == u32::MAX {
+                    slot[a] = slots;
+                    slots += 1;
+                }
+            }
+        }
+        let mut consts = Vec::new();
+        for (k, op) in tape.ops.iter().enumerate() {
+            if let Op::K(c) = *op {
+                slot[k] = consts.len() as u32;
+                consts.push(c);
+            }
+        }
+        let consts: Box<[f64]> = consts.into_boxed_slice();
+        let consts_addr = consts.as_ptr() as usize;
+        let mut stores: Vec<(u32, u32)> = (0..tape.outputs.len() as u32)
+            .map(|k| (tape.outputs[k as usize], k))
+            .collect();
+        stores.sort_unstable();
+        Layout {
+            chunks,
+            slot,
+            slots: slots as usize,
+            stores,
+            consts,
+            consts_addr,
+        }
+    }
+}
+
+/// The operands of an instruction (none for a leaf).
+fn operands(op: &Op) -> ([u32; 2], usize) {
+    match *op {
+        Op::X(_) | Op::P(_) | Op::V(_) | Op::K(_) => ([0, 0], 0),
+        Op::Neg(a) | Op::Powi(a, _) | Op::Func(_, a) => ([a, 0], 1),
+        Op::Add(a, b) | Op::Sub(a, b) | Op::Mul(a, b) | Op::Div(a, b) | Op::Powf(a, b) => {
+            ([a, b], 2)
+        }
+    }
+}
+
+/// Whether `op` reads an input or is a number (emitted again where a later function needs
+/// it, never kept in the scratch array).
+fn leaf(op: &Op) -> bool {
+    matches!(op, Op::X(_) | Op::P(_) | Op::V(_) | Op::K(_))
+}
+
+/// The function's arguments: `x`, `p`, `v`, the two output buffers and the scratch array.
+struct Args {
+    x: Value,
+    p: Value,
+    v: Value,
+    head: Value,
+    tail: Value,
+    scratch: Value,
+}
+
+/// Fill `func` (its signature set) with the code of chunk `c` of `tape` (`layout`).
 pub(crate) fn function(
     module: &mut JITModule,
     func: &mut cranelift_codegen::ir::Function,
     tape: &Tape,
+    layout: &Layout,
+    c: usize,
 ) -> Result<(), JitError> {
+    let range = layout.chunks[c].clone();
     let mut fctx = FunctionBuilderContext::new();
     let mut imports = Imports {
         funcs: Vec::new(),
         powf: None,
     };
-    declare_imports(module, func, tape, &mut imports)?;
+    declare_imports(module, func, &tape.ops[range.clone()], &mut imports)?;
     let config = module.target_config();
     let mut b = FunctionBuilder::new(func, &mut fctx);
     let block = b.create_block();
     b.append_block_params_for_function_params(block);
     b.switch_to_block(block);
     b.seal_block(block);
-    let args = b.block_params(block).to_vec();
-    let (x, p, v, out) = (args[0], args[1], args[2], args[3]);
+    let a = b.block_params(block).to_vec();
+    let args = Args {
+        x: a[0],
+        p: a[1],
+        v: a[2],
+        head: a[3],
+        tail: a[4],
+        scratch: a[5],
+    };
+    let head = tape.head();
     let flags = MemFlagsData::trusted();
-    let mut regs: Vec<Value> = Vec::with_capacity(tape.ops.len());
-    for op in &tape.ops {
-        let r = |k: u32| regs[k as usize];
-        let val = match *op {
-            Op::X(i) => b.ins().load(types::F64, flags, x, offset(i)),
-            Op::P(k) => b.ins().load(types::F64, flags, p, offset(k)),
-            Op::V(i) => b.ins().load(types::F64, flags, v, offset(i)),
-            Op::K(c) => b.ins().f64const(c),
-            Op::Add(a, c) => b.ins().fadd(r(a), r(c)),
-            Op::Sub(a, c) => b.ins().fsub(r(a), r(c)),
-            Op::Mul(a, c) => b.ins().fmul(r(a), r(c)),
-            Op::Div(a, c) => b.ins().fdiv(r(a), r(c)),
-            Op::Neg(a) => b.ins().fneg(r(a)),
-            Op::Powi(a, k) => powi(&mut b, r(a), k),
-            Op::Powf(a, c) => match imports.powf {
-                Some(f) => call(&mut b, f, &[r(a), r(c)]),
-                None => return Err(missing()),
-            },
-            Op::Func(f, a) => func_value(&mut b, &imports, f, r(a))?,
+    let ptr = module.target_config().pointer_type();
+    // the registers this function has: its own (none for a leaf), and those of earlier
+    // functions it read
+    let mut regs: HashMap<u32, Value> = HashMap::new();
+    let mut own: Vec<Option<Value>> = Vec::with_capacity(range.len());
+    let mut minus_zero: Option<Value> = None;
+    let consts = b.ins().iconst(ptr, layout.consts_addr as i64);
+    let mut stores = layout
+        .stores
+        .partition_point(|&(r, _)| (r as usize) < range.start);
+    for k in range.clone() {
+        // a leaf is loaded again at every use (a memory operand of its user): never kept in a
+        // register across the function, never spilled (the parameters are used everywhere)
+        let mut r = |q: u32| -> Value {
+            let q_us = q as usize;
+            if let Some(v) = leaf_value(&mut b, &args, consts, layout, q_us, &tape.ops[q_us]) {
+                return v;
+            }
+            if q_us >= range.start {
+                if let Some(v) = own[q_us - range.start] {
+                    return v;
+                }
+            }
+            *regs.entry(q).or_insert_with(|| {
+                let at = offset(layout.slot[q_us]);
+                b.ins().load(types::F64, flags, args.scratch, at)
+            })
         };
-        regs.push(val);
-    }
-    for (k, &o) in tape.outputs.iter().enumerate() {
-        b.ins()
-            .store(flags, regs[o as usize], out, offset(k as u32));
+        let op = tape.ops[k];
+        let val = match op {
+            Op::X(_) | Op::P(_) | Op::V(_) | Op::K(_) => {
+                let has_output = layout
+                    .stores
+                    .get(stores)
+                    .is_some_and(|&(g, _)| g as usize == k);
+                if !has_output {
+                    own.push(None);
+                    continue;
+                }
+                r(k as u32)
+            }
+            Op::Add(a, c) => {
+                let (a, c) = (r(a), r(c));
+                b.ins().fadd(a, c)
+            }
+            Op::Sub(a, c) => {
+                let (a, c) = (r(a), r(c));
+                b.ins().fsub(a, c)
+            }
+            Op::Mul(a, c) => {
+                let (a, c) = (r(a), r(c));
+                b.ins().fmul(a, c)
+            }
+            Op::Div(a, c) => {
+                let (a, c) = (r(a), r(c));
+                b.ins().fdiv(a, c)
+            }
+            Op::Neg(a) => {
+                let a = r(a);
+                // the sign bit flipped, as `fneg` (and Rust's `-a`) does; `fneg` would
+                // build its mask again at every use, 3 instructions instead of 1
+                let sign = *minus_zero.get_or_insert_with(|| b.ins().f64const(-0.0));
+                b.ins().bxor(a, sign)
+            }
+            Op::Powi(a, e) => {
+                let a = r(a);
+                powi(&mut b, a, e)
+            }
+            Op::Powf(a, c) => {
+                let (a, c) = (r(a), r(c));
+                match imports.powf {
+                    Some(f) => call(&mut b, f, &[a, c]),
+                    None => return Err(missing()),
+                }
+            }
+            Op::Func(f, a) => {
+                let a = r(a);
+                func_value(&mut b, &imports, f, a)?
+            }
+        };
+        own.push(Some(val));
+        if !leaf(&op) && layout.slot[k] != u32::MAX {
+            b.ins()
+                .store(flags, val, args.scratch, offset(layout.slot[k]));
+        }
+        while let Some(&(reg, out)) = layout.stores.get(stores) {
+            if reg as usize != k {
+                break;
+            }
+            let out = out as usize;
+            let (base, at) = if out < head {
+                (args.head, out)
+            } else {
+                (args.tail, out - head)
+            };
+            b.ins().store(flags, val, base, offset(at as u32));
+            stores += 1;
+        }
     }
     b.ins().return_(&[]);
     b.finalize(config);
     Ok(())
+}
+
+/// The value of leaf instruction `k`, loaded (`None` for any other instruction). A number is
+/// loaded from the tape's table of numbers (`f64const` would be one value shared by every
+/// use, kept in a register or spilled for the whole function).
+fn leaf_value(
+    b: &mut FunctionBuilder,
+    args: &Args,
+    consts: Value,
+    layout: &Layout,
+    k: usize,
+    op: &Op,
+) -> Option<Value> {
+    let flags = MemFlagsData::trusted();
+    Some(match *op {
+        Op::X(i) => b.ins().load(types::F64, flags, args.x, offset(i)),
+        Op::P(k) => b.ins().load(types::F64, flags, args.p, offset(k)),
+        Op::V(i) => b.ins().load(types::F64, flags, args.v, offset(i)),
+        Op::K(_) => b
+            .ins()
+            .load(types::F64, flags, consts, offset(layout.slot[k])),
+        _ => return None,
+    })
 }
 
 /// The byte offset of element `i` of an `f64` array.
@@ -83,7 +284,7 @@ fn missing() -> JitError {
 fn declare_imports(
     module: &mut JITModule,
     func: &mut cranelift_codegen::ir::Function,
-    tape: &Tape,
+    ops: &[Op],
     imports: &mut Imports,
 ) -> Result<(), JitError> {
     let sig = |arity: usize| {
@@ -95,7 +296,7 @@ fn declare_imports(
         s
     };
     let (unary, binary) = (sig(1), sig(2));
-    for op in &tape.ops {
+    for op in ops {
         match *op {
             Op::Func(f, _) if inline(f) => {}
             Op::Func(f, _) if !imports.funcs.iter().any(|&(g, _)| g == f) => {
@@ -133,6 +334,10 @@ fn func_value(
     Ok(match f {
         Func::Abs => b.ins().fabs(a),
         Func::Sqrt => b.ins().sqrt(a),
+        Func::Tanh => match imports.funcs.iter().find(|&&(g, _)| g == f) {
+            Some(&(_, r)) => tanh(b, r, a),
+            None => return Err(missing()),
+        },
         Func::Sign => {
             // sign(0) = sign(NaN) = 0, as `stirling_dsl::expr::sign`
             let zero = b.ins().f64const(0.0);
@@ -148,6 +353,33 @@ fn func_value(
             None => return Err(missing()),
         },
     })
+}
+
+/// `tanh(a)` as `stirling_dsl::expr::tanh` computes it (and as the macro's code inlines it):
+/// saturated, `|a| >= 22`, it is `+-1` (the usual case, away from a flow reversal), inline;
+/// else the shim is called in a cold block. A call makes the code spill every live `xmm`
+/// register around it (all caller-saved), so calling on every `tanh` cost the JIT a spill
+/// of everything at every link of every section.
+fn tanh(b: &mut FunctionBuilder, shim: FuncRef, a: Value) -> Value {
+    let abs = b.ins().fabs(a);
+    let limit = b.ins().f64const(22.0);
+    let saturated = b.ins().fcmp(FloatCC::GreaterThanOrEqual, abs, limit);
+    let (sat, slow, join) = (b.create_block(), b.create_block(), b.create_block());
+    b.append_block_param(join, types::F64);
+    b.ins().brif(saturated, sat, &[], slow, &[]);
+    b.seal_block(sat);
+    b.seal_block(slow);
+    b.switch_to_block(sat);
+    let one = b.ins().f64const(1.0);
+    let v = b.ins().fcopysign(one, a);
+    b.ins().jump(join, &[BlockArg::Value(v)]);
+    b.switch_to_block(slow);
+    b.set_cold_block(slow);
+    let v = call(b, shim, &[a]);
+    b.ins().jump(join, &[BlockArg::Value(v)]);
+    b.seal_block(join);
+    b.switch_to_block(join);
+    b.block_params(join)[0]
 }
 
 /// `a^k` by the multiplications `f64::powi` performs (compiler-rt's `__powidf2`: square and

@@ -1,5 +1,6 @@
 //! [`JitTape`]: one tape compiled to native code, owning the code's memory.
 
+use std::cell::RefCell;
 use std::sync::Arc;
 
 use cranelift_codegen::ir::AbiParam;
@@ -27,82 +28,163 @@ impl From<ModuleError> for JitError {
     }
 }
 
-/// The signature of the compiled code.
-type Code = extern "C" fn(*const f64, *const f64, *const f64, *mut f64);
+/// The signature of the compiled code: `x`, `p`, `v`, the two output buffers, the scratch
+/// array.
+type Code = extern "C" fn(*const f64, *const f64, *const f64, *mut f64, *mut f64, *mut f64);
 
 /// A tape compiled to native code: `run` writes output `k` of the tape to `out[k]`.
 pub struct JitTape {
     /// Owns the code's memory (never freed while `code` may run: both live and die together).
     _module: JITModule,
-    /// The code's address; a [`Code`] (`call`).
-    code: *const u8,
-    /// The shortest `x`, `p`, `v` and `out` the code may be called with.
-    needs: [usize; 4],
+    /// The functions' addresses, each a [`Code`] (`call`), run in order.
+    code: Vec<*const u8>,
+    /// The shortest `x`, `p`, `v`, first and second output buffer the code may be called
+    /// with.
+    needs: [usize; 5],
+    /// The length of the scratch array the functions pass registers through.
+    scratch: usize,
+    /// The tape's numbers, which the code reads at their address (a boxed slice: its
+    /// elements never move, and live as long as the code).
+    _consts: Box<[f64]>,
 }
 
 impl std::fmt::Debug for JitTape {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.debug_struct("JitTape")
             .field("needs", &self.needs)
+            .field("functions", &self.code.len())
             .finish_non_exhaustive()
     }
 }
 
 // SAFETY: `JITModule` is neither `Send` nor `Sync` only because it holds raw pointers to the
 // code's memory. After `finalize_definitions` nothing mutates it (`JitTape` never hands it
-// out, mutably or not); the code is pure (it reads its inputs and writes `out` only), so
-// moving the owner to or calling the code from any thread is sound.
+// out, mutably or not); the code is pure (it reads its inputs and writes the output buffers
+// and the calling thread's scratch array only), so moving the owner to or calling the code
+// from any thread is sound.
 #[allow(unsafe_code)]
 unsafe impl Send for JitTape {}
 // SAFETY: as for `Send`: shared access only ever calls the read-only code.
 #[allow(unsafe_code)]
 unsafe impl Sync for JitTape {}
 
+thread_local! {
+    /// The scratch array of the tapes compiled as several functions (one per thread, reused).
+    static SCRATCH: RefCell<Vec<f64>> = const { RefCell::new(Vec::new()) };
+}
+
+/// The instructions per function: Cranelift compiles a few thousand in one block in tens of
+/// milliseconds, but its time grows faster than linearly beyond (one block of 80,000: 14 s).
+pub const CHUNK_OPS: usize = 4_000;
+
 impl JitTape {
-    /// Compile `tape` for this machine.
+    /// Compile `tape` for this machine (as functions of at most [`CHUNK_OPS`] instructions).
     pub fn compile(tape: &Tape) -> Result<JitTape, JitError> {
+        JitTape::compile_chunked(tape, CHUNK_OPS)
+    }
+
+    /// Compile `tape` as functions of at most `chunk` instructions each.
+    pub fn compile_chunked(tape: &Tape, chunk: usize) -> Result<JitTape, JitError> {
         let mut module = module()?;
         let ptr = module.target_config().pointer_type();
+        let mut layout = build::Layout::new(tape, chunk);
+        let mut ids = Vec::with_capacity(layout.chunks.len());
         let mut ctx = module.make_context();
-        for _ in 0..4 {
-            ctx.func.signature.params.push(AbiParam::new(ptr));
+        for c in 0..layout.chunks.len() {
+            for _ in 0..6 {
+                ctx.func.signature.params.push(AbiParam::new(ptr));
+            }
+            build::function(&mut module, &mut ctx.func, tape, &layout, c)?;
+            let name = format!("tape{c}");
+            let id = module.declare_function(&name, Linkage::Export, &ctx.func.signature)?;
+            module.define_function(id, &mut ctx)?;
+            module.clear_context(&mut ctx);
+            ids.push(id);
         }
-        build::function(&mut module, &mut ctx.func, tape)?;
-        let id = module.declare_function("tape", Linkage::Export, &ctx.func.signature)?;
-        module.define_function(id, &mut ctx)?;
-        module.clear_context(&mut ctx);
         module.finalize_definitions()?;
-        let code = module.get_finalized_function(id);
+        let code = ids
+            .into_iter()
+            .map(|id| module.get_finalized_function(id))
+            .collect();
         Ok(JitTape {
             _module: module,
             code,
             needs: needs(tape),
+            scratch: layout.slots,
+            _consts: std::mem::take(&mut layout.consts),
         })
+    }
+
+    /// The number of functions the tape was compiled as.
+    pub fn functions(&self) -> usize {
+        self.code.len()
     }
 
     /// Run on the state `x`, the parameters `p` and the sensor reads `v`, output `k` to
     /// `out[k]`; `false` (nothing written) when a slice is shorter than the tape reads or
     /// writes.
     pub fn run(&self, x: &[f64], p: &[f64], v: &[f64], out: &mut [f64]) -> bool {
-        let [nx, np, nv, no] = self.needs;
-        if x.len() < nx || p.len() < np || v.len() < nv || out.len() < no {
+        if out.len() < self.needs[3] + self.needs[4] {
             return false;
         }
-        self.call(x, p, v, out);
+        let (head, tail) = out.split_at_mut(self.needs[3]);
+        self.run_split(x, p, v, head, tail)
+    }
+
+    /// Run as [`JitTape::run`], the outputs from the tape's split on
+    /// ([`Tape::split`](stirling_dsl::compiled::Tape::split)) to `tail`.
+    pub fn run_split(
+        &self,
+        x: &[f64],
+        p: &[f64],
+        v: &[f64],
+        head: &mut [f64],
+        tail: &mut [f64],
+    ) -> bool {
+        let [nx, np, nv, nh, nt] = self.needs;
+        if x.len() < nx || p.len() < np || v.len() < nv || head.len() < nh || tail.len() < nt {
+            return false;
+        }
+        if self.code.len() == 1 {
+            self.call(x, p, v, head, tail, &mut []);
+            return true;
+        }
+        SCRATCH.with(|s| {
+            let mut s = s.borrow_mut();
+            if s.len() < self.scratch {
+                s.resize(self.scratch, 0.0);
+            }
+            self.call(x, p, v, head, tail, &mut s);
+        });
         true
     }
 
-    /// The call of the compiled code.
+    /// The calls of the compiled functions.
     #[allow(unsafe_code)]
-    fn call(&self, x: &[f64], p: &[f64], v: &[f64], out: &mut [f64]) {
-        // SAFETY: `self.code` is the finalized address of the function `compile` declared
-        // with exactly `Code`'s signature (four pointers, no result, the platform's C
-        // convention), and its module (a field of `self`) keeps the code alive. The code
-        // reads `x[i]`, `p[k]`, `v[i]` only at indices the tape names and writes `out[k]`
-        // only for its outputs; `run` checked every slice is at least that long (`needs`),
-        // and `out` is borrowed mutably, so no one else sees the writes.
-        let code = unsafe { std::mem::transmute::<*const u8, Code>(self.code) };
-        code(x.as_ptr(), p.as_ptr(), v.as_ptr(), out.as_mut_ptr());
+    fn call(&self, x: &[f64], p: &[f64], v: &[f64], h: &mut [f64], t: &mut [f64], s: &mut [f64]) {
+        debug_assert!(self.code.len() == 1 || s.len() >= self.scratch);
+        for &f in &self.code {
+            // SAFETY: `f` is the finalized address of a function `compile_chunked` declared
+            // with exactly `Code`'s signature (six pointers, no result, the platform's C
+            // convention), and its module (a field of `self`) keeps the code alive. The code
+            // reads `x[i]`, `p[k]`, `v[i]` only at indices the tape names and writes the
+            // output buffers only at its outputs' indices; `run_split` checked every slice is
+            // at least that long (`needs`); it reads the numbers of `self._consts` at the
+            // address they were compiled with (their heap block, never moved or freed
+            // before `self`). The scratch array is read and written only at
+            // slots below `self.scratch` (`Layout`), its length with more than one function
+            // (a single function never touches it). Every buffer is borrowed mutably, so no
+            // one else sees the writes.
+            let code = unsafe { std::mem::transmute::<*const u8, Code>(f) };
+            code(
+                x.as_ptr(),
+                p.as_ptr(),
+                v.as_ptr(),
+                h.as_mut_ptr(),
+                t.as_mut_ptr(),
+                s.as_mut_ptr(),
+            );
+        }
     }
 }
 
@@ -115,6 +197,9 @@ fn module() -> Result<JITModule, JitError> {
     set(&mut flags, "use_colocated_libcalls", "false")?;
     set(&mut flags, "is_pic", "false")?;
     set(&mut flags, "opt_level", "speed")?;
+    // the IR is checked by construction (and by the tests); the verifier cost ~5% of the
+    // compile time
+    set(&mut flags, "enable_verifier", "false")?;
     let isa = cranelift_native::builder()
         .map_err(|e| JitError::Host(e.to_string()))?
         .finish(settings::Flags::new(flags))
@@ -126,9 +211,10 @@ fn module() -> Result<JITModule, JitError> {
     Ok(JITModule::new(jb))
 }
 
-/// The lengths of `x`, `p`, `v` and `out` the tape needs.
-fn needs(tape: &Tape) -> [usize; 4] {
-    let mut n = [0, 0, 0, tape.outputs.len()];
+/// The lengths of `x`, `p`, `v` and both output buffers the tape needs.
+fn needs(tape: &Tape) -> [usize; 5] {
+    let head = tape.head();
+    let mut n = [0, 0, 0, head, tape.outputs.len() - head];
     for op in &tape.ops {
         match *op {
             Op::X(i) => n[0] = n[0].max(i as usize + 1),
@@ -141,16 +227,16 @@ fn needs(tape: &Tape) -> [usize; 4] {
 }
 
 impl Runner for JitTape {
-    fn run(&self, x: &[f64], p: &[f64], v: &[f64], out: &mut [f64]) -> bool {
-        JitTape::run(self, x, p, v, out)
+    fn run(&self, x: &[f64], p: &[f64], v: &[f64], head: &mut [f64], tail: &mut [f64]) -> bool {
+        JitTape::run_split(self, x, p, v, head, tail)
     }
 }
 
-/// The longest tape compiled: Cranelift's time grows faster than linearly with one
-/// straight-line block (the RHS + Jacobian of `nsection` compiled in 85 ms at n = 100, about
-/// 25,000 instructions, and in 14 s at n = 1000); a longer tape is left to the interpreter,
-/// which starts at once (5-7x slower per call).
-pub const MAX_JIT_OPS: usize = 60_000;
+/// The longest tape compiled: its functions of [`CHUNK_OPS`] instructions compile in about
+/// 20-30 ms each (the RHS + Jacobian of `nsection` at n = 1000, about 80,000 instructions,
+/// in 0.3-0.6 s), so this cap is some 2-4 s of compile time; a longer tape is left to the
+/// interpreter, which starts at once (5-7x slower per call).
+pub const MAX_JIT_OPS: usize = 400_000;
 
 /// The [`Jit`](stirling_dsl::compiled::Jit) of this crate: `tape` compiled, or `None` where
 /// it cannot be or is longer than `MAX_JIT_OPS` (the interpreter runs it then).

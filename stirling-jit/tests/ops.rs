@@ -32,12 +32,24 @@ fn tape() -> Tape {
         }
     }
     let outputs = (0..ops.len() as u32).collect();
-    Tape { ops, outputs }
+    Tape {
+        ops,
+        outputs,
+        split: None,
+    }
 }
 
 fn same(x: &[f64], p: &[f64], v: &[f64]) {
     let t = tape();
-    let jit = JitTape::compile(&t).expect("the host has a JIT");
+    for chunk in [usize::MAX, 7] {
+        same_chunked(&t, chunk, x, p, v);
+    }
+}
+
+/// The tape compiled as functions of at most `chunk` instructions gives the interpreter's
+/// bits.
+fn same_chunked(t: &Tape, chunk: usize, x: &[f64], p: &[f64], v: &[f64]) {
+    let jit = JitTape::compile_chunked(t, chunk).expect("the host has a JIT");
     let mut regs = Vec::new();
     t.run(p, x, v, &mut regs);
     let mut out = vec![0.0; t.outputs.len()];
@@ -84,4 +96,73 @@ fn short_slices_are_refused_before_the_call() {
     assert!(!jit.run(&[1.0, 2.0], &[1.0], &[1.0], &mut out[1..]));
     assert!(out.iter().all(|&o| o == 0.0), "nothing written");
     assert!(jit.run(&[1.0, 2.0], &[1.0], &[1.0], &mut out));
+}
+
+/// A long tape of chained arithmetic reaching back over many instructions (so that registers
+/// cross the functions' boundaries), its outputs a spread of registers in scrambled order.
+fn long_tape(len: usize) -> Tape {
+    let mut ops = vec![Op::X(0), Op::X(1), Op::P(0), Op::K(0.5)];
+    let mut k = 4u32;
+    while (k as usize) < len {
+        let a = k - 1;
+        let b = (k * 7919) % k;
+        ops.push(match k % 6 {
+            0 => Op::Add(a, b),
+            1 => Op::Mul(a, b),
+            2 => Op::Sub(b, a),
+            3 => Op::Div(a, 3),
+            4 => Op::Func(Func::Tanh, a),
+            _ => Op::Neg(b),
+        });
+        k += 1;
+    }
+    let outputs = (0..len as u32).rev().step_by(3).collect();
+    Tape {
+        ops,
+        outputs,
+        split: None,
+    }
+}
+
+#[test]
+fn a_tape_cut_into_functions_gives_the_same_bits() {
+    let t = long_tape(3000);
+    for chunk in [1, 2, 64, 1000, 3000] {
+        let jit = JitTape::compile_chunked(&t, chunk).expect("the host has a JIT");
+        assert_eq!(jit.functions(), 3000usize.div_ceil(chunk));
+        for x in [[0.3, -1.7], [2.0, 0.0]] {
+            let p = [1.1];
+            let mut regs = Vec::new();
+            t.run(&p, &x, &[], &mut regs);
+            let mut out = vec![0.0; t.outputs.len()];
+            assert!(jit.run(&x, &p, &[], &mut out));
+            for (k, o) in out.iter().enumerate() {
+                let want = t.output(&regs, k);
+                let equal = want.to_bits() == o.to_bits() || (want.is_nan() && o.is_nan());
+                assert!(equal, "chunk {chunk}, output {k}: {want} vs {o}");
+            }
+        }
+    }
+}
+
+#[test]
+fn split_outputs_go_to_their_two_slices() {
+    let mut t = long_tape(50);
+    t.split = Some(5);
+    let jit = JitTape::compile_chunked(&t, 16).expect("the host has a JIT");
+    let (x, p) = ([0.3, -1.7], [1.1]);
+    let mut regs = Vec::new();
+    t.run(&p, &x, &[], &mut regs);
+    let (mut head, mut tail) = (vec![0.0; 5], vec![0.0; t.outputs.len() - 5]);
+    assert!(jit.run_split(&x, &p, &[], &mut head, &mut tail));
+    for k in 0..t.outputs.len() {
+        let got = if k < 5 { head[k] } else { tail[k - 5] };
+        assert_eq!(got.to_bits(), t.output(&regs, k).to_bits(), "output {k}");
+    }
+    // one slot short in either slice: refused, nothing written
+    let mut short = vec![0.0; tail.len() - 1];
+    let mut head2 = vec![0.0; 5];
+    assert!(!jit.run_split(&x, &p, &[], &mut head2, &mut short));
+    assert!(!jit.run_split(&x, &p, &[], &mut head2[..4], &mut tail));
+    assert!(head2.iter().all(|&v| v == 0.0));
 }

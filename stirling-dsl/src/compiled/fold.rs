@@ -3,34 +3,7 @@
 //! interpreter's own arithmetic, so a folded tape gives bit for bit what the tape gives at
 //! `p`), and the instructions no output reaches any more are dropped.
 
-use super::tape::{Op, Tape};
-
-/// The operands of an instruction (none for a leaf).
-fn operands(op: &Op) -> ([u32; 2], usize) {
-    match *op {
-        Op::X(_) | Op::P(_) | Op::V(_) | Op::K(_) => ([0, 0], 0),
-        Op::Neg(a) | Op::Powi(a, _) | Op::Func(_, a) => ([a, 0], 1),
-        Op::Add(a, b) | Op::Sub(a, b) | Op::Mul(a, b) | Op::Div(a, b) | Op::Powf(a, b) => {
-            ([a, b], 2)
-        }
-    }
-}
-
-/// `op` with its operands renumbered by `to`.
-fn renumber(op: Op, to: &[u32]) -> Op {
-    let r = |k: u32| to[k as usize];
-    match op {
-        Op::Add(a, b) => Op::Add(r(a), r(b)),
-        Op::Sub(a, b) => Op::Sub(r(a), r(b)),
-        Op::Mul(a, b) => Op::Mul(r(a), r(b)),
-        Op::Div(a, b) => Op::Div(r(a), r(b)),
-        Op::Powf(a, b) => Op::Powf(r(a), r(b)),
-        Op::Neg(a) => Op::Neg(r(a)),
-        Op::Powi(a, k) => Op::Powi(r(a), k),
-        Op::Func(f, a) => Op::Func(f, r(a)),
-        leaf => leaf,
-    }
-}
+use super::tape::{prune, Op, Tape};
 
 /// The value of `op` if its operands are numbers (`known[k]`: register `k`'s number).
 fn constant(op: &Op, p: &[f64], known: &[Option<f64>]) -> Option<f64> {
@@ -64,29 +37,12 @@ impl Tape {
                 c.map_or(*op, Op::K)
             })
             .collect();
-        // keep what the outputs reach
-        let mut live = vec![false; folded.len()];
-        for &o in &self.outputs {
-            live[o as usize] = true;
+        let (ops, outputs) = prune(folded, &self.outputs);
+        Tape {
+            ops,
+            outputs,
+            split: self.split,
         }
-        for k in (0..folded.len()).rev() {
-            if live[k] {
-                let (args, count) = operands(&folded[k]);
-                for &a in &args[..count] {
-                    live[a as usize] = true;
-                }
-            }
-        }
-        let mut to = vec![u32::MAX; folded.len()];
-        let mut ops = Vec::new();
-        for (k, op) in folded.into_iter().enumerate() {
-            if live[k] {
-                to[k] = ops.len() as u32;
-                ops.push(renumber(op, &to));
-            }
-        }
-        let outputs = self.outputs.iter().map(|&o| to[o as usize]).collect();
-        Tape { ops, outputs }
     }
 }
 
@@ -108,6 +64,7 @@ mod tests {
                 Op::Div(4, 5),
             ],
             outputs: vec![6, 5],
+            split: None,
         };
         let p = [2.0, 3.0];
         let f = t.fold(&p);

@@ -41,6 +41,31 @@ impl Function {
         Function::new(self.tape.clone(), self.places.clone()).jit_set(jit)
     }
 
+    /// This function with its first `head` outputs (values, at `(row, 0)`) in the order of
+    /// their rows and the tape split after them ([`Tape::split`]), so that native code writes
+    /// them straight to the caller's rows and the outputs after them (in order) to a second
+    /// slice; unchanged where the first `head` rows are not exactly `0..head`.
+    pub(crate) fn split_rows(mut self, head: usize) -> Function {
+        if head > self.places.len() {
+            return self;
+        }
+        let mut order: Vec<usize> = (0..head).collect();
+        order.sort_by_key(|&k| self.places[k].0);
+        let rows_ok = order
+            .iter()
+            .enumerate()
+            .all(|(r, &k)| self.places[k] == (r, 0));
+        if !rows_ok {
+            return self;
+        }
+        let outputs: Vec<u32> = order.iter().map(|&k| self.tape.outputs[k]).collect();
+        self.tape.outputs.splice(0..head, outputs);
+        let places: Vec<(usize, usize)> = order.iter().map(|&k| self.places[k]).collect();
+        self.places.splice(0..head, places);
+        self.tape.split = Some(head);
+        self
+    }
+
     fn jit_set(mut self, jit: Option<Jit>) -> Function {
         self.jit = jit;
         self
@@ -59,6 +84,12 @@ struct Outputs<'i, 'a> {
     inst: &'i mut Instance<'a>,
     roots: Vec<Id>,
     places: Vec<(usize, usize)>,
+    /// Per root, its group in the tape's schedule (`Tape::scheduled`): the scalar rows 0,
+    /// section `j`'s rows `j + 1`, so that the right-hand side and the Jacobian of one
+    /// section are computed together.
+    groups: Vec<u32>,
+    /// The group of the roots pushed now.
+    group: u32,
 }
 
 impl<'i, 'a> Outputs<'i, 'a> {
@@ -67,6 +98,8 @@ impl<'i, 'a> Outputs<'i, 'a> {
             inst,
             roots: Vec::new(),
             places: Vec::new(),
+            groups: Vec::new(),
+            group: 0,
         }
     }
 
@@ -78,13 +111,21 @@ impl<'i, 'a> Outputs<'i, 'a> {
         at: (usize, usize),
     ) -> Result<(), InstanceError> {
         let r = self.inst.get(id, place, recip)?;
-        self.roots.push(r);
-        self.places.push(at);
+        self.root(r, at);
         Ok(())
     }
 
+    fn root(&mut self, r: Id, at: (usize, usize)) {
+        self.roots.push(r);
+        self.places.push(at);
+        self.groups.push(self.group);
+    }
+
     fn finish(self) -> Function {
-        Function::new(Tape::new(&self.inst.out, &self.roots), self.places)
+        let mut schedule: Vec<usize> = (0..self.roots.len()).collect();
+        schedule.sort_by_key(|&k| self.groups[k]);
+        let tape = Tape::scheduled(&self.inst.out, &self.roots, &schedule);
+        Function::new(tape, self.places)
     }
 }
 
@@ -132,8 +173,7 @@ fn rows_into(out: &mut Outputs, plan: &Plan, rows: &Rows) -> Result<(), Instance
                 let c = out.inst.index(cb, cat, place)?;
                 let v = out.inst.get(ds, place, true)?;
                 let e = out.inst.out.mul(d, v);
-                out.roots.push(e);
-                out.places.push((row, c));
+                out.root(e, (row, c));
             }
         }
     }
@@ -141,11 +181,13 @@ fn rows_into(out: &mut Outputs, plan: &Plan, rows: &Rows) -> Result<(), Instance
     for j in 0..n {
         let v = variant(j, n);
         let place = Place::Row { v, j: j as u32 };
+        out.group = j as u32 + 1;
         for o in &rows.arrays[v as usize] {
             let at = position(out.inst, plan, o, place)?;
             out.push(o.id, place, true, at)?;
         }
     }
+    out.group = 0;
     Ok(())
 }
 

@@ -86,7 +86,8 @@ fn run(f: &Function, p: &[f64], x: &[f64], v: &[f64], mut each: impl FnMut((usiz
         let ran = OUTS.with(|o| {
             let mut out = o.borrow_mut();
             out.resize(f.places.len(), 0.0);
-            if !code.run(x, p, v, &mut out) {
+            let (head, tail) = out.split_at_mut(f.tape.head());
+            if !code.run(x, p, v, head, tail) {
                 return false;
             }
             for (&at, &val) in f.places.iter().zip(out.iter()) {
@@ -105,6 +106,18 @@ fn run(f: &Function, p: &[f64], x: &[f64], v: &[f64], mut each: impl FnMut((usiz
             each(at, f.tape.output(&regs, k));
         }
     });
+}
+
+/// Run `f`'s native code straight into the caller's slices: its outputs before the tape's
+/// split (rows `0..s`, [`Function::split_rows`]) to `head`, the others in order to `tail`.
+/// `false` (nothing written) without native code, without a split or where a slice is too
+/// short: the caller runs [`run`] then.
+#[inline]
+fn run_direct(f: &Function, p: &[f64], x: &[f64], head: &mut [f64], tail: &mut [f64]) -> bool {
+    match (f.tape.split, f.code()) {
+        (Some(_), Some(code)) => code.run(x, p, &[], head, tail),
+        _ => false,
+    }
 }
 
 impl Definition {
@@ -164,10 +177,12 @@ impl Definition {
             .iter()
             .map(|s| s.as_ref().map(|s| functions::sensor(i, s)).transpose())
             .collect::<Result<_, _>>()?;
+        let rhs = functions::rows(i, plan, &[&plan.rhs])?;
+        let head = rhs.places.len();
         Ok(Functions {
-            rhs: functions::rows(i, plan, &[&plan.rhs])?,
-            jac: functions::rows(i, plan, &[&plan.jac])?,
-            rhs_jac: functions::rows(i, plan, &[&plan.rhs, &plan.jac])?,
+            rhs: rhs.split_rows(head),
+            jac: functions::rows(i, plan, &[&plan.jac])?.split_rows(0),
+            rhs_jac: functions::rows(i, plan, &[&plan.rhs, &plan.jac])?.split_rows(head),
             pjac: functions::rows(i, plan, &[&plan.pjac])?,
             init: functions::rows(i, plan, &[&plan.init])?,
             forces: functions::forces(i, plan)?,
@@ -313,6 +328,12 @@ impl CompiledModel {
         (f.rhs.tape.ops.len(), f.jac.tape.ops.len())
     }
 
+    /// The tape of the right-hand side with the Jacobian (`Model::rhs_and_jacobian_values`:
+    /// the right-hand side's outputs, then the Jacobian's values) at `p`.
+    pub fn rhs_jacobian_tape(&self, p: &[f64]) -> &super::Tape {
+        &self.fns(p).rhs_jac.tape
+    }
+
     /// Each vessel element's `[P, V, E, Q, boundary, m, T]`, in order.
     fn each_vessel(&self, p: &[f64], x: &[f64], mut f: impl FnMut(usize, usize, f64)) {
         run(&self.fns(p).vessels, p, x, &[], |(k, t), v| f(k, t, v));
@@ -402,7 +423,10 @@ impl Model for CompiledModel {
         v
     }
     fn rhs(&self, p: &[f64], x: &[f64], _t: f64, out: &mut [f64]) {
-        run(&self.fns(p).rhs, p, x, &[], |(r, _), v| out[r] = v);
+        let f = &self.fns(p).rhs;
+        if !run_direct(f, p, x, out, &mut []) {
+            run(f, p, x, &[], |(r, _), v| out[r] = v);
+        }
     }
     fn jacobian(&self, p: &[f64], x: &[f64], _t: f64, sink: &mut JacSink) {
         run(&self.fns(p).jac, p, x, &[], |(r, c), v| sink.add(r, c, v));
@@ -420,6 +444,10 @@ impl Model for CompiledModel {
         });
     }
     fn jacobian_values(&self, p: &[f64], x: &[f64], _t: f64, values: &mut [f64]) {
+        let f = &self.fns(p).jac;
+        if run_direct(f, p, x, &mut [], values) {
+            return;
+        }
         let mut i = 0;
         run(&self.fns(p).jac, p, x, &[], |_, v| {
             values[i] = v;
@@ -434,6 +462,9 @@ impl Model for CompiledModel {
         out: &mut [f64],
         values: &mut [f64],
     ) {
+        if run_direct(&self.fns(p).rhs_jac, p, x, out, values) {
+            return;
+        }
         let k = self.fns(p).rhs.places.len();
         let mut i = 0;
         run(&self.fns(p).rhs_jac, p, x, &[], |(r, _), v| {

@@ -8,12 +8,13 @@ use std::sync::Arc;
 use super::tape::Tape;
 
 /// A tape compiled to something faster than the interpreter: writes output `k` of the tape
-/// it was compiled from to `out[k]`, exactly as [`Tape::run`] computes it.
+/// it was compiled from to `head[k]` (`tail[k - s]` from the tape's [`Tape::split`] `s`
+/// on), exactly as [`Tape::run`] computes it.
 pub trait Runner: Debug + Send + Sync {
     /// Run on the state `x`, the parameters `p` and the sensor reads `v`.
     /// `false` (nothing written) when a slice is too short for the tape: the caller runs the
     /// interpreter then.
-    fn run(&self, x: &[f64], p: &[f64], v: &[f64], out: &mut [f64]) -> bool;
+    fn run(&self, x: &[f64], p: &[f64], v: &[f64], head: &mut [f64], tail: &mut [f64]) -> bool;
 }
 
 /// A JIT: the runner of a tape, or `None` where it cannot compile it (the interpreter runs

@@ -33,20 +33,158 @@ pub enum Op {
 pub struct Tape {
     pub ops: Vec<Op>,
     pub outputs: Vec<u32>,
+    /// Where the outputs split between two buffers ([`Runner`](super::Runner)): outputs
+    /// `0..s` go to the first at their index, outputs from `s` on to the second at their
+    /// index minus `s` (e.g. a right-hand side and a Jacobian's values written straight to
+    /// the caller's slices); `None`: every output to the first.
+    pub split: Option<usize>,
+}
+
+/// `node` with a negated operand folded in, if it has one, as LLVM folds it in the macro's
+/// code: `-a + b` is `b - a` and `a + -b` is `a - b` by IEEE 754's definition of subtraction
+/// (the same bits; a NaN's sign aside). The arena's constructors fold the other cases already.
+fn fused(arena: &Arena, reg: &[u32], node: &Node) -> Option<Op> {
+    let neg = |c: Id| match *arena.node(c) {
+        Node::Neg(d) => Some(reg[d.index()]),
+        _ => None,
+    };
+    match *node {
+        Node::Add(a, b) => match (neg(a), neg(b)) {
+            (_, Some(nb)) => Some(Op::Sub(reg[a.index()], nb)),
+            (Some(na), None) => Some(Op::Sub(reg[b.index()], na)),
+            (None, None) => None,
+        },
+        _ => None,
+    }
+}
+
+/// The height of every node the roots reach (a leaf 0, else one more than its tallest
+/// operand); children precede parents in the arena.
+fn heights(arena: &Arena, roots: &[Id]) -> Vec<u32> {
+    let seen = arena.reachable(roots);
+    let mut h = vec![0u32; arena.len()];
+    for i in 0..arena.len() {
+        if seen[i] {
+            let kids = arena.node(Id(i as u32)).children();
+            h[i] = kids.iter().map(|c| h[c.index()] + 1).max().unwrap_or(0);
+        }
+    }
+    h
+}
+
+/// The operands of an instruction (none for a leaf).
+pub(crate) fn operands(op: &Op) -> ([u32; 2], usize) {
+    match *op {
+        Op::X(_) | Op::P(_) | Op::V(_) | Op::K(_) => ([0, 0], 0),
+        Op::Neg(a) | Op::Powi(a, _) | Op::Func(_, a) => ([a, 0], 1),
+        Op::Add(a, b) | Op::Sub(a, b) | Op::Mul(a, b) | Op::Div(a, b) | Op::Powf(a, b) => {
+            ([a, b], 2)
+        }
+    }
+}
+
+/// `op` with its operands renumbered by `to`.
+pub(crate) fn renumber(op: Op, to: &[u32]) -> Op {
+    let r = |k: u32| to[k as usize];
+    match op {
+        Op::Add(a, b) => Op::Add(r(a), r(b)),
+        Op::Sub(a, b) => Op::Sub(r(a), r(b)),
+        Op::Mul(a, b) => Op::Mul(r(a), r(b)),
+        Op::Div(a, b) => Op::Div(r(a), r(b)),
+        Op::Powf(a, b) => Op::Powf(r(a), r(b)),
+        Op::Neg(a) => Op::Neg(r(a)),
+        Op::Powi(a, k) => Op::Powi(r(a), k),
+        Op::Func(f, a) => Op::Func(f, r(a)),
+        leaf => leaf,
+    }
+}
+
+/// `ops` without the instructions no output reaches, and the outputs renumbered.
+pub(crate) fn prune(ops: Vec<Op>, outputs: &[u32]) -> (Vec<Op>, Vec<u32>) {
+    let mut live = vec![false; ops.len()];
+    for &o in outputs {
+        live[o as usize] = true;
+    }
+    for k in (0..ops.len()).rev() {
+        if live[k] {
+            let (args, count) = operands(&ops[k]);
+            for &a in &args[..count] {
+                live[a as usize] = true;
+            }
+        }
+    }
+    let mut to = vec![u32::MAX; ops.len()];
+    let mut kept = Vec::with_capacity(ops.len());
+    for (k, op) in ops.into_iter().enumerate() {
+        if live[k] {
+            to[k] = kept.len() as u32;
+            kept.push(renumber(op, &to));
+        }
+    }
+    let outputs = outputs.iter().map(|&o| to[o as usize]).collect();
+    (kept, outputs)
 }
 
 impl Tape {
-    /// The tape computing `roots` of `arena` (leaves as [`Leaf`] encodes them).
+    /// The tape computing `roots` of `arena` (leaves as [`Leaf`] encodes them), its
+    /// instructions in arena order.
     pub(crate) fn new(arena: &Arena, roots: &[Id]) -> Tape {
         let seen = arena.reachable(roots);
+        let nodes = (0..arena.len()).filter(|&i| seen[i]);
+        Tape::in_order(arena, roots, nodes)
+    }
+
+    /// The tape computing `roots` of `arena`, its instructions in the order a depth-first
+    /// walk from the roots taken in `schedule`'s order (indices into `roots`) needs them:
+    /// each value computed close to where it is used, so that native code keeps it in a
+    /// register rather than spilling it (e.g. a section's right-hand side next to its
+    /// Jacobian entries, which share most of their terms).
+    pub(crate) fn scheduled(arena: &Arena, roots: &[Id], schedule: &[usize]) -> Tape {
+        // the taller operand first (Sethi-Ullman): fewer values wait in registers meanwhile
+        let height = heights(arena, roots);
+        // 0: not visited, 1: children pending, 2: emitted
+        let mut state = vec![0u8; arena.len()];
+        let mut nodes = Vec::new();
+        let mut stack: Vec<(Id, bool)> = Vec::new();
+        for &k in schedule {
+            stack.push((roots[k], false));
+            while let Some((id, ready)) = stack.pop() {
+                let st = &mut state[id.index()];
+                if ready {
+                    *st = 2;
+                    nodes.push(id.index());
+                    continue;
+                }
+                if *st != 0 {
+                    continue;
+                }
+                *st = 1;
+                stack.push((id, true));
+                let mut kids = arena.node(id).children();
+                kids.sort_by_key(|c| height[c.index()]);
+                for &c in &kids {
+                    if state[c.index()] == 0 {
+                        stack.push((c, false));
+                    }
+                }
+            }
+        }
+        Tape::in_order(arena, roots, nodes.into_iter())
+    }
+
+    /// The tape of `roots`, its instructions the nodes `nodes` (children before parents).
+    fn in_order(arena: &Arena, roots: &[Id], nodes: impl Iterator<Item = usize>) -> Tape {
         let mut reg = vec![u32::MAX; arena.len()];
         let mut ops = Vec::new();
-        for i in 0..arena.len() {
-            if !seen[i] {
+        for i in nodes {
+            let r = |c: Id| reg[c.index()];
+            let node = arena.node(Id(i as u32));
+            if let Some(op) = fused(arena, &reg, node) {
+                reg[i] = ops.len() as u32;
+                ops.push(op);
                 continue;
             }
-            let r = |c: Id| reg[c.index()];
-            let op = match *arena.node(Id(i as u32)) {
+            let op = match *node {
                 Node::Const(bits) => Op::K(f64::from_bits(bits)),
                 Node::Sym(s) => match Leaf::of(s) {
                     Some(Leaf::State(k)) => Op::X(k as u32),
@@ -71,8 +209,19 @@ impl Tape {
             reg[i] = ops.len() as u32;
             ops.push(op);
         }
-        let outputs = roots.iter().map(|r| reg[r.index()]).collect();
-        Tape { ops, outputs }
+        let outputs: Vec<u32> = roots.iter().map(|r| reg[r.index()]).collect();
+        let (ops, outputs) = prune(ops, &outputs);
+        Tape {
+            ops,
+            outputs,
+            split: None,
+        }
+    }
+
+    /// The number of outputs written to the first buffer ([`Tape::split`]).
+    pub fn head(&self) -> usize {
+        self.split
+            .map_or(self.outputs.len(), |s| s.min(self.outputs.len()))
     }
 
     /// Run the tape: every register into `regs` (resized to fit).
@@ -103,5 +252,68 @@ impl Tape {
     #[inline]
     pub fn output(&self, regs: &[f64], k: usize) -> f64 {
         regs[self.outputs[k] as usize]
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::expr::{At, Sym};
+
+    /// `[-x0 + x1, x1 * x0 + -(x0 * x0), x0 * x0]` over states `x0`, `x1`.
+    fn arena() -> (Arena, Vec<Id>) {
+        let mut a = Arena::new();
+        let x0 = a.sym(Sym::State(0, At::Scalar));
+        let x1 = a.sym(Sym::State(1, At::Scalar));
+        let n0 = a.neg(x0);
+        let e0 = a.add(n0, x1);
+        let sq = a.mul(x0, x0);
+        let m = a.mul(x1, x0);
+        let nsq = a.neg(sq);
+        let e1 = a.add(nsq, m);
+        (a, vec![e0, e1, sq])
+    }
+
+    fn want(x0: f64, x1: f64) -> [f64; 3] {
+        [-x0 + x1, -(x0 * x0) + x1 * x0, x0 * x0]
+    }
+
+    #[test]
+    fn negations_fold_into_their_users_with_the_same_bits() {
+        let (a, roots) = arena();
+        let t = Tape::new(&a, &roots);
+        assert!(
+            t.ops.iter().all(|o| !matches!(o, Op::Neg(_))),
+            "{:?}",
+            t.ops
+        );
+        let vals = [0.0, -0.0, 1.5, -2.25, 1e-310, f64::INFINITY, 3e300];
+        let mut regs = Vec::new();
+        for &x0 in &vals {
+            for &x1 in &vals {
+                t.run(&[], &[x0, x1], &[], &mut regs);
+                for (k, w) in want(x0, x1).iter().enumerate() {
+                    let got = t.output(&regs, k);
+                    let same = got.to_bits() == w.to_bits() || (got.is_nan() && w.is_nan());
+                    assert!(same, "output {k} at ({x0}, {x1}): {got} vs {w}");
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn a_scheduled_tape_computes_the_same_outputs() {
+        let (a, roots) = arena();
+        let t = Tape::new(&a, &roots);
+        let s = Tape::scheduled(&a, &roots, &[2, 0, 1]);
+        assert_eq!(s.ops.len(), t.ops.len());
+        // the walk starts at the third root: `x0`, then `x0 * x0`
+        assert_eq!(&s.ops[..2], &[Op::X(0), Op::Mul(0, 0)]);
+        let (mut ra, mut rb) = (Vec::new(), Vec::new());
+        t.run(&[], &[0.7, -1.3], &[], &mut ra);
+        s.run(&[], &[0.7, -1.3], &[], &mut rb);
+        for k in 0..3 {
+            assert_eq!(t.output(&ra, k).to_bits(), s.output(&rb, k).to_bits());
+        }
     }
 }
