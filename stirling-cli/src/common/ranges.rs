@@ -69,11 +69,14 @@ pub fn non_negative(s: &str) -> Parsed<f64> {
 
 /// A solver tolerance in (0, 0.1].
 pub fn tolerance(s: &str) -> Parsed<f64> {
+    above_zero_to(s, 0.1, "a tolerance must lie in (0, 0.1], e.g. 1e-7")
+}
+
+/// A finite number in `(0, hi]`; `why` otherwise.
+fn above_zero_to(s: &str, hi: f64, why: &'static str) -> Parsed<f64> {
     let v = number(s)?;
-    if !(v > 0.0 && v <= 0.1) {
-        return Err(RangeError::Outside(
-            "a tolerance must lie in (0, 0.1], e.g. 1e-7",
-        ));
+    if !(v > 0.0 && v <= hi) {
+        return Err(RangeError::Outside(why));
     }
     Ok(v)
 }
@@ -111,13 +114,7 @@ pub fn cycles(s: &str) -> Parsed<f64> {
 /// A restart interval in cycles: positive, at most 1000 (beyond that a record has no
 /// second segment and the option would do nothing).
 pub fn restart_cycles(s: &str) -> Parsed<f64> {
-    let v = number(s)?;
-    if !(v > 0.0 && v <= 1000.0) {
-        return Err(RangeError::Outside(
-            "must be above 0 and at most 1000 cycles",
-        ));
-    }
-    Ok(v)
+    above_zero_to(s, 1000.0, "must be above 0 and at most 1000 cycles")
 }
 
 /// A pair of counts `TUNE:EVAL` (whole numbers >= 0), as `--seeds 1:1`.

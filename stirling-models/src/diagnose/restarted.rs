@@ -1,7 +1,7 @@
 //! The second pass for end stops: a gap the library leaves unexplained after a calibration
 //! that absorbed something is diagnosed again over the effects with end-stop travels, with
 //! stage 1 restarted from the measured body states every quarter cycle
-//! ([`crate::fit::driven::Restarts`]).
+//! ([`crate::fit::restarts::Restarts`]).
 //!
 //! Why a second pass and not restarts throughout: driven by the measured pressure, a piston
 //! between stops is an impact oscillator with several responses to one forcing, and one run

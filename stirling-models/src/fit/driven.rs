@@ -58,20 +58,7 @@ pub struct Stage<'a> {
     /// measured: a sensor effect does not act on them.
     pub derived: Vec<usize>,
     /// Restarts of the integration from the measured state (`None`: one run over the window).
-    pub restarts: Option<Restarts>,
-}
-
-/// Restarts of a driven run from the measured state every `every` samples: the run is cut
-/// into segments of a few cycles, each started from the free states the record shows at its
-/// first sample, so that a run cannot drift onto another response of the driven subsystem
-/// (a piston between end stops is an impact oscillator with several responses to one
-/// forcing). The sensitivities restart at zero: a later segment does not depend on the
-/// initial-state variables.
-#[derive(Clone, Debug)]
-pub struct Restarts {
-    pub every: usize,
-    /// The free states at every sample of the record, from the smoothed measurements.
-    pub states: Vec<Vec<f64>>,
+    pub restarts: Option<super::restarts::Restarts>,
 }
 
 /// What a run is built from at given variable values.
@@ -222,7 +209,7 @@ impl Stage<'_> {
         };
         let rows = match &self.restarts {
             Some(r) if r.every < last - first => {
-                self.integrate_restarted(&sys, &z0, first, last, r)?
+                self.integrate_restarted(&sys, &z0, (first, last), r)?
             }
             _ => self.integrate_window(&sys, &z0, last - first)?,
         };
@@ -251,62 +238,8 @@ impl Stage<'_> {
             .collect()
     }
 
-    /// [`Stage::integrate_window`] over `first..=last` in segments of [`Restarts::every`]
-    /// samples, each after the first started from the measured state with its sensitivities
-    /// at zero; a segment's first row is the last row of the segment before.
-    fn integrate_restarted(
-        &self,
-        sys: &Driven,
-        z0: &[f64],
-        first: usize,
-        last: usize,
-        r: &Restarts,
-    ) -> Result<Vec<Vec<f64>>, FitError> {
-        let mut rows = self.integrate_window(sys, z0, r.every)?;
-        let mut a = first + r.every;
-        let columns: Vec<Column> = sys
-            .columns
-            .iter()
-            .map(|c| match c {
-                Column::Initial { scale, .. } => Column::Input {
-                    du: vec![0.0; sys.given.len()],
-                    scale: *scale,
-                },
-                c => c.clone(),
-            })
-            .collect();
-        while a < last {
-            let b = (a + r.every).min(last);
-            let shift = (a - first) as f64 * self.dt;
-            let seg = Driven {
-                model: sys.model,
-                p: sys.p.clone(),
-                base: sys.base.clone(),
-                free: sys.free.clone(),
-                given: sys.given.clone(),
-                signals: sys
-                    .signals
-                    .iter()
-                    .map(|s| Signal {
-                        t0: s.t0 - shift,
-                        ..s.clone()
-                    })
-                    .collect(),
-                columns: columns.clone(),
-                zscale: sys.zscale.clone(),
-            };
-            let nz = sys.free.len();
-            let mut za = r.states[a].clone();
-            za.resize(nz, 0.0);
-            let seg_rows = self.integrate_window(&seg, &za, b - a)?;
-            rows.extend(seg_rows.into_iter().skip(1));
-            a = b;
-        }
-        Ok(rows)
-    }
-
     /// Integrate `sys` from the free states `z0` over `steps` samples; the rows at the samples.
-    fn integrate_window(
+    pub(super) fn integrate_window(
         &self,
         sys: &Driven,
         z0: &[f64],

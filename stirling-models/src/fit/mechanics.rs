@@ -121,7 +121,7 @@ fn restarts(
     x_off: [f64; 2],
     cycles: Option<f64>,
     f0: f64,
-) -> Option<super::driven::Restarts> {
+) -> Option<super::restarts::Restarts> {
     let every = (cycles? / (f0 * rec.dt)).round();
     if !every.is_finite() || every < MIN_SEGMENT {
         return None;
@@ -137,7 +137,7 @@ fn restarts(
             ]
         })
         .collect();
-    Some(super::driven::Restarts {
+    Some(super::restarts::Restarts {
         every: every as usize,
         states,
     })

@@ -42,6 +42,8 @@ pub mod prior;
 pub mod record;
 /// Estimates, standard errors, intervals, correlations (statistics, no figures).
 pub mod report;
+/// Stage runs restarted from the measured state.
+pub mod restarts;
 /// Forward sensitivities of a driven subsystem.
 pub mod sensitivity;
 /// Sensor distortions fitted as stage variables.
@@ -108,7 +110,7 @@ pub struct FitOptions {
     /// default: it costs several times the two stages).
     pub multiple_shooting: Option<multiple_shooting::MsOptions>,
     /// Stage 1 restarted from the measured body states every this many cycles
-    /// ([`driven::Restarts`]; `None`: one run over the block).
+    /// ([`restarts::Restarts`]; `None`: one run over the block).
     pub restart_cycles: Option<f64>,
 }
 

@@ -85,6 +85,7 @@ pub enum Column {
 }
 
 /// A driven subsystem with its sensitivities, as an [`OdeSystem`]: state `[z, vec(S)]`.
+#[derive(Clone)]
 pub struct Driven<'a> {
     pub model: &'a dyn Model,
     pub p: Vec<f64>,

@@ -1,0 +1,61 @@
+//! Stage runs restarted from the measured state: the window cut into segments of a few
+//! cycles, each started from the free states the record shows at its first sample.
+
+use super::driven::Stage;
+use super::sensitivity::{Column, Driven, Signal};
+use super::FitError;
+
+/// Restarts of a driven run from the measured state every `every` samples: the run is cut
+/// into segments of a few cycles, each started from the free states the record shows at its
+/// first sample, so that a run cannot drift onto another response of the driven subsystem
+/// (a piston between end stops is an impact oscillator with several responses to one
+/// forcing). The sensitivities restart at zero: a later segment does not depend on the
+/// initial-state variables.
+#[derive(Clone, Debug)]
+pub struct Restarts {
+    pub every: usize,
+    /// The free states at every sample of the record, from the smoothed measurements.
+    pub states: Vec<Vec<f64>>,
+}
+
+impl Stage<'_> {
+    /// [`Stage::integrate_window`] over `first..=last` in segments of [`Restarts::every`]
+    /// samples, each after the first started from the measured state with its sensitivities
+    /// at zero; a segment's first row is the last row of the segment before.
+    pub(super) fn integrate_restarted(
+        &self,
+        sys: &Driven,
+        z0: &[f64],
+        (first, last): (usize, usize),
+        r: &Restarts,
+    ) -> Result<Vec<Vec<f64>>, FitError> {
+        let mut rows = self.integrate_window(sys, z0, r.every)?;
+        // a later segment does not depend on the initial-state variables: their columns
+        // start at zero there (an input column that moves nothing)
+        let mut seg = sys.clone();
+        for c in &mut seg.columns {
+            if let Column::Initial { scale, .. } = *c {
+                *c = Column::Input {
+                    du: vec![0.0; sys.given.len()],
+                    scale,
+                };
+            }
+        }
+        let mut a = first + r.every;
+        while a < last {
+            let b = (a + r.every).min(last);
+            let shift = (a - first) as f64 * self.dt;
+            for (s, orig) in seg.signals.iter_mut().zip(&sys.signals) {
+                *s = Signal {
+                    t0: orig.t0 - shift,
+                    ..orig.clone()
+                };
+            }
+            let mut za = r.states[a].clone();
+            za.resize(sys.free.len(), 0.0);
+            rows.extend(self.integrate_window(&seg, &za, b - a)?.into_iter().skip(1));
+            a = b;
+        }
+        Ok(rows)
+    }
+}
