@@ -5,7 +5,7 @@
 //! docs/diagnosis.md, "Several effects at once".
 
 use stirling::models::diagnose::selfcheck::record::{seeded_start, through_csv};
-use stirling::models::diagnose::selfcheck::verdict_settings;
+use stirling::models::diagnose::selfcheck::{settings, verdict_settings};
 use stirling::models::diagnose::{diagnose, nominal_model, DiagnoseOptions, Diagnosis};
 use stirling::models::rig::{self, RigConfig};
 
@@ -17,6 +17,16 @@ fn diagnosed(effects: &[&str], m: f64, seed: u64, candidates: &[&str]) -> Diagno
 
 /// [`diagnosed`] on a record sampled at `rate`.
 fn diagnosed_at(rate: f64, effects: &[&str], m: f64, seed: u64, candidates: &[&str]) -> Diagnosis {
+    let settings = effects
+        .iter()
+        .flat_map(|e| verdict_settings(e, m))
+        .collect();
+    diagnosed_with(rate, settings, seed, candidates)
+}
+
+/// A 2 s record sampled at `rate` with the rig settings `effects`, diagnosed over
+/// `candidates` from a perturbed start.
+fn diagnosed_with(rate: f64, effects: Vec<String>, seed: u64, candidates: &[&str]) -> Diagnosis {
     let cfg = RigConfig {
         model: "nsection".into(),
         n: Some(2),
@@ -25,10 +35,7 @@ fn diagnosed_at(rate: f64, effects: &[&str], m: f64, seed: u64, candidates: &[&s
         rate,
         seed,
         channels: ["p", "x", "y"].map(String::from).to_vec(),
-        effects: effects
-            .iter()
-            .flat_map(|e| verdict_settings(e, m))
-            .collect(),
+        effects,
         ..Default::default()
     };
     let dir = tempdir(seed);
@@ -43,7 +50,8 @@ fn diagnosed_at(rate: f64, effects: &[&str], m: f64, seed: u64, candidates: &[&s
     let d = diagnose(model.as_ref(), &p0, &data, &opts).unwrap();
     let _ = std::fs::remove_dir_all(&dir);
     eprintln!(
-        "{effects:?}: {} {:?} remainder {} ({}) in {:.1} s",
+        "{:?}: {} {:?} remainder {} ({}) in {:.1} s",
+        cfg.effects,
         d.verdict.verdict,
         d.verdict.effects,
         d.verdict.unexplained_remainder,
@@ -149,14 +157,14 @@ fn a_clean_record_names_nothing() {
 
 #[test]
 fn a_withheld_end_stop_is_named_at_one_and_two_units() {
-    // stops at 2 mm and 1.1 mm take most of the stroke; the calibration absorbs them into a
-    // piston spring at 0.02x and the first pass explains nothing: the second pass, stage 1
-    // restarted every quarter cycle, names them (2 kHz, the self-check's rate)
+    // hard stops (the rank check's: 2 mm and 1.1 mm, 87 % of the stroke) take most of the
+    // stroke; the calibration absorbs them into a piston spring at 0.02x and the first pass
+    // explains nothing: the second pass, stage 1 restarted every quarter cycle, names them
+    // (2 kHz, the self-check's rate)
     for (m, seed) in [(1.0, 44), (2.0, 45)] {
-        let d = diagnosed_at(
+        let d = diagnosed_with(
             2000.0,
-            &["end_stops"],
-            m,
+            settings("end_stops", m),
             seed,
             &["coulomb", "end_stops", "sensor_lag", "sensor_gain"],
         );

@@ -16,7 +16,7 @@ use super::context::{Context, Eval};
 use super::joint::EffectAt;
 use super::rank::{self, Assessed, On};
 use super::screen::screen_set;
-use super::steps::{passes, Named};
+use super::steps::{passes, Named, StepRule};
 use super::types::RankEntry;
 use super::verdict::STRONG_BIC;
 use super::DiagnoseOptions;
@@ -29,7 +29,7 @@ pub fn best_pair(
     ctx: &Context,
     on: &On,
     assessed: &[Assessed],
-    level: f64,
+    (level, rule): (f64, StepRule),
     opts: &DiagnoseOptions,
 ) -> Option<Named> {
     use rayon::prelude::*;
@@ -59,7 +59,7 @@ pub fn best_pair(
     pairs
         .par_iter()
         .filter_map(|&(i, j)| try_pair(ctx, on, (pool[i], pool[j]), opts))
-        .filter(|n| passes(&n.entry, level))
+        .filter(|n| passes(&n.entry, level, rule))
         .min_by(|a, b| {
             let d = |n: &Named| n.entry.delta_bic.unwrap_or(f64::INFINITY);
             d(a).total_cmp(&d(b))

@@ -63,11 +63,8 @@ pub fn second_pass(
         )
     });
     let mut o = opts.clone();
-    // the family-wise level of the first pass: Bonferroni over all its candidates, not only
-    // those tried again
-    let n_all = candidates(model, &opts.effects).ok()?.len().max(1);
-    o.alpha = opts.alpha * stops.len() as f64 / n_all as f64;
-    o.effects = Some(stops);
+    // every candidate, at the first pass's family-wise level: the first step tries only the
+    // stops (`steps::round_candidates`), the steps after them every other effect
     o.fit.restart_cycles = Some(RESTART_CYCLES);
     let mut second = diagnose_once(model, p0, data, &o).ok()?;
     if second.verdict.verdict != "effect" {

@@ -145,6 +145,9 @@ pub struct Step {
     /// The candidates of this step's round, ranked.
     pub ranking: Vec<RankEntry>,
     pub seconds: f64,
+    /// A step after the end stops on the second pass (stage 1 restarted), named under that
+    /// pass's rule ([`super::steps::StepRule`]).
+    pub after_stops: bool,
     /// Residual series after this step, for the report.
     #[serde(skip)]
     pub eval: Option<Eval>,

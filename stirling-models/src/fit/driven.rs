@@ -209,7 +209,7 @@ impl Stage<'_> {
         };
         let rows = match &self.restarts {
             Some(r) if r.every < last - first => {
-                self.integrate_restarted(&sys, &z0, (first, last), r)?
+                self.integrate_restarted(&sys, &z0, (first, last), r, &gain)?
             }
             _ => self.integrate_window(&sys, &z0, last - first)?,
         };

@@ -140,6 +140,7 @@ fn restarts(
     Some(super::restarts::Restarts {
         every: every as usize,
         states,
+        channels: vec!["x", "x", "y", "y"],
     })
 }
 

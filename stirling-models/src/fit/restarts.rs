@@ -16,19 +16,27 @@ pub struct Restarts {
     pub every: usize,
     /// The free states at every sample of the record, from the smoothed measurements.
     pub states: Vec<Vec<f64>>,
+    /// The channel each free state is read from (a position and its velocity from the
+    /// position's channel): a gain on that sensor divides the restart state as it divides
+    /// the measurement ([`Stage::apply_sensors`]).
+    pub channels: Vec<&'static str>,
 }
 
 impl Stage<'_> {
     /// [`Stage::integrate_window`] over `first..=last` in segments of [`Restarts::every`]
     /// samples, each after the first started from the measured state with its sensitivities
-    /// at zero; a segment's first row is the last row of the segment before.
+    /// at zero; a segment's first row is the last row of the segment before. `gain[o]` is
+    /// output `o`'s sensor gain factor: a restart state read from that output's channel is
+    /// divided by it (the states are measurements, not the bodies' true positions).
     pub(super) fn integrate_restarted(
         &self,
         sys: &Driven,
         z0: &[f64],
         (first, last): (usize, usize),
         r: &Restarts,
+        gain: &[f64],
     ) -> Result<Vec<Vec<f64>>, FitError> {
+        let factor = self.restart_factors(r, gain);
         let mut rows = self.integrate_window(sys, z0, r.every)?;
         // a later segment does not depend on the initial-state variables: their columns
         // start at zero there (an input column that moves nothing)
@@ -51,11 +59,29 @@ impl Stage<'_> {
                     ..orig.clone()
                 };
             }
-            let mut za = r.states[a].clone();
+            let mut za: Vec<f64> = r.states[a]
+                .iter()
+                .zip(&factor)
+                .map(|(z, f)| z / f)
+                .collect();
             za.resize(sys.free.len(), 0.0);
             rows.extend(self.integrate_window(&seg, &za, b - a)?.into_iter().skip(1));
             a = b;
         }
         Ok(rows)
+    }
+
+    /// The gain factor of each restart state: that of the output read from its channel (1
+    /// without one).
+    fn restart_factors(&self, r: &Restarts, gain: &[f64]) -> Vec<f64> {
+        r.channels
+            .iter()
+            .map(|c| {
+                self.outputs
+                    .iter()
+                    .position(|o| o.channel == *c)
+                    .map_or(1.0, |o| gain[o])
+            })
+            .collect()
     }
 }

@@ -10,7 +10,7 @@ use stirling_dsl::Model;
 use super::plan::{set_label, Planned, Split, Truth, VerdictOptions};
 use super::record::{record, seeded_start, signature, Signature};
 use crate::diagnose::run::diagnose;
-use crate::diagnose::steps::MIN_STEP_CLOSURE;
+use crate::diagnose::steps::StepRule;
 use crate::diagnose::types::{Diagnosis, RankEntry};
 use crate::diagnose::verdict::{pick, Pick, Thresholds, GROSS_GAP};
 use crate::diagnose::DiagnoseError;
@@ -65,6 +65,8 @@ pub struct StepBrief {
     pub ci_low: f64,
     /// Lower bound of the cumulative closure after the step.
     pub cumulative_low: f64,
+    /// Named after the stops on the second pass ([`StepRule::at`]).
+    pub after_stops: bool,
 }
 
 /// The verdict label of a diagnosis: the set of named effects (`a+b`), `unexplained` or
@@ -101,7 +103,8 @@ impl Outcome {
         let mut named = Vec::new();
         let mut cumulative = f64::NEG_INFINITY;
         for s in &self.steps {
-            if !(s.p_value < level && s.delta_bic < th.strong_bic && s.ci_low > MIN_STEP_CLOSURE) {
+            let rule = StepRule::at(th.strong_bic, s.after_stops);
+            if !(s.p_value < level && s.delta_bic < rule.bic && s.ci_low > rule.min_closure) {
                 break;
             }
             named.extend(s.effects.iter().cloned());
@@ -163,6 +166,7 @@ impl Outcome {
                 delta_bic: s.delta_bic,
                 ci_low: s.closure.ci_low,
                 cumulative_low: s.cumulative.ci_low,
+                after_stops: s.after_stops,
             })
             .collect();
         self.tuned_verdict = self.verdict.clone();

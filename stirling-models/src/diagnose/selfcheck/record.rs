@@ -69,13 +69,54 @@ pub fn rig_config(opts: &VerdictOptions, c: &Planned) -> RigConfig {
 
 /// The record of case `c`, through a CSV in `dir`.
 pub fn record(opts: &VerdictOptions, c: &Planned, dir: &Path) -> Result<Measured, DiagnoseError> {
-    let cfg = rig_config(opts, c);
-    let out = rig::run(&cfg).map_err(|source| DiagnoseError::Rig {
-        truth: c.truth.label(),
-        source,
-    })?;
-    through_csv(out, dir, c.index)
+    let mut cfg = rig_config(opts, c);
+    let run = |cfg: &RigConfig| {
+        rig::run(cfg).map_err(|source| DiagnoseError::Rig {
+            truth: c.truth.label(),
+            source,
+        })
+    };
+    if let Truth::Pair { names, .. } = &c.truth {
+        if names.iter().any(|n| n == "end_stops") {
+            let partner = RigConfig {
+                effects: without_stops(&cfg.effects),
+                ..cfg.clone()
+            };
+            let sig = signature(&run(&partner)?.data);
+            cfg.effects = stops_inside(&cfg.effects, &sig);
+        }
+    }
+    through_csv(run(&cfg)?, dir, c.index)
 }
+
+/// The rig settings without the end stops' (`kc`, `xmax`, `ymax`).
+fn without_stops(set: &[String]) -> Vec<String> {
+    let stops = ["kc=", "xmax=", "ymax="];
+    set.iter()
+        .filter(|s| !stops.iter().any(|k| s.starts_with(k)))
+        .cloned()
+        .collect()
+}
+
+/// The settings with the stops' travels at [`STOP_FRACTIONS`] of the amplitudes `sig` of
+/// the record without them: a stop inside the stroke the partner leaves, as the single
+/// stops lie inside the clean stroke. At the clean record's amplitudes (9.3 mm, 7.6 mm) the
+/// travels are the single's ([`super::VERDICT_STOPS`]); beside a quadratic regenerator loss
+/// that halves the stroke, stops at the clean record's travels never touch.
+fn stops_inside(set: &[String], sig: &Signature) -> Vec<String> {
+    let mut out: Vec<String> = set
+        .iter()
+        .filter(|s| !s.starts_with("xmax=") && !s.starts_with("ymax="))
+        .cloned()
+        .collect();
+    out.push(format!("xmax={}", STOP_FRACTIONS[0] * sig.x_amp));
+    out.push(format!("ymax={}", STOP_FRACTIONS[1] * sig.y_amp));
+    out
+}
+
+/// The end stops' travels in a pair as fractions of the displacer's and the piston's
+/// amplitudes without them: those of [`super::VERDICT_STOPS`] on the clean record.
+pub const STOP_FRACTIONS: [f64; 2] = [1.08, 0.73];
 
 /// A rig record written to `dir/case<k>.csv` and read back (the diagnosis sees only what a
 /// user's CSV holds); the file is removed after reading.
