@@ -77,7 +77,7 @@ fn series<'py>(py: Python<'py>, s: &[Series]) -> PyResult<Bound<'py, PyList>> {
 
 /// Fit `model` (its parameters are the start) to `record`.
 #[pyfunction]
-#[pyo3(signature = (model, p, record, free=None, bounds=None, train=None, holdout=None, multiple_shooting=None))]
+#[pyo3(signature = (model, p, record, free=None, bounds=None, train=None, holdout=None, multiple_shooting=None, restart_cycles=None))]
 pub fn fit<'py>(
     py: Python<'py>,
     model: &NativeModel,
@@ -88,6 +88,7 @@ pub fn fit<'py>(
     train: Block,
     holdout: Block,
     multiple_shooting: Option<f64>,
+    restart_cycles: Option<f64>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let m = model.dyn_model();
     check_full(m)?;
@@ -103,8 +104,17 @@ pub fn fit<'py>(
             .into());
         }
     }
+    if let Some(c) = restart_cycles {
+        if !(c.is_finite() && c > 0.0 && c <= 1000.0) {
+            return Err(Failure::option(format!(
+                "restart_cycles = {c}: above 0 and at most 1000 cycles between restarts"
+            ))
+            .into());
+        }
+    }
     let opts = FitOptions {
         free,
+        restart_cycles,
         bounds: self::bounds(m, bounds)?,
         multiple_shooting: multiple_shooting.map(|c| library::multiple_shooting::MsOptions {
             cycles: c,

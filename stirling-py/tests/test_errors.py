@@ -129,6 +129,8 @@ def test_irregular_sampling_and_blocks(cv1):
         cv1.fit(rec, train=(0.0, 0.7), holdout=(0.5, 1.0))
     with pytest.raises(RecordError, match="expected a stirling.Record"):
         cv1.fit([1, 2, 3])
+    with pytest.raises(OptionError, match="restart_cycles = 0: above 0"):
+        cv1.fit(rec, restart_cycles=0.0)
 
 
 def test_csv_errors_name_row_and_column(tmp_path):

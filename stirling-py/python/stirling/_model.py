@@ -353,6 +353,7 @@ class Model:
         train: Optional[Tuple[float, float]] = None,
         holdout: Optional[Tuple[float, float]] = None,
         multiple_shooting: Optional[float] = None,
+        restart_cycles: Optional[float] = None,
     ) -> Fit:
         """The two-stage identification from this model's parameters: stage 1 fits the
         mechanics driven by the measured pressure, stage 2 the gas driven by the measured
@@ -361,13 +362,15 @@ class Model:
         ``free``: the parameters fitted (default: those the model declares free, else
         ``kd, kp, bd, bp, hh, hk, Rf`` where used); ``bounds``: ``{name: (lo, hi)}`` over the
         declared ones; ``train``/``holdout``: blocks ``(start, end)`` in s (default: the first
-        70 % and the rest); ``multiple_shooting``: refine over segments of that many cycles.
+        70 % and the rest); ``multiple_shooting``: refine over segments of that many cycles;
+        ``restart_cycles``: restart stage 1 from the measured body states every that many
+        cycles (a piston between end stops, which one driven run cannot follow).
         A stage that does not converge warns (:attr:`Fit.converged`).
         """
         raw = _native.fit(
             self._m, self._p, _as_native(record), None if free is None else list(free),
             None if bounds is None else dict(bounds), _block(train, "train"), _block(holdout, "holdout"),
-            multiple_shooting,
+            multiple_shooting, restart_cycles,
         )
         res = Fit(raw)
         for s in res.stages:

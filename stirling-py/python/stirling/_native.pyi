@@ -86,7 +86,7 @@ def rig(
 def fit(
     model: NativeModel, p: ArrayLike, record: NativeRecord, free: Optional[List[str]] = None,
     bounds: Optional[Dict[str, Tuple[float, float]]] = None, train: Block = None, holdout: Block = None,
-    multiple_shooting: Optional[float] = None,
+    multiple_shooting: Optional[float] = None, restart_cycles: Optional[float] = None,
 ) -> Dict[str, Any]: ...
 def diagnose(
     model: str, record: NativeRecord, n: Optional[int] = None, params: Optional[Dict[str, float]] = None,
