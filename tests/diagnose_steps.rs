@@ -178,3 +178,37 @@ fn a_withheld_end_stop_is_named_at_one_and_two_units() {
         check_steps(&d);
     }
 }
+
+#[test]
+fn end_stops_and_a_pressure_lag_are_both_named() {
+    // stops inside the stroke (the verdict check's, 10 mm and 5.5 mm) with a 2 ms lag: the
+    // second pass names the stops, then the lag on the restarted basis (truth 2 ms)
+    let d = diagnosed_at(
+        2000.0,
+        &["end_stops", "sensor_lag"],
+        1.0,
+        46,
+        &["coulomb", "end_stops", "sensor_lag", "sensor_gain"],
+    );
+    assert_eq!(d.verdict.verdict, "effect", "{}", d.verdict.reason);
+    assert_eq!(
+        named(&d),
+        ["end_stops", "sensor_lag"],
+        "{}",
+        d.verdict.reason
+    );
+    check_steps(&d);
+    let tau = d
+        .steps
+        .last()
+        .unwrap()
+        .params
+        .iter()
+        .find(|q| q.name == "tau_p")
+        .unwrap();
+    assert!(
+        (tau.value / 2e-3 - 1.0).abs() < 0.3,
+        "tau_p {:e}",
+        tau.value
+    );
+}
