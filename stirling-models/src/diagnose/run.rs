@@ -44,6 +44,7 @@ pub(super) fn diagnose_once(
     let b = blocks(data, opts)?;
     let cands = candidates(model, &opts.effects)?;
     let (id, stages) = fit::identify_stages(model, p0, data, &calibration_options(opts, &b))?;
+    let calibrated = clock.elapsed().as_secs_f64();
     let p_nom = nominal_params(model, p0, &id);
     let ctx = context(model, data, &b, &stages, p_nom.clone(), opts)?;
     let all: Vec<Prediction> = ctx.nominal_preds.iter().flatten().cloned().collect();
@@ -52,8 +53,10 @@ pub(super) fn diagnose_once(
     let localization = localize::localize(data, &nominal, &ctx);
     super::assess::report(opts, || {
         format!(
-            "nominal calibration done ({:.1} s); assessing {} candidate effects",
+            "nominal calibration done ({:.1} s; its predictions and the input noise's {} draws {:.1} s of it); assessing {} candidate effects",
             clock.elapsed().as_secs_f64(),
+            opts.noise_draws,
+            clock.elapsed().as_secs_f64() - calibrated,
             cands.len()
         )
     });
