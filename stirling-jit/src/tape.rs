@@ -7,9 +7,9 @@ use cranelift_codegen::ir::AbiParam;
 use cranelift_codegen::settings::{self, Configurable};
 use cranelift_jit::{JITBuilder, JITModule};
 use cranelift_module::{Linkage, Module, ModuleError};
-use stirling_dsl::compiled::{Op, Runner, Tape};
+use stirling_dsl::compiled::{Op, Repeat, Runner, Tape};
 
-use crate::{build, shims};
+use crate::{build, looped, shims};
 
 /// Why a tape could not be compiled.
 #[derive(Debug, thiserror::Error)]
@@ -46,6 +46,10 @@ pub struct JitTape {
     /// The tape's numbers, which the code reads at their address (a boxed slice: its
     /// elements never move, and live as long as the code).
     _consts: Box<[f64]>,
+    /// Whether the code loops over the tape's repeating sections ([`Repeat`]).
+    looped: bool,
+    /// The machine code's size in bytes, every function together.
+    bytes: usize,
 }
 
 impl std::fmt::Debug for JitTape {
@@ -53,6 +57,8 @@ impl std::fmt::Debug for JitTape {
         f.debug_struct("JitTape")
             .field("needs", &self.needs)
             .field("functions", &self.code.len())
+            .field("looped", &self.looped)
+            .field("bytes", &self.bytes)
             .finish_non_exhaustive()
     }
 }
@@ -78,9 +84,42 @@ thread_local! {
 pub const CHUNK_OPS: usize = 4_000;
 
 impl JitTape {
-    /// Compile `tape` for this machine (as functions of at most [`CHUNK_OPS`] instructions).
+    /// Compile `tape` for this machine: with a loop over its repeating sections where it
+    /// has some ([`Tape::repeat`], [`JitTape::compile_looped`]), else unrolled as functions
+    /// of at most [`CHUNK_OPS`] instructions.
     pub fn compile(tape: &Tape) -> Result<JitTape, JitError> {
-        JitTape::compile_chunked(tape, CHUNK_OPS)
+        match tape.repeat().filter(|r| worth_looping(tape, r)) {
+            Some(rep) => JitTape::compile_looped(tape, &rep),
+            None => JitTape::compile_chunked(tape, CHUNK_OPS),
+        }
+    }
+
+    /// Compile `tape` as one function with a loop over the sections `rep` (found on it by
+    /// [`Tape::repeat`]).
+    pub fn compile_looped(tape: &Tape, rep: &Repeat) -> Result<JitTape, JitError> {
+        let mut module = module()?;
+        let ptr = module.target_config().pointer_type();
+        let numbers = looped::Numbers::new(tape, rep);
+        let mut ctx = module.make_context();
+        for _ in 0..6 {
+            ctx.func.signature.params.push(AbiParam::new(ptr));
+        }
+        looped::function(&mut module, &mut ctx.func, tape, rep, &numbers)?;
+        let id = module.declare_function("tape_loop", Linkage::Export, &ctx.func.signature)?;
+        module.define_function(id, &mut ctx)?;
+        let bytes = code_bytes(&ctx);
+        module.clear_context(&mut ctx);
+        module.finalize_definitions()?;
+        let code = vec![module.get_finalized_function(id)];
+        Ok(JitTape {
+            _module: module,
+            code,
+            needs: needs(tape),
+            scratch: 0,
+            _consts: numbers.values,
+            looped: true,
+            bytes,
+        })
     }
 
     /// Compile `tape` as functions of at most `chunk` instructions each.
@@ -90,6 +129,7 @@ impl JitTape {
         let mut layout = build::Layout::new(tape, chunk);
         let mut ids = Vec::with_capacity(layout.chunks.len());
         let mut ctx = module.make_context();
+        let mut bytes = 0;
         for c in 0..layout.chunks.len() {
             for _ in 0..6 {
                 ctx.func.signature.params.push(AbiParam::new(ptr));
@@ -98,6 +138,7 @@ impl JitTape {
             let name = format!("tape{c}");
             let id = module.declare_function(&name, Linkage::Export, &ctx.func.signature)?;
             module.define_function(id, &mut ctx)?;
+            bytes += code_bytes(&ctx);
             module.clear_context(&mut ctx);
             ids.push(id);
         }
@@ -112,7 +153,19 @@ impl JitTape {
             needs: needs(tape),
             scratch: layout.slots,
             _consts: std::mem::take(&mut layout.consts),
+            looped: false,
+            bytes,
         })
+    }
+
+    /// Whether the code loops over the tape's repeating sections.
+    pub fn looped(&self) -> bool {
+        self.looped
+    }
+
+    /// The size of the machine code in bytes.
+    pub fn code_bytes(&self) -> usize {
+        self.bytes
     }
 
     /// The number of functions the tape was compiled as.
@@ -188,6 +241,28 @@ impl JitTape {
     }
 }
 
+/// The size of the machine code `ctx` holds after `define_function`.
+fn code_bytes(ctx: &cranelift_codegen::Context) -> usize {
+    ctx.compiled_code()
+        .map_or(0, |c| c.code_info().total_size as usize)
+}
+
+/// The fewest iterations a loop is compiled for: below, the unrolled code is about as
+/// small (it fits the instruction cache) and a little faster.
+pub const LOOP_MIN: usize = 2;
+
+/// The longest straight part (before or after the loop) or body compiled as one function.
+const LOOP_PART_OPS: usize = 2 * CHUNK_OPS;
+
+/// Whether `rep` is worth a loop (enough iterations) and compiles as one function (no
+/// part too long for one block).
+fn worth_looping(tape: &Tape, rep: &Repeat) -> bool {
+    rep.count >= LOOP_MIN
+        && rep.start <= LOOP_PART_OPS
+        && rep.len <= LOOP_PART_OPS
+        && tape.ops.len() - rep.end() <= LOOP_PART_OPS
+}
+
 /// The JIT module for this machine, the shims known by name.
 fn module() -> Result<JITModule, JitError> {
     let mut flags = settings::builder();
@@ -229,6 +304,14 @@ fn needs(tape: &Tape) -> [usize; 5] {
 impl Runner for JitTape {
     fn run(&self, x: &[f64], p: &[f64], v: &[f64], head: &mut [f64], tail: &mut [f64]) -> bool {
         JitTape::run_split(self, x, p, v, head, tail)
+    }
+
+    fn looped(&self) -> bool {
+        self.looped
+    }
+
+    fn code_bytes(&self) -> Option<usize> {
+        Some(self.bytes)
     }
 }
 
