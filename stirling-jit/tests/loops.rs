@@ -130,6 +130,10 @@ fn a_tape_whose_sections_differ_is_compiled_unrolled() {
     for (k, o) in out.iter().enumerate() {
         assert_eq!(o.to_bits(), tape.output(&regs, k).to_bits(), "output {k}");
     }
-    assert!(!code.looped());
-    assert_eq!(tape.repeat(), None);
+    // the loop (if any) stops before section 5 or starts after it
+    let rep = tape.repeat();
+    assert_eq!(code.looped(), rep.is_some());
+    if let Some(rep) = rep {
+        assert!(rep.end() <= s5 || rep.start > s5, "{rep:?}");
+    }
 }

@@ -297,8 +297,16 @@ impl Tape {
             return None;
         }
         let n = s.len() - 1;
-        // the first interior sections may differ from the rest (a number first used there)
-        (1..4.min(n)).find_map(|first| self.repeat_from(first, n - 2))
+        // the first interior sections may differ from the rest (a number first used there),
+        // and the last ones (the last section builds its inflow itself, so the one before it
+        // computes less for it): the longest run first
+        let mut runs: Vec<(usize, usize)> = (1..4.min(n))
+            .flat_map(|first| (n.saturating_sub(5)..n - 1).map(move |last| (first, last)))
+            .filter(|&(first, last)| last >= first)
+            .collect();
+        runs.sort_by_key(|&(first, last)| std::cmp::Reverse(last - first));
+        runs.into_iter()
+            .find_map(|(first, last)| self.repeat_from(first, last))
     }
 
     /// Sections `first..=last` as one loop, if they repeat.
@@ -341,5 +349,76 @@ impl Tape {
             table,
             cols,
         })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// `n` sections: `out_j = (x[j] - carried) * p0`, carried the previous section's
+    /// difference (the number 1 before the first); section `j`'s index as a number.
+    fn chain(n: usize) -> Tape {
+        let mut ops = vec![Op::P(0), Op::K(1.0)];
+        let (mut outputs, mut sections) = (Vec::new(), Vec::new());
+        let mut carried = 1u32;
+        for j in 0..n {
+            let s = ops.len() as u32;
+            sections.push(s);
+            ops.extend([
+                Op::X(j as u32),
+                Op::Sub(s, carried),
+                Op::K(j as f64),
+                Op::Mul(s + 1, 0),
+                Op::Mul(s + 3, s + 2),
+            ]);
+            outputs.extend([s + 3, s + 4]);
+            carried = s + 1;
+        }
+        sections.push(ops.len() as u32);
+        Tape {
+            ops,
+            outputs,
+            split: None,
+            sections,
+        }
+    }
+
+    #[test]
+    fn the_interior_sections_are_one_body() {
+        let t = chain(10);
+        let r = t.repeat().expect("sections 1..=8 repeat");
+        assert_eq!((r.start, r.len, r.count, r.cols), (7, 5, 8, 1));
+        assert_eq!(r.body[0], Step::Leaf(LoopLeaf::X { base: 1, step: 1 }));
+        let prev = Arg::Prev { t: 1, init: 3 };
+        let sub = Step::Op {
+            op: Op::Sub(0, 0),
+            args: [Arg::Leaf(LoopLeaf::X { base: 1, step: 1 }), prev],
+        };
+        assert_eq!(r.body[1], sub);
+        assert_eq!(
+            r.body[3].clone(),
+            Step::Op {
+                op: Op::Mul(0, 0),
+                args: [Arg::Body(1), Arg::Leaf(LoopLeaf::P { base: 0, step: 0 })],
+            }
+        );
+        // outputs 2j and 2j + 1 of section j: 2 and 3 in the first iteration, step 2
+        assert_eq!(r.stores, vec![(3, 2, 2), (4, 3, 2)]);
+        assert_eq!(r.table, (1..9).map(|j| j as f64).collect::<Vec<_>>());
+    }
+
+    #[test]
+    fn sections_that_differ_do_not_repeat() {
+        let mut t = chain(10);
+        // section 6 reads the first section's difference instead of the previous one's
+        let s6 = t.sections[6] as usize;
+        t.ops[s6 + 1] = Op::Sub(s6 as u32, 3);
+        let r = t.repeat().expect("sections 1..=5 still repeat");
+        assert_eq!((r.start, r.count, r.end()), (7, 5, s6));
+        let mut t = chain(10);
+        t.sections.clear();
+        assert_eq!(t.repeat(), None, "no sections marked");
+        assert_eq!(chain(3).repeat(), None, "one interior section");
     }
 }
