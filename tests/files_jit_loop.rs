@@ -1,6 +1,6 @@
 //! The JIT's loop over the repeating interior sections (`Tape::repeat`, `stirling-jit`'s
 //! looped code) on the family's files: found at every n with interior sections to repeat,
-//! its code the same size at n = 10 and 100 (unrolled, it grew with n), and its results the
+//! its code the same size at n = 30 and 100 (unrolled, it grew with n), and its results the
 //! interpreter's bits (`files_jit` checks every function of every file at n = 10 and 100;
 //! here the right-hand side with the Jacobian, with the parameters as inputs and folded in).
 
@@ -31,7 +31,7 @@ fn values(m: &dyn Model, p: &[f64], x: &[f64]) -> Vec<f64> {
 fn the_interior_sections_run_as_one_loop() {
     for name in ["nsection", "nsection_fx", "nsection_ext"] {
         let mut bytes = Vec::new();
-        for n in [10, 100] {
+        for n in [30, 100] {
             let m = model(name, n);
             let p = m.default_params();
             let rep = m.rhs_jacobian_tape(&p).repeat();
@@ -82,7 +82,7 @@ fn the_interior_sections_run_as_one_loop() {
         }
         assert!(
             bytes[1] < bytes[0] * 2,
-            "{name}: code of {} bytes at n = 100 against {} at n = 10",
+            "{name}: code of {} bytes at n = 100 against {} at n = 30",
             bytes[1],
             bytes[0]
         );

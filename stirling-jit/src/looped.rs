@@ -69,9 +69,11 @@ impl Numbers {
     }
 }
 
-/// The function's arguments: `x`, `p`, `v`, the two output buffers.
+/// The function's arguments: `x`, `p`, `v`, the two output buffers, the scratch array
+/// (the values computed before the loop that it reads, [`Arg::Before`]).
 struct Args {
     ptrs: [Value; 5],
+    scratch: Value,
 }
 
 const X: usize = 0;
@@ -255,6 +257,7 @@ pub(crate) fn function(
         imports,
         args: Args {
             ptrs: [a[0], a[1], a[2], a[3], a[4]],
+            scratch: a[5],
         },
         numbers,
         consts,
@@ -288,6 +291,24 @@ fn carried(rep: &Repeat) -> Vec<(u32, u32)> {
     }
     c.sort_unstable();
     c
+}
+
+/// The registers computed before the loop that the body reads ([`Arg::Before`]), each
+/// given a slot of the scratch array in this order.
+pub(crate) fn before(rep: &Repeat) -> Vec<u32> {
+    let mut v: Vec<u32> = Vec::new();
+    for s in &rep.body {
+        if let Step::Op { args, .. } = s {
+            for a in args {
+                if let Arg::Before(r) = *a {
+                    v.push(r);
+                }
+            }
+        }
+    }
+    v.sort_unstable();
+    v.dedup();
+    v
 }
 
 /// The body instructions of the last iteration the code after the loop reads.
@@ -324,6 +345,16 @@ fn body(e: &mut Emit, vals: &[Option<Value>]) -> Result<HashMap<usize, Value>, J
         .iter()
         .map(|_| e.b.append_block_param(exit, types::F64))
         .collect();
+    // the values computed before the loop go to the scratch array, read where they are used
+    // (a memory operand of their user): kept in registers across the loop they were
+    // spilled, and reloaded before each use, an instruction more per use
+    let before = before(rep);
+    for (k, &r) in before.iter().enumerate() {
+        let v = vals[r as usize]
+            .ok_or_else(|| JitError::Codegen(format!("loop reads register {r} unset")))?;
+        e.b.ins()
+            .store(flags(), v, e.args.scratch, offset(k as u32));
+    }
     let zero = e.b.ins().iconst(types::I64, 0);
     let mut init = vec![BlockArg::Value(zero)];
     for &(_, r) in &carried {
@@ -354,9 +385,10 @@ fn body(e: &mut Emit, vals: &[Option<Value>]) -> Result<HashMap<usize, Value>, J
                 for k in 0..count {
                     v[k] = match args[k] {
                         Arg::Leaf(l) => loop_leaf(e, &mut m, l),
-                        Arg::Before(r) => vals[r as usize].ok_or_else(|| {
-                            JitError::Codegen(format!("loop reads register {r} unset"))
-                        })?,
+                        Arg::Before(r) => {
+                            let slot = before.binary_search(&r).unwrap_or(0);
+                            e.load(e.args.scratch, slot as u32)
+                        }
                         Arg::Body(u) => own[u as usize].ok_or_else(|| {
                             JitError::Codegen(format!("body reads instruction {u} unset"))
                         })?,

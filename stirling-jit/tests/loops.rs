@@ -4,7 +4,7 @@
 
 use stirling_dsl::compiled::{Op, Tape};
 use stirling_dsl::expr::Func;
-use stirling_jit::JitTape;
+use stirling_jit::{JitTape, LOOP_MIN};
 
 /// A chain of `n` sections, as a function of the rows lays them out: a scalar part (the
 /// parameters' terms), then per section `j` its state's terms, a value carried from the
@@ -76,8 +76,11 @@ fn the_looped_code_gives_the_unrolled_codes_and_the_interpreters_bits() {
             (n - 2, 1),
             "sections 1..=n-2 at n = {n}"
         );
-        let looped = JitTape::compile(&tape).unwrap();
+        let looped = JitTape::compile_looped(&tape, &rep).unwrap();
         assert!(looped.looped(), "n = {n}");
+        // `compile` loops from `LOOP_MIN` iterations on
+        let chosen = JitTape::compile(&tape).unwrap();
+        assert_eq!(chosen.looped(), rep.count >= LOOP_MIN, "n = {n}");
         let unrolled = JitTape::compile_chunked(&tape, usize::MAX).unwrap();
         assert!(!unrolled.looped());
         let p = [1.3, -0.7];
@@ -100,7 +103,11 @@ fn the_looped_code_gives_the_unrolled_codes_and_the_interpreters_bits() {
 
 #[test]
 fn the_looped_code_does_not_grow_with_n() {
-    let size = |n: usize| JitTape::compile(&chain(n)).unwrap().code_bytes();
+    let size = |n: usize| {
+        let tape = chain(n);
+        let rep = tape.repeat().expect("the interior sections repeat");
+        JitTape::compile_looped(&tape, &rep).unwrap().code_bytes()
+    };
     let unrolled = |n: usize| {
         JitTape::compile_chunked(&chain(n), usize::MAX)
             .unwrap()
