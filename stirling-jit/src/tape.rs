@@ -106,15 +106,9 @@ impl JitTape {
             ctx.func.signature.params.push(AbiParam::new(ptr));
         }
         looped::function(&mut module, &mut ctx.func, tape, rep, &numbers)?;
-        ctx.set_disasm(std::env::var_os("STIRLING_JIT_DISASM").is_some());
         let id = module.declare_function("tape_loop", Linkage::Export, &ctx.func.signature)?;
         module.define_function(id, &mut ctx)?;
         let bytes = code_bytes(&ctx);
-        if let Some(path) = std::env::var_os("STIRLING_JIT_DISASM") {
-            if let Some(v) = ctx.compiled_code().and_then(|c| c.vcode.clone()) {
-                let _ = std::fs::write(format!("{}.{}", path.to_string_lossy(), tape.ops.len()), v);
-            }
-        }
         module.clear_context(&mut ctx);
         module.finalize_definitions()?;
         let code = vec![module.get_finalized_function(id)];
