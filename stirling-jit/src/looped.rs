@@ -1,7 +1,7 @@
 //! The Cranelift IR of a tape whose interior sections repeat ([`Repeat`]): one function, the
 //! instructions before the run straight, then one loop over the run's sections (the body
 //! once, its state, parameter, output and table addresses advanced per iteration, the values
-//! the next section reads carried as block parameters), then the instructions after the run
+//! the next section reads carried in the scratch array), then the instructions after the run
 //! straight, reading the last iteration's values from the loop's exit. The arithmetic is the
 //! unrolled code's instruction for instruction (`build::arith`), so the results are the same
 //! bits.
@@ -276,7 +276,7 @@ pub(crate) fn function(
 
 /// The body instructions the next iteration reads (`Arg::Prev`), with the register each
 /// reads in the first, in order.
-fn carried(rep: &Repeat) -> Vec<(u32, u32)> {
+pub(crate) fn carried(rep: &Repeat) -> Vec<(u32, u32)> {
     let mut c: Vec<(u32, u32)> = Vec::new();
     for s in &rep.body {
         if let Step::Op { args, .. } = s {
@@ -336,10 +336,6 @@ fn body(e: &mut Emit, vals: &[Option<Value>]) -> Result<HashMap<usize, Value>, J
     let outs = live_out(e.tape, rep);
     let lp = e.b.create_block();
     let i = e.b.append_block_param(lp, types::I64);
-    let prev: Vec<Value> = carried
-        .iter()
-        .map(|_| e.b.append_block_param(lp, types::F64))
-        .collect();
     let exit = e.b.create_block();
     let exits: Vec<Value> = outs
         .iter()
@@ -356,13 +352,27 @@ fn body(e: &mut Emit, vals: &[Option<Value>]) -> Result<HashMap<usize, Value>, J
             .store(flags(), v, e.args.scratch, offset(k as u32));
     }
     let zero = e.b.ins().iconst(types::I64, 0);
-    let mut init = vec![BlockArg::Value(zero)];
-    for &(_, r) in &carried {
+    // the values the next iteration reads go through the scratch array too, after the
+    // values from before the loop: stored as soon as no read of the previous one follows
+    // in the body, else at its end
+    let slot = |c: usize| (before.len() + c) as u32;
+    let mut last_read = vec![0usize; carried.len()];
+    for (t, st) in rep.body.iter().enumerate() {
+        if let Step::Op { args, .. } = st {
+            for a in args {
+                if let Arg::Prev { t: u, .. } = *a {
+                    let c = carried.iter().position(|&(w, _)| w == u).unwrap_or(0);
+                    last_read[c] = last_read[c].max(t);
+                }
+            }
+        }
+    }
+    for (c, &(_, r)) in carried.iter().enumerate() {
         let v = vals[r as usize]
             .ok_or_else(|| JitError::Codegen(format!("loop reads register {r} unset")))?;
-        init.push(BlockArg::Value(v));
+        e.b.ins().store(flags(), v, e.args.scratch, offset(slot(c)));
     }
-    e.b.ins().jump(lp, &init);
+    e.b.ins().jump(lp, &[BlockArg::Value(zero)]);
     e.b.switch_to_block(lp);
     let mut m = Moved {
         i,
@@ -394,7 +404,7 @@ fn body(e: &mut Emit, vals: &[Option<Value>]) -> Result<HashMap<usize, Value>, J
                         })?,
                         Arg::Prev { t: u, .. } => {
                             let c = carried.iter().position(|&(w, _)| w == u).unwrap_or(0);
-                            prev[c]
+                            e.load(e.args.scratch, slot(c))
                         }
                     };
                 }
@@ -403,6 +413,12 @@ fn body(e: &mut Emit, vals: &[Option<Value>]) -> Result<HashMap<usize, Value>, J
             }
         };
         own[t] = Some(val);
+        if let Some(c) = carried.iter().position(|&(w, _)| w as usize == t) {
+            if last_read[c] < t {
+                e.b.ins()
+                    .store(flags(), val, e.args.scratch, offset(slot(c)));
+            }
+        }
         while let Some(&(u, out, step)) = rep.stores.get(s) {
             if u as usize != t {
                 break;
@@ -422,10 +438,13 @@ fn body(e: &mut Emit, vals: &[Option<Value>]) -> Result<HashMap<usize, Value>, J
     let more =
         e.b.ins()
             .icmp_imm_s(IntCC::UnsignedLessThan, next, rep.count as i64);
-    let mut again = vec![BlockArg::Value(next)];
-    for &(t, _) in &carried {
-        again.push(BlockArg::Value(body_val(t)?));
+    for (c, &(t, _)) in carried.iter().enumerate() {
+        if last_read[c] >= t as usize {
+            let v = body_val(t)?;
+            e.b.ins().store(flags(), v, e.args.scratch, offset(slot(c)));
+        }
     }
+    let again = [BlockArg::Value(next)];
     let leave = outs
         .iter()
         .map(|&t| body_val(t).map(BlockArg::Value))

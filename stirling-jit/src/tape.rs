@@ -116,7 +116,7 @@ impl JitTape {
             _module: module,
             code,
             needs: needs(tape),
-            scratch: looped::before(rep).len(),
+            scratch: looped::before(rep).len() + looped::carried(rep).len(),
             _consts: numbers.values,
             looped: true,
             bytes,
