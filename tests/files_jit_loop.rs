@@ -88,3 +88,4 @@ fn the_interior_sections_run_as_one_loop() {
         );
     }
 }
+
