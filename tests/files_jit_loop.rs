@@ -88,4 +88,3 @@ fn the_interior_sections_run_as_one_loop() {
         );
     }
 }
-
