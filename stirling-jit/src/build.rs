@@ -17,9 +17,9 @@ use stirling_dsl::expr::Func;
 use crate::{shims, JitError};
 
 /// The shims a function calls, declared in it once each.
-struct Imports {
-    funcs: Vec<(Func, FuncRef)>,
-    powf: Option<FuncRef>,
+pub(crate) struct Imports {
+    pub funcs: Vec<(Func, FuncRef)>,
+    pub powf: Option<FuncRef>,
 }
 
 /// How a tape is cut into functions (Cranelift's compile time grows faster than linearly
@@ -85,7 +85,7 @@ impl Layout {
 }
 
 /// The operands of an instruction (none for a leaf).
-fn operands(op: &Op) -> ([u32; 2], usize) {
+pub(crate) fn operands(op: &Op) -> ([u32; 2], usize) {
     match *op {
         Op::X(_) | Op::P(_) | Op::V(_) | Op::K(_) => ([0, 0], 0),
         Op::Neg(a) | Op::Powi(a, _) | Op::Func(_, a) => ([a, 0], 1),
@@ -97,7 +97,7 @@ fn operands(op: &Op) -> ([u32; 2], usize) {
 
 /// Whether `op` reads an input or is a number (emitted again where a later function needs
 /// it, never kept in the scratch array).
-fn leaf(op: &Op) -> bool {
+pub(crate) fn leaf(op: &Op) -> bool {
     matches!(op, Op::X(_) | Op::P(_) | Op::V(_) | Op::K(_))
 }
 
@@ -184,43 +184,11 @@ pub(crate) fn function(
                 }
                 r(k as u32)
             }
-            Op::Add(a, c) => {
-                let (a, c) = (r(a), r(c));
-                b.ins().fadd(a, c)
-            }
-            Op::Sub(a, c) => {
-                let (a, c) = (r(a), r(c));
-                b.ins().fsub(a, c)
-            }
-            Op::Mul(a, c) => {
-                let (a, c) = (r(a), r(c));
-                b.ins().fmul(a, c)
-            }
-            Op::Div(a, c) => {
-                let (a, c) = (r(a), r(c));
-                b.ins().fdiv(a, c)
-            }
-            Op::Neg(a) => {
-                let a = r(a);
-                // the sign bit flipped, as `fneg` (and Rust's `-a`) does; `fneg` would
-                // build its mask again at every use, 3 instructions instead of 1
-                let sign = *minus_zero.get_or_insert_with(|| b.ins().f64const(-0.0));
-                b.ins().bxor(a, sign)
-            }
-            Op::Powi(a, e) => {
-                let a = r(a);
-                powi(&mut b, a, e)
-            }
-            Op::Powf(a, c) => {
-                let (a, c) = (r(a), r(c));
-                match imports.powf {
-                    Some(f) => call(&mut b, f, &[a, c]),
-                    None => return Err(missing()),
-                }
-            }
-            Op::Func(f, a) => {
-                let a = r(a);
-                func_value(&mut b, &imports, f, a)?
+            _ => {
+                let (args, count) = operands(&op);
+                let a = r(args[0]);
+                let c = if count == 2 { r(args[1]) } else { a };
+                arith(&mut b, &imports, &mut minus_zero, op, a, c)?
             }
         };
         own.push(Some(val));
@@ -247,6 +215,39 @@ pub(crate) fn function(
     Ok(())
 }
 
+/// The value of the operation `op` (not a leaf) on `a` and `c` (its second operand, if it
+/// has one); `minus_zero`: the function's shared `-0.0`, made on first use.
+pub(crate) fn arith(
+    b: &mut FunctionBuilder,
+    imports: &Imports,
+    minus_zero: &mut Option<Value>,
+    op: Op,
+    a: Value,
+    c: Value,
+) -> Result<Value, JitError> {
+    Ok(match op {
+        Op::Add(..) => b.ins().fadd(a, c),
+        Op::Sub(..) => b.ins().fsub(a, c),
+        Op::Mul(..) => b.ins().fmul(a, c),
+        Op::Div(..) => b.ins().fdiv(a, c),
+        Op::Neg(_) => {
+            // the sign bit flipped, as `fneg` (and Rust's `-a`) does; `fneg` would
+            // build its mask again at every use, 3 instructions instead of 1
+            let sign = *minus_zero.get_or_insert_with(|| b.ins().f64const(-0.0));
+            b.ins().bxor(a, sign)
+        }
+        Op::Powi(_, e) => powi(b, a, e),
+        Op::Powf(..) => match imports.powf {
+            Some(f) => call(b, f, &[a, c]),
+            None => return Err(missing()),
+        },
+        Op::Func(f, _) => func_value(b, imports, f, a)?,
+        Op::X(_) | Op::P(_) | Op::V(_) | Op::K(_) => {
+            return Err(JitError::Codegen("a leaf is not an operation".into()))
+        }
+    })
+}
+
 /// The value of leaf instruction `k`, loaded (`None` for any other instruction). A number is
 /// loaded from the tape's table of numbers (`f64const` would be one value shared by every
 /// use, kept in a register or spilled for the whole function).
@@ -271,7 +272,7 @@ fn leaf_value(
 }
 
 /// The byte offset of element `i` of an `f64` array.
-fn offset(i: u32) -> i32 {
+pub(crate) fn offset(i: u32) -> i32 {
     (i as i64 * 8).min(i32::MAX as i64) as i32
 }
 
@@ -281,7 +282,7 @@ fn missing() -> JitError {
 }
 
 /// Declare the shims the tape calls (only those).
-fn declare_imports(
+pub(crate) fn declare_imports(
     module: &mut JITModule,
     func: &mut cranelift_codegen::ir::Function,
     ops: &[Op],

@@ -14,7 +14,8 @@
 //! on a model ([`CompiledModel::with_jit`](stirling_dsl::compiled::CompiledModel::with_jit)).
 
 mod build;
+mod looped;
 mod shims;
 mod tape;
 
-pub use tape::{jit, JitError, JitTape, CHUNK_OPS};
+pub use tape::{jit, JitError, JitTape, CHUNK_OPS, LOOP_MIN};

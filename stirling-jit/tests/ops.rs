@@ -36,6 +36,7 @@ fn tape() -> Tape {
         ops,
         outputs,
         split: None,
+        sections: Vec::new(),
     }
 }
 
@@ -121,6 +122,7 @@ fn long_tape(len: usize) -> Tape {
         ops,
         outputs,
         split: None,
+        sections: Vec::new(),
     }
 }
 

@@ -37,11 +37,12 @@ impl Tape {
                 c.map_or(*op, Op::K)
             })
             .collect();
-        let (ops, outputs) = prune(folded, &self.outputs);
+        let (ops, outputs, sections) = prune(folded, &self.outputs, &self.sections);
         Tape {
             ops,
             outputs,
             split: self.split,
+            sections,
         }
     }
 }
@@ -65,6 +66,7 @@ mod tests {
             ],
             outputs: vec![6, 5],
             split: None,
+            sections: Vec::new(),
         };
         let p = [2.0, 3.0];
         let f = t.fold(&p);

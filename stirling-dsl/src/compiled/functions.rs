@@ -90,6 +90,8 @@ struct Outputs<'i, 'a> {
     groups: Vec<u32>,
     /// The group of the roots pushed now.
     group: u32,
+    /// Whether the groups mark sections ([`Tape::sections`]): a function of the rows.
+    sections: bool,
 }
 
 impl<'i, 'a> Outputs<'i, 'a> {
@@ -100,6 +102,7 @@ impl<'i, 'a> Outputs<'i, 'a> {
             places: Vec::new(),
             groups: Vec::new(),
             group: 0,
+            sections: false,
         }
     }
 
@@ -124,7 +127,8 @@ impl<'i, 'a> Outputs<'i, 'a> {
     fn finish(self) -> Function {
         let mut schedule: Vec<usize> = (0..self.roots.len()).collect();
         schedule.sort_by_key(|&k| self.groups[k]);
-        let tape = Tape::scheduled(&self.inst.out, &self.roots, &schedule);
+        let groups = if self.sections { &self.groups[..] } else { &[] };
+        let tape = Tape::scheduled(&self.inst.out, &self.roots, &schedule, groups);
         Function::new(tape, self.places)
     }
 }
@@ -198,6 +202,7 @@ pub(crate) fn rows(
     which: &[&Rows],
 ) -> Result<Function, InstanceError> {
     let mut out = Outputs::new(inst);
+    out.sections = out.inst.n() > 1;
     for r in which {
         rows_into(&mut out, plan, r)?;
     }

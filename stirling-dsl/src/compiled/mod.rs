@@ -10,6 +10,8 @@
 //!   (`instance`), laid out as a [`Tape`](crate::compiled::Tape) (`functions`) and run by a
 //!   tight interpreter loop, or by native code a [`Jit`](crate::compiled::Jit) compiled
 //!   from it; on request with one parameter vector folded in (`fold`);
+//! - [`Repeat`](crate::compiled::Repeat): the interior sections of a tape that repeat, found
+//!   on the tape, as one loop body for native code (`repeat`);
 //! - the descriptions the trait hands out as `&'static` are leaked once per definition
 //!   (`statics`).
 
@@ -19,6 +21,7 @@ mod functions;
 mod instance;
 mod model;
 mod plan;
+mod repeat;
 mod runner;
 mod statics;
 mod tape;
@@ -27,5 +30,6 @@ pub use definition::Definition;
 pub use functions::Function;
 pub use instance::InstanceError;
 pub use model::{CompileError, CompiledModel};
+pub use repeat::{Arg, LoopLeaf, Repeat, Step};
 pub use runner::{Jit, Runner};
 pub use tape::{Op, Tape};

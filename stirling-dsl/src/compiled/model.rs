@@ -334,6 +334,12 @@ impl CompiledModel {
         &self.fns(p).rhs_jac.tape
     }
 
+    /// The native code of the right-hand side with the Jacobian at `p`, compiled now if it
+    /// was not yet (`None`: no JIT, or it could not compile the tape).
+    pub fn rhs_jacobian_code(&self, p: &[f64]) -> Option<&Arc<dyn super::Runner>> {
+        self.fns(p).rhs_jac.code()
+    }
+
     /// Each vessel element's `[P, V, E, Q, boundary, m, T]`, in order.
     fn each_vessel(&self, p: &[f64], x: &[f64], mut f: impl FnMut(usize, usize, f64)) {
         run(&self.fns(p).vessels, p, x, &[], |(k, t), v| f(k, t, v));

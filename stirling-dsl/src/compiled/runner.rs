@@ -15,6 +15,16 @@ pub trait Runner: Debug + Send + Sync {
     /// `false` (nothing written) when a slice is too short for the tape: the caller runs the
     /// interpreter then.
     fn run(&self, x: &[f64], p: &[f64], v: &[f64], head: &mut [f64], tail: &mut [f64]) -> bool;
+
+    /// Whether the code loops over the tape's repeating sections ([`Tape::repeat`]).
+    fn looped(&self) -> bool {
+        false
+    }
+
+    /// The size of the native code in bytes, if known.
+    fn code_bytes(&self) -> Option<usize> {
+        None
+    }
 }
 
 /// A JIT: the runner of a tape, or `None` where it cannot compile it (the interpreter runs

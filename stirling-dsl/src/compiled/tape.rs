@@ -38,6 +38,12 @@ pub struct Tape {
     /// index minus `s` (e.g. a right-hand side and a Jacobian's values written straight to
     /// the caller's slices); `None`: every output to the first.
     pub split: Option<usize>,
+    /// Where the sections' instructions start, for a function of the rows laid out section
+    /// by section (`Tape::scheduled` with groups): section `j`'s instructions are
+    /// `sections[j]..sections[j + 1]`, the last entry the end of the last section (what
+    /// comes before `sections[0]` is the scalar rows' part). Empty: no sections marked.
+    /// [`Tape::repeat`] finds the sections that repeat from it.
+    pub sections: Vec<u32>,
 }
 
 /// `node` with a negated operand folded in, if it has one, as LLVM folds it in the macro's
@@ -99,8 +105,9 @@ pub(crate) fn renumber(op: Op, to: &[u32]) -> Op {
     }
 }
 
-/// `ops` without the instructions no output reaches, and the outputs renumbered.
-pub(crate) fn prune(ops: Vec<Op>, outputs: &[u32]) -> (Vec<Op>, Vec<u32>) {
+/// `ops` without the instructions no output reaches, the outputs renumbered and the marks
+/// (instruction positions, e.g. [`Tape::sections`]) moved to where their instructions went.
+pub(crate) fn prune(ops: Vec<Op>, outputs: &[u32], marks: &[u32]) -> (Vec<Op>, Vec<u32>, Vec<u32>) {
     let mut live = vec![false; ops.len()];
     for &o in outputs {
         live[o as usize] = true;
@@ -122,7 +129,18 @@ pub(crate) fn prune(ops: Vec<Op>, outputs: &[u32]) -> (Vec<Op>, Vec<u32>) {
         }
     }
     let outputs = outputs.iter().map(|&o| to[o as usize]).collect();
-    (kept, outputs)
+    // a mark at `m` moves to the number of instructions kept before it
+    let mut before = Vec::with_capacity(live.len() + 1);
+    before.push(0u32);
+    for &l in &live {
+        let last = before[before.len() - 1];
+        before.push(last + u32::from(l));
+    }
+    let marks = marks
+        .iter()
+        .map(|&m| before[(m as usize).min(live.len())])
+        .collect();
+    (kept, outputs, marks)
 }
 
 impl Tape {
@@ -131,7 +149,7 @@ impl Tape {
     pub(crate) fn new(arena: &Arena, roots: &[Id]) -> Tape {
         let seen = arena.reachable(roots);
         let nodes = (0..arena.len()).filter(|&i| seen[i]);
-        Tape::in_order(arena, roots, nodes)
+        Tape::in_order(arena, roots, nodes, &[])
     }
 
     /// The tape computing `roots` of `arena`, its instructions in the order a depth-first
@@ -139,14 +157,30 @@ impl Tape {
     /// each value computed close to where it is used, so that native code keeps it in a
     /// register rather than spilling it (e.g. a section's right-hand side next to its
     /// Jacobian entries, which share most of their terms).
-    pub(crate) fn scheduled(arena: &Arena, roots: &[Id], schedule: &[usize]) -> Tape {
+    ///
+    /// `groups` (empty, or one per root, non-decreasing along `schedule`): group 0 the
+    /// scalar part, group `j + 1` section `j`; the tape marks where each section's
+    /// instructions start ([`Tape::sections`]).
+    pub(crate) fn scheduled(
+        arena: &Arena,
+        roots: &[Id],
+        schedule: &[usize],
+        groups: &[u32],
+    ) -> Tape {
         // the taller operand first (Sethi-Ullman): fewer values wait in registers meanwhile
         let height = heights(arena, roots);
         // 0: not visited, 1: children pending, 2: emitted
         let mut state = vec![0u8; arena.len()];
         let mut nodes = Vec::new();
         let mut stack: Vec<(Id, bool)> = Vec::new();
+        // `marks[g]`: the position in `nodes` where group `g + 1` (section `g`) starts
+        let mut marks: Vec<u32> = Vec::new();
         for &k in schedule {
+            if let Some(&g) = groups.get(k) {
+                while marks.len() < g as usize {
+                    marks.push(nodes.len() as u32);
+                }
+            }
             stack.push((roots[k], false));
             while let Some((id, ready)) = stack.pop() {
                 let st = &mut state[id.index()];
@@ -169,14 +203,27 @@ impl Tape {
                 }
             }
         }
-        Tape::in_order(arena, roots, nodes.into_iter())
+        if !marks.is_empty() {
+            marks.push(nodes.len() as u32);
+        }
+        Tape::in_order(arena, roots, nodes.into_iter(), &marks)
     }
 
-    /// The tape of `roots`, its instructions the nodes `nodes` (children before parents).
-    fn in_order(arena: &Arena, roots: &[Id], nodes: impl Iterator<Item = usize>) -> Tape {
+    /// The tape of `roots`, its instructions the nodes `nodes` (children before parents);
+    /// `marks` (positions in `nodes`) become [`Tape::sections`].
+    fn in_order(
+        arena: &Arena,
+        roots: &[Id],
+        nodes: impl Iterator<Item = usize>,
+        marks: &[u32],
+    ) -> Tape {
         let mut reg = vec![u32::MAX; arena.len()];
         let mut ops = Vec::new();
-        for i in nodes {
+        let mut sections = Vec::with_capacity(marks.len());
+        for (at, i) in nodes.enumerate() {
+            while sections.len() < marks.len() && marks[sections.len()] as usize == at {
+                sections.push(ops.len() as u32);
+            }
             let r = |c: Id| reg[c.index()];
             let node = arena.node(Id(i as u32));
             if let Some(op) = fused(arena, &reg, node) {
@@ -209,12 +256,16 @@ impl Tape {
             reg[i] = ops.len() as u32;
             ops.push(op);
         }
+        while sections.len() < marks.len() {
+            sections.push(ops.len() as u32);
+        }
         let outputs: Vec<u32> = roots.iter().map(|r| reg[r.index()]).collect();
-        let (ops, outputs) = prune(ops, &outputs);
+        let (ops, outputs, sections) = prune(ops, &outputs, &sections);
         Tape {
             ops,
             outputs,
             split: None,
+            sections,
         }
     }
 
@@ -305,7 +356,7 @@ mod tests {
     fn a_scheduled_tape_computes_the_same_outputs() {
         let (a, roots) = arena();
         let t = Tape::new(&a, &roots);
-        let s = Tape::scheduled(&a, &roots, &[2, 0, 1]);
+        let s = Tape::scheduled(&a, &roots, &[2, 0, 1], &[]);
         assert_eq!(s.ops.len(), t.ops.len());
         // the walk starts at the third root: `x0`, then `x0 * x0`
         assert_eq!(&s.ops[..2], &[Op::X(0), Op::Mul(0, 0)]);
