@@ -74,7 +74,11 @@ pub fn run(a: &FitArgs) -> anyhow::Result<()> {
     if let Some(dir) = &a.plot {
         files::prepare_dir(dir, &FIGURES, a.force, "--plot")?;
     }
-    let (data, lines) = common::read_record(&a.data, a.drop_outliers)?;
+    let (data, lines) = common::read_record(
+        &a.data,
+        a.drop_outliers,
+        (a.train.as_deref(), a.holdout.as_deref()),
+    )?;
     check_uniform(&data, Some(&lines))?;
     let (train, holdout) = common::blocks(a.train.as_deref(), a.holdout.as_deref(), &data, 0.7)?;
     let model = stirling_models::build(&a.model, a.with.n, Closure::Full)?;

@@ -58,7 +58,7 @@ pub struct RigArgs {
     #[arg(long, default_value_t = 2e-3, allow_negative_numbers = true, value_parser = ranges::finite)]
     pub x0: f64,
     /// Noise seed
-    #[arg(long, default_value_t = 1)]
+    #[arg(long, default_value_t = 1, allow_negative_numbers = true, value_parser = ranges::seed)]
     pub seed: u64,
     /// Channels to write besides t: the seed's sensors p (cold side), x, y by default; add
     /// p_hot (hot-side pressure, multi-CV models) for a richer rig than the seed's engine had

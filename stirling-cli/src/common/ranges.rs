@@ -93,6 +93,24 @@ pub fn at_least_one(s: &str) -> Parsed<usize> {
     Ok(v as usize)
 }
 
+/// A noise seed: a whole number from 0 to 2^64 - 1 (a negative one is refused by this range,
+/// not taken for an option).
+pub fn seed(s: &str) -> Parsed<u64> {
+    if let Ok(v) = s.trim().parse::<u64>() {
+        return Ok(v);
+    }
+    let v = integer(s)?;
+    if v < 0.0 {
+        return Err(RangeError::Outside(
+            "a seed is a whole number from 0 to 2^64 - 1, e.g. --seed 1",
+        ));
+    }
+    if v >= 1.8446744073709552e19 {
+        return Err(RangeError::Outside("is too large (a seed is at most 2^64 - 1)"));
+    }
+    Ok(v as u64)
+}
+
 /// A number of output samples in [2, MAX_SAMPLES].
 pub fn samples(s: &str) -> Parsed<usize> {
     let v = integer(s)?;
