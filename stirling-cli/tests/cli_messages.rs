@@ -1,0 +1,71 @@
+//! Errors a user can act on (issue 38, "errors a user cannot act on"): each names its cause
+//! and a next step - old Mac line endings, a negative seed, an empty self-check evaluation
+//! set, the parameter value where a root locus fails.
+
+mod support;
+
+use support::{fails_with, s, scratch};
+
+#[test]
+fn carriage_return_line_ends_are_named_not_an_empty_file() {
+    let dir = scratch("msg_cr");
+    let f = dir.join("mac.csv");
+    let mut text = String::from("t,p,x,y\r");
+    for k in 0..100 {
+        text.push_str(&format!("{},101325,0.001,0.002\r", k as f64 * 1e-3));
+    }
+    std::fs::write(&f, text).unwrap();
+    let err = fails_with(
+        &["fit", "cv1", "--data", s(&f)],
+        &["carriage returns (CR)", "old Mac line endings", "convert them to LF"],
+    );
+    assert!(!err.contains("empty"), "{err}");
+}
+
+#[test]
+fn a_negative_seed_is_refused_by_its_range_not_taken_for_an_option() {
+    let dir = scratch("msg_seed");
+    for args in [
+        &["rig", "cv1", "--seed", "-1", "--out", s(&dir.join("r.csv"))][..],
+        &["diagnose", "--self-check", "--seed", "-1", "--out", s(&dir)][..],
+    ] {
+        let err = fails_with(args, &["'-1'", "a seed is a whole number from 0"]);
+        assert!(!err.contains("to pass '-1' as a value"), "{err}");
+    }
+    fails_with(
+        &["rig", "cv1", "--seed", "1.5", "--out", s(&dir.join("r.csv"))],
+        &["not a whole number"],
+    );
+}
+
+#[test]
+fn an_empty_self_check_evaluation_set_is_refused_up_front() {
+    let dir = scratch("msg_selfcheck");
+    let start = std::time::Instant::now();
+    fails_with(
+        &[
+            "diagnose",
+            "--self-check",
+            "--seeds",
+            "1:0",
+            "--clean",
+            "10:0",
+            "--out",
+            s(&dir),
+        ],
+        &["evaluation set is empty", "--seeds 1:1"],
+    );
+    // it took 44 s of tuning cases before
+    assert!(start.elapsed().as_secs_f64() < 10.0);
+    assert!(!dir.join("selfcheck.json").exists());
+}
+
+#[test]
+fn a_root_locus_names_the_parameter_value_where_it_fails() {
+    fails_with(
+        &[
+            "locus", "cv1", "--param", "Pb", "--from", "1e5", "--to", "1e7", "--steps", "5",
+        ],
+        &["at Pb = ", "point ", "sweep a range that ends before it"],
+    );
+}
