@@ -213,6 +213,20 @@ impl Errors<'_> {
     }
 }
 
+/// The next line that is neither blank nor a comment, trimmed.
+fn next<R: std::io::BufRead>(
+    source: &mut Lines<R>,
+) -> Result<Option<(usize, String)>, DataError> {
+    for r in source.by_ref() {
+        let (i, l) = r?;
+        let l = l.trim();
+        if !l.is_empty() && !l.starts_with('#') {
+            return Ok(Some((i, l.to_string())));
+        }
+    }
+    Ok(None)
+}
+
 /// The rows of a record: comment and blank lines skipped, each row's time checked against
 /// the previous row's, the rows inside `lim.keep` stored.
 fn parse<R: std::io::BufRead>(
@@ -222,17 +236,7 @@ fn parse<R: std::io::BufRead>(
     lim: &ReadLimits,
 ) -> Result<(Measured, Vec<usize>), DataError> {
     let e = Errors { file };
-    let mut next = || -> Result<Option<(usize, String)>, DataError> {
-        for r in source.by_ref() {
-            let (i, l) = r?;
-            let l = l.trim();
-            if !l.is_empty() && !l.starts_with('#') {
-                return Ok(Some((i, l.to_string())));
-            }
-        }
-        Ok(None)
-    };
-    let first_line = next()?;
+    let first_line = next(source)?;
     let raw = first_line
         .as_ref()
         .map(|(_, l)| l.clone())
@@ -249,7 +253,7 @@ fn parse<R: std::io::BufRead>(
     let mut rows = Vec::new();
     let (mut read, mut first, mut prev) = (0usize, None, None);
     let mut last_row = hrow;
-    while let Some((row, line)) = next()? {
+    while let Some((row, line)) = next(source)? {
         let fields: Vec<&str> = line.split(',').map(str::trim).collect();
         let tv = e.field(row, &fields, names.len(), (it, "t"))?;
         e.check_time(row, tv, prev)?;
