@@ -60,7 +60,7 @@ rec("not.csv", header="time,p,x,y")
 rec("other.csv", header="t,a,b,c")
 rec("upper.csv", header="T,P,X,Y")
 rec("ms.csv", tscale=1e3)
-rec("ps.csv", dt=1e-12 * 20, f=13.4)
+rec("ps.csv", tscale=1e-12 / 5e-4)
 rec("coarse.csv", n=1200, dt=1 / 120)
 rec("alias.csv", n=600, dt=1.0)
 rec("short.csv", n=100)
@@ -131,7 +131,7 @@ err "no data rows" fit cv1 --data header.csv
 err "only one data row" fit cv1 --data onerow.csv
 err "the file is empty" fit cv1 --data comments.csv
 err "JSON" fit cv1 --data json.csv
-err "UTF-8" fit cv1 --data binary.csv
+err "not a text file" fit cv1 --data binary.csv
 err "UTF-8" fit cv1 --data utf16.csv
 err "separators" fit cv1 --data semi.csv
 err "tab-separated" fit cv1 --data tab.csv
@@ -139,7 +139,7 @@ err "carriage returns" fit cv1 --data cr.csv
 err "appears twice" fit cv1 --data dupcol.csv
 err "missing column \`t\`" fit cv1 --data not.csv
 err "missing column \`t\`" fit cv1 --data upper.csv
-err "no measured channel" fit cv1 --data other.csv
+err "none of its columns" fit cv1 --data other.csv
 err "time goes backwards" fit cv1 --data back.csv
 err "duplicate time" fit cv1 --data dupt.csv
 err "NaN" fit cv1 --data nan.csv
@@ -164,7 +164,7 @@ err "samples per cycle" fit cv1 --data alias.csv
 err "fewer than two cycles" fit cv1 --data short.csv
 err "does not move enough" fit cv1 --data still.csv
 err "uniform" fit cv1 --data jitter.csv
-err "only one data row" fit cv1 --data crlf.csv --train 0:0.001 --holdout 0.001:0.002
+err "too few to fit" fit cv1 --data crlf.csv --train 0:0.001 --holdout 0.001:0.002
 err "No such file" fit cv1 --data nosuch.csv
 err "directory" fit cv1 --data dir.csv
 err "the file is empty" diagnose cv1 --data empty.csv
@@ -224,8 +224,13 @@ err "not a whole number" rig cv1 --seed 1.5 --out out/r.csv
 err "too large" rig cv1 --seed 1e30 --out out/r.csv
 err "noise" rig cv1 --noise x=-1 --out out/r.csv
 err "foo" rig cv1 --channels foo --out out/r.csv
-err "twice" rig cv1 --channels x,x --out out/r.csv
-err "nosuchdir" rig cv1 --t-end 0.5 --out nosuchdir/r.csv
+err "named twice" rig cv1 --channels x,x --out out/r.csv
+err "named twice" rig cv1 --effect leak=1e-8 --effect leak=2e-8 --out out/r.csv
+err "named twice" rig cv1 --noise x=1e-5 --noise x=2e-5 --out out/r.csv
+err "named twice" diagnose --self-check --channels p,p,x --out out/sc
+err "named twice" diagnose --self-check --strengths 1,1 --out out/sc
+err "none of its columns" diagnose cv1 --data other.csv
+ok rig cv1 --t-end 0.5 --out out/new/folder/r.csv
 # sweeps
 err "count k" sweep cv1 --grid Th=500:700:0 --out out/s
 err "values on one axis" sweep cv1 --grid Th=500:700:1000000000 --poles-only --out out/s
@@ -233,7 +238,7 @@ err "NAME=a:b:k" sweep cv1 --grid Th --out out/s
 err "nosuch" sweep cv1 --grid nosuch=1:2:3 --out out/s
 err "not a finite number" sweep cv1 --grid Th=a:b:3 --out out/s
 err "a:b:k" sweep cv1 --grid Th=1:2:3:4 --out out/s
-err "--shard" sweep cv1 --grid Th=500:700:4 --grid Tk=280:320:4 --grid Pmean=1e5:2e5:100000 --poles-only --out out/s
+err "--shard" sweep cv1 --grid Th=500:700:4 --grid Tk=280:320:4 --grid Pmean=1e5:2e5:1000000 --poles-only --out out/s
 err "shard" sweep cv1 --grid Th=500:700:4 --shard 0/2 --out out/s
 err "shard" sweep cv1 --grid Th=500:700:4 --shard 3/2 --out out/s
 err "shard" sweep cv1 --grid Th=500:700:4 --shard a/b --out out/s
@@ -253,7 +258,7 @@ err "a seed is a whole number" diagnose --self-check --seed -1 --out out/sc
 # the command line itself
 err "unrecognized subcommand" frobnicate
 err "unexpected argument" linearize cv1 --nosuch
-err "info" info nosuch
+err "unknown model" info nosuch
 # unusual but valid: answered
 ok linearize cv1
 ok linearize cv1 --set kd=6.5e9

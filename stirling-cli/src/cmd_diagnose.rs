@@ -154,6 +154,7 @@ pub fn run(a: &DiagnoseArgs) -> anyhow::Result<()> {
     check_uniform(&data, Some(&lines))?;
     let (train, holdout) = common::blocks(a.train.as_deref(), a.holdout.as_deref(), &data, 0.6)?;
     let (model, mut p0) = diagnose::nominal_model(model_name, a.with.n)?;
+    common::check_channels(model.as_ref(), &data)?;
     a.with.apply(model.as_ref(), &mut p0)?;
     let bounds = common::bounds_file(model.as_ref(), a.bounds.as_deref())?;
     let opts = DiagnoseOptions {
@@ -218,6 +219,14 @@ fn run_self_check(a: &DiagnoseArgs) -> anyhow::Result<()> {
         s => effects_arg(s),
     };
     empty_evaluation(a, outside.as_ref())?;
+    common::unique("--channels", &a.channels, |c| c.trim().to_string())?;
+    common::unique("--strengths", &a.strengths, |v| v.to_string())?;
+    common::unique("--outside-strengths", &a.outside_strengths, |v| {
+        v.to_string()
+    })?;
+    if let Some(o) = &outside {
+        common::unique("--outside", o, |c| c.clone())?;
+    }
     let model = a.model.clone().unwrap_or_else(|| "nsection".into());
     let n = match model.as_str() {
         "nsection" => a.with.n.or(Some(2)),

@@ -7,7 +7,7 @@ use std::io::Write;
 use clap::Args;
 use stirling_models::rig::{self, RigConfig};
 
-use crate::common::ranges;
+use crate::common::{self, ranges};
 
 /// Arguments of `stirling rig`.
 #[derive(Args, Debug)]
@@ -76,6 +76,10 @@ pub struct RigArgs {
 }
 
 pub fn run(a: &RigArgs) -> anyhow::Result<()> {
+    let name = |s: &String| s.split('=').next().unwrap_or("").trim().to_string();
+    common::unique("--channels", &a.channels, |c| c.trim().to_string())?;
+    common::unique("--effect", &a.effect, name)?;
+    common::unique("--noise", &a.noise, |(c, _)| c.clone())?;
     let cfg = RigConfig {
         model: a.model.clone(),
         n: a.with.n,

@@ -51,6 +51,53 @@ pub fn read_record(
     Ok((data, lines))
 }
 
+/// A list option names each item once: `--channels x,x` or `--effect leak=1 --effect leak=2`
+/// is refused (which one would count?). `key` gives an item's name (`NAME` of `NAME=VALUE`).
+pub fn unique<'a, T: 'a>(
+    option: &str,
+    items: impl IntoIterator<Item = &'a T>,
+    key: impl Fn(&T) -> String,
+) -> anyhow::Result<()> {
+    let mut seen = std::collections::HashSet::new();
+    for it in items {
+        let k = key(it);
+        if !seen.insert(k.clone()) {
+            anyhow::bail!("{option}: `{k}` is named twice: name each once");
+        }
+    }
+    Ok(())
+}
+
+/// The record holds a channel the model reads: one of p, p_hot, x, y or a sensor it declares
+/// (a record with other columns only would end in a misleading "fewer than two cycles").
+pub fn check_channels(
+    model: &dyn Model,
+    data: &stirling_models::data::Measured,
+) -> anyhow::Result<()> {
+    let sensors: Vec<&str> = model.sensors().iter().map(|s| s.name).collect();
+    let has_sensor = data
+        .others
+        .iter()
+        .any(|(n, _)| sensors.contains(&n.as_str()));
+    if !data
+        .channels()
+        .iter()
+        .any(|c| stirling_models::data::CHANNELS.contains(c))
+        && !has_sensor
+    {
+        let mut reads: Vec<&str> = stirling_models::data::CHANNELS.to_vec();
+        reads.extend(&sensors);
+        anyhow::bail!(
+            "{}: none of its columns ({}) is a channel `{}` reads ({}): name the columns in the header, e.g. t,p,x,y",
+            data.source,
+            data.channels().join(", "),
+            model.name(),
+            reads.join(", ")
+        );
+    }
+    Ok(())
+}
+
 /// The bounds of `--bounds FILE` (none without the option).
 pub fn bounds_file(
     model: &dyn Model,

@@ -63,7 +63,15 @@ fn a_record_past_the_memory_limit_is_refused_up_front_with_the_next_step() {
     let (ok, err) = with_limit(
         "50",
         &[
-            "fit", "cv1", "--data", s(&f), "--train", "0:1", "--holdout", "1:1.5", "--free",
+            "fit",
+            "cv1",
+            "--data",
+            s(&f),
+            "--train",
+            "0:1",
+            "--holdout",
+            "1:1.5",
+            "--free",
             "nosuch",
         ],
     );
@@ -73,7 +81,16 @@ fn a_record_past_the_memory_limit_is_refused_up_front_with_the_next_step() {
     // blocks that are themselves too large are refused the same way
     let (ok, err) = with_limit(
         "50",
-        &["fit", "cv1", "--data", s(&f), "--train", "0:60", "--holdout", "60:90"],
+        &[
+            "fit",
+            "cv1",
+            "--data",
+            s(&f),
+            "--train",
+            "0:60",
+            "--holdout",
+            "60:90",
+        ],
     );
     assert!(!ok);
     assert!(err.contains("the blocks asked for hold about"), "{err}");
@@ -83,7 +100,16 @@ fn a_record_past_the_memory_limit_is_refused_up_front_with_the_next_step() {
 fn blocks_outside_a_windowed_record_are_named_with_the_record_span() {
     let f = long_record("mem_outside", 4000);
     fails_with(
-        &["fit", "cv1", "--data", s(&f), "--train", "10:11", "--holdout", "11:12"],
+        &[
+            "fit",
+            "cv1",
+            "--data",
+            s(&f),
+            "--train",
+            "10:11",
+            "--holdout",
+            "11:12",
+        ],
         &["record runs from 0 s to 1.9995 s", "inside the record"],
     );
 }

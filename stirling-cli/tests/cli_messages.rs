@@ -17,7 +17,11 @@ fn carriage_return_line_ends_are_named_not_an_empty_file() {
     std::fs::write(&f, text).unwrap();
     let err = fails_with(
         &["fit", "cv1", "--data", s(&f)],
-        &["carriage returns (CR)", "old Mac line endings", "convert them to LF"],
+        &[
+            "carriage returns (CR)",
+            "old Mac line endings",
+            "convert them to LF",
+        ],
     );
     assert!(!err.contains("empty"), "{err}");
 }
@@ -33,7 +37,14 @@ fn a_negative_seed_is_refused_by_its_range_not_taken_for_an_option() {
         assert!(!err.contains("to pass '-1' as a value"), "{err}");
     }
     fails_with(
-        &["rig", "cv1", "--seed", "1.5", "--out", s(&dir.join("r.csv"))],
+        &[
+            "rig",
+            "cv1",
+            "--seed",
+            "1.5",
+            "--out",
+            s(&dir.join("r.csv")),
+        ],
         &["not a whole number"],
     );
 }

@@ -106,7 +106,9 @@ pub fn seed(s: &str) -> Parsed<u64> {
         ));
     }
     if v >= 1.8446744073709552e19 {
-        return Err(RangeError::Outside("is too large (a seed is at most 2^64 - 1)"));
+        return Err(RangeError::Outside(
+            "is too large (a seed is at most 2^64 - 1)",
+        ));
     }
     Ok(v as u64)
 }

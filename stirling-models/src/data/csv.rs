@@ -214,9 +214,7 @@ impl Errors<'_> {
 }
 
 /// The next line that is neither blank nor a comment, trimmed.
-fn next<R: std::io::BufRead>(
-    source: &mut Lines<R>,
-) -> Result<Option<(usize, String)>, DataError> {
+fn next<R: std::io::BufRead>(source: &mut Lines<R>) -> Result<Option<(usize, String)>, DataError> {
     for r in source.by_ref() {
         let (i, l) = r?;
         let l = l.trim();

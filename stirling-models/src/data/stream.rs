@@ -116,6 +116,13 @@ impl<R: BufRead> Iterator for Lines<R> {
                     .into(),
             )));
         }
+        if let Some(c) = text.chars().find(|c| c.is_control() && *c != '\t') {
+            let hint = format_hint(&self.file, "");
+            return Some(Err(self.err(format!(
+                "not a text file: control character {:#04x} in the line{hint}",
+                c as u32
+            ))));
+        }
         Some(Ok((self.line, text.to_string())))
     }
 }

@@ -70,8 +70,7 @@ pub fn locus(
             points: values.len(),
             source: Box::new(e),
         };
-        crate::params::validate(model, &q)
-            .map_err(|e| at(LinearError::Param(e.to_string())))?;
+        crate::params::validate(model, &q).map_err(|e| at(LinearError::Param(e.to_string())))?;
         let d = dynamic_poles(model, &q, newton).map_err(at)?;
         points.push(LocusPoint {
             value: v,
