@@ -160,7 +160,8 @@ err "outlier" fit cv1 --data outp.csv
 err "milliseconds" fit cv1 --data ms.csv
 err "time column's unit" fit cv1 --data ps.csv
 err "samples per cycle" fit cv1 --data coarse.csv
-err "samples per cycle" fit cv1 --data alias.csv
+err "alias" fit cv1 --data alias.csv
+err "alias" diagnose cv1 --data alias.csv
 err "fewer than two cycles" fit cv1 --data short.csv
 err "does not move enough" fit cv1 --data still.csv
 err "uniform" fit cv1 --data jitter.csv

@@ -9,9 +9,11 @@ mod blocks;
 pub mod files;
 /// Value parsers for the numeric options.
 pub mod ranges;
+mod sampling;
 mod stdout;
 
 pub use blocks::blocks;
+pub use sampling::check_sampling;
 pub use stdout::{is_stdout_closed, note, print, print_json, stdout};
 
 use std::path::PathBuf;

@@ -80,3 +80,27 @@ fn a_root_locus_names_the_parameter_value_where_it_fails() {
         &["at Pb = ", "point ", "sweep a range that ends before it"],
     );
 }
+
+#[test]
+fn a_record_sampled_once_a_second_is_refused_as_aliased_not_as_a_still_engine() {
+    // 13.4 Hz sampled at 1 Hz: the samples trace a 0.4 Hz alias; it was "does `p` move? is
+    // the engine running?" (and kd 55.8 instead of 650.7 on the rig's record)
+    let f = scratch("msg_alias").join("alias.csv");
+    let mut text = String::from("t,p,x,y\n");
+    for k in 0..600 {
+        let t = k as f64;
+        let w = (std::f64::consts::TAU * 13.4 * t).sin();
+        let v = (std::f64::consts::TAU * 13.4 * t + 1.4).sin();
+        text.push_str(&format!(
+            "{t},{},{},{}\n",
+            101325.0 + 5800.0 * w,
+            0.0079 * v,
+            0.0062 * w
+        ));
+    }
+    std::fs::write(&f, text).unwrap();
+    for cmd in ["fit", "diagnose"] {
+        let err = fails_with(&[cmd, "cv1", "--data", s(&f)], &["the model at", "alias"]);
+        assert!(!err.contains("is the engine running"), "{err}");
+    }
+}
