@@ -154,7 +154,7 @@ pub fn run(a: &DiagnoseArgs) -> anyhow::Result<()> {
     check_uniform(&data, Some(&lines))?;
     let (train, holdout) = common::blocks(a.train.as_deref(), a.holdout.as_deref(), &data, 0.6)?;
     let (model, mut p0) = diagnose::nominal_model(model_name, a.with.n)?;
-    common::check_channels(model.as_ref(), &data)?;
+    common::check_channels(model_name, model.as_ref(), &data)?;
     a.with.apply(model.as_ref(), &mut p0)?;
     common::check_sampling(model.as_ref(), &p0, &data, train, 0.6)?;
     let bounds = common::bounds_file(model.as_ref(), a.bounds.as_deref())?;

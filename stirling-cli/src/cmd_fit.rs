@@ -82,7 +82,7 @@ pub fn run(a: &FitArgs) -> anyhow::Result<()> {
     check_uniform(&data, Some(&lines))?;
     let (train, holdout) = common::blocks(a.train.as_deref(), a.holdout.as_deref(), &data, 0.7)?;
     let model = stirling_models::build(&a.model, a.with.n, Closure::Full)?;
-    common::check_channels(model.as_ref(), &data)?;
+    common::check_channels(&a.model, model.as_ref(), &data)?;
     let p0 = a.with.load(model.as_ref())?;
     common::check_sampling(model.as_ref(), &p0, &data, train, 0.7)?;
     let bounds = common::bounds_file(model.as_ref(), a.bounds.as_deref())?;

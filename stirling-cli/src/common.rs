@@ -73,6 +73,7 @@ pub fn unique<'a, T: 'a>(
 /// The record holds a channel the model reads: one of p, p_hot, x, y or a sensor it declares
 /// (a record with other columns only would end in a misleading "fewer than two cycles").
 pub fn check_channels(
+    name: &str,
     model: &dyn Model,
     data: &stirling_models::data::Measured,
 ) -> anyhow::Result<()> {
@@ -88,12 +89,16 @@ pub fn check_channels(
         && !has_sensor
     {
         let mut reads: Vec<&str> = stirling_models::data::CHANNELS.to_vec();
-        reads.extend(&sensors);
+        for s in sensors {
+            if !reads.contains(&s) {
+                reads.push(s);
+            }
+        }
         anyhow::bail!(
             "{}: none of its columns ({}) is a channel `{}` reads ({}): name the columns in the header, e.g. t,p,x,y",
             data.source,
             data.channels().join(", "),
-            model.name(),
+            name,
             reads.join(", ")
         );
     }

@@ -104,3 +104,72 @@ fn a_record_sampled_once_a_second_is_refused_as_aliased_not_as_a_still_engine() 
         assert!(!err.contains("is the engine running"), "{err}");
     }
 }
+
+#[test]
+fn a_name_given_twice_in_a_list_option_is_refused() {
+    let dir = scratch("msg_lists");
+    let out = dir.join("r.csv");
+    for args in [
+        &["rig", "cv1", "--channels", "x,x", "--out", s(&out)][..],
+        &[
+            "rig",
+            "cv1",
+            "--effect",
+            "leak=1e-8",
+            "--effect",
+            "leak=2e-8",
+            "--out",
+            s(&out),
+        ][..],
+        &[
+            "rig",
+            "cv1",
+            "--noise",
+            "x=1e-5",
+            "--noise",
+            "x=2e-5",
+            "--out",
+            s(&out),
+        ][..],
+        &[
+            "diagnose",
+            "--self-check",
+            "--strengths",
+            "1,1",
+            "--out",
+            s(&dir),
+        ][..],
+    ] {
+        fails_with(args, &["is named twice", "name each once"]);
+    }
+    assert!(!out.exists());
+}
+
+#[test]
+fn a_record_without_a_channel_the_model_reads_is_named() {
+    // columns t,a,b,c: it ended in "the training block holds fewer than two cycles"
+    let f = scratch("msg_columns").join("other.csv");
+    let mut text = String::from("t,a,b,c\n");
+    for k in 0..4000 {
+        let t = k as f64 * 5e-4;
+        let w = (std::f64::consts::TAU * 13.4 * t).sin();
+        text.push_str(&format!(
+            "{t},{},{},{}\n",
+            101325.0 + 5800.0 * w,
+            0.0079 * w,
+            0.0062 * w
+        ));
+    }
+    std::fs::write(&f, text).unwrap();
+    for cmd in ["fit", "diagnose"] {
+        let err = fails_with(
+            &[cmd, "cv1", "--data", s(&f)],
+            &[
+                "none of its columns (a, b, c)",
+                "`cv1` reads (p, p_hot, x, y",
+                "t,p,x,y",
+            ],
+        );
+        assert!(!err.contains("fewer than two cycles"), "{err}");
+    }
+}
