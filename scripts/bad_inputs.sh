@@ -214,6 +214,8 @@ err "times its default" linearize nsection --n 2 --set Rf=1e-9
 err "t-end" simulate cv1 --t-end -1
 err "t-end" simulate cv1 --t-end 0
 err "between 2" simulate cv1 --samples 1
+err "stable at rest" simulate cv1 --set Th=320 --limit-cycle --t-end 2
+err "stable at rest" simulate cv1 --set Th=320 --limit-cycle --t-end 0.2
 err "[1e-14, 0.1]" simulate cv1 --t-end 0.1 --atol 1e-30
 err "[1e-14, 0.1]" simulate cv1 --t-end 0.1 --rtol 1e-20
 err "between 2" simulate cv1 --samples 1e9

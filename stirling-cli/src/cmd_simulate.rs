@@ -143,7 +143,14 @@ fn simulate(
             shooting,
             Some(progress),
         )
+        .map_err(|e| match common::rest::stable_at_rest(model, p) {
+            // its "run longer" would not help
+            Some(re) => anyhow::anyhow!("no limit cycle: {}", common::rest::no_cycle(re)),
+            None => e.into(),
+        })
         .with_context(|| format!("limit cycle of `{}`", model.name()))?;
+        common::rest::check_cycle(model, p, &lc)
+            .with_context(|| format!("limit cycle of `{}`", model.name()))?;
         let tr = lc.settled.trajectory.clone();
         let s = SimSummary::from_run(model, &tr).with_cycle(&lc);
         return Ok((tr, s, Some(lc)));

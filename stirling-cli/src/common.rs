@@ -9,6 +9,8 @@ mod blocks;
 pub mod files;
 /// Value parsers for the numeric options.
 pub mod ranges;
+/// A limit cycle asked of an engine stable at rest.
+pub mod rest;
 mod sampling;
 mod stdout;
 

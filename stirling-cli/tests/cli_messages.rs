@@ -173,3 +173,30 @@ fn a_record_without_a_channel_the_model_reads_is_named() {
         assert!(!err.contains("fewer than two cycles"), "{err}");
     }
 }
+
+#[test]
+fn a_limit_cycle_of_an_engine_stable_at_rest_is_refused_with_the_cause() {
+    // Th = 320 K against Tk = 300 K: every pole at rest is stable. A long run closed the
+    // shooting on the rest state and printed a "limit cycle" of zero amplitude with exit 0;
+    // a short one said "run longer".
+    for t_end in ["2", "0.2"] {
+        let err = fails_with(
+            &[
+                "simulate",
+                "cv1",
+                "--set",
+                "Th=320",
+                "--limit-cycle",
+                "--t-end",
+                t_end,
+            ],
+            &[
+                "no limit cycle",
+                "stable at rest",
+                "stirling linearize",
+                "temperature ratio",
+            ],
+        );
+        assert!(!err.contains("run longer"), "{err}");
+    }
+}
