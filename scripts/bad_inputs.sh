@@ -83,7 +83,7 @@ open("negative.toml", "w").write("kd = -5.0\n")
 open("params.json", "w").write('{"kd": "fast"}\n')
 open("bounds.toml", "w").write("[kd]\nlo = 10\nhi = 1\n")
 PY
-mkdir -p keep dir.csv
+mkdir -p keep dir.csv side/r.csv.truth.json
 echo '{}' > keep/selfcheck.json
 KEEP_SUM=$(cat keep.csv keep/selfcheck.json | md5sum)
 
@@ -221,6 +221,9 @@ err "[1e-14, 0.1]" simulate cv1 --t-end 0.1 --rtol 1e-20
 err "between 2" simulate cv1 --samples 1e9
 err "exists" simulate cv1 --t-end 0.1 --out keep.csv
 err "exists" rig cv1 --t-end 0.5 --out keep.csv
+err "is a folder" rig cv1 --t-end 0.5 --out side/r.csv --force
+err "is a folder" rig cv1 --t-end 0.5 --out dir.csv --force
+err "is a folder" simulate cv1 --t-end 0.1 --out dir.csv --force
 err "rate" rig cv1 --rate 0 --out out/r.csv
 err "rate" rig cv1 --rate -5 --out out/r.csv
 err "rate" rig cv1 --rate nan --out out/r.csv

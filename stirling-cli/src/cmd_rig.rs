@@ -101,7 +101,16 @@ pub fn run(a: &RigArgs) -> anyhow::Result<()> {
         truth: a.truth.clone(),
     };
     // refuse before the (long) simulation
+    // both files of the pair: a folder in the sidecar's place would leave the record alone
     for f in [a.out.clone(), rig::sidecar_path(&a.out)] {
+        if f.is_dir() {
+            anyhow::bail!(
+                "`{}` is a folder: the record and its truth sidecar ({}) must both be files; \
+                 choose another --out or move the folder",
+                f.display(),
+                rig::sidecar_path(&a.out).display()
+            );
+        }
         if f.exists() && !a.force {
             anyhow::bail!("`{}` exists: pass --force to overwrite", f.display());
         }
