@@ -137,7 +137,7 @@ pub struct Estimate {
 }
 
 impl Estimate {
-    /// Whether to judge now: after [`SAMPLE_ROWS`] data rows, or at the end of the file.
+    /// Whether to judge now: after the first 1000 data rows (a shorter record is small).
     pub fn due(rows: usize) -> bool {
         rows == SAMPLE_ROWS
     }
