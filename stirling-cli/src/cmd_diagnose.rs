@@ -79,7 +79,7 @@ pub struct DiagnoseArgs {
     #[arg(long, value_delimiter = ',', default_value = "p,x,y")]
     pub channels: Vec<String>,
     /// Self-check: first noise seed (tuning seeds from it, evaluation seeds from it + 1000)
-    #[arg(long, default_value_t = 5)]
+    #[arg(long, default_value_t = 5, allow_negative_numbers = true, value_parser = ranges::seed)]
     pub seed: u64,
     /// Self-check: noise seeds per effect and outside case, TUNE:EVAL (thresholds are chosen
     /// on the tuning seeds, the accuracy is counted on the evaluation seeds)
@@ -146,11 +146,17 @@ pub fn run(a: &DiagnoseArgs) -> anyhow::Result<()> {
     if let Some(dir) = &a.report {
         files::prepare_dir(dir, &REPORT, a.force, "--report")?;
     }
-    let (data, lines) = common::read_record(path, a.drop_outliers)?;
+    let (data, lines) = common::read_record(
+        path,
+        a.drop_outliers,
+        (a.train.as_deref(), a.holdout.as_deref()),
+    )?;
     check_uniform(&data, Some(&lines))?;
     let (train, holdout) = common::blocks(a.train.as_deref(), a.holdout.as_deref(), &data, 0.6)?;
     let (model, mut p0) = diagnose::nominal_model(model_name, a.with.n)?;
+    common::check_channels(model_name, model.as_ref(), &data)?;
     a.with.apply(model.as_ref(), &mut p0)?;
+    common::check_sampling(model.as_ref(), &p0, &data, train, 0.6)?;
     let bounds = common::bounds_file(model.as_ref(), a.bounds.as_deref())?;
     let opts = DiagnoseOptions {
         fit: stirling_models::fit::FitOptions {
@@ -181,6 +187,29 @@ pub fn run(a: &DiagnoseArgs) -> anyhow::Result<()> {
     Ok(print_text(&mut common::stdout(), path, &d)?)
 }
 
+/// An evaluation set without a case is refused before any record is made (it failed after
+/// the tuning cases' 44 s): no evaluation seed of an effect, an outside cause or a pair, and no
+/// clean evaluation record.
+fn empty_evaluation(a: &DiagnoseArgs, outside: Option<&Vec<String>>) -> anyhow::Result<()> {
+    let effect_cases = a.seeds.1 > 0
+        && (effects_arg(&a.effects).is_none_or(|e| !e.is_empty())
+            || outside.is_none_or(|o| !o.is_empty())
+            || a.pair_strength > 0.0);
+    if effect_cases || a.clean.1 > 0 {
+        return Ok(());
+    }
+    bail!(
+        "the self-check's evaluation set is empty (--seeds {}:{} --clean {}:{}): nothing to count \
+         verdicts on; give at least one evaluation seed, e.g. --seeds {}:1 or --clean {}:1",
+        a.seeds.0,
+        a.seeds.1,
+        a.clean.0,
+        a.clean.1,
+        a.seeds.0,
+        a.clean.0
+    )
+}
+
 /// `--self-check`: the verdict self-check (rig records with library effects, causes outside
 /// the library and clean records; thresholds tuned on one seed set, verdicts counted on the
 /// other); fails when the evaluation accuracy is under 90 % or false alarms over 5 %.
@@ -190,6 +219,15 @@ fn run_self_check(a: &DiagnoseArgs) -> anyhow::Result<()> {
         "none" => Some(Vec::new()),
         s => effects_arg(s),
     };
+    empty_evaluation(a, outside.as_ref())?;
+    common::unique("--channels", &a.channels, |c| c.trim().to_string())?;
+    common::unique("--strengths", &a.strengths, |v| v.to_string())?;
+    common::unique("--outside-strengths", &a.outside_strengths, |v| {
+        v.to_string()
+    })?;
+    if let Some(o) = &outside {
+        common::unique("--outside", o, |c| c.clone())?;
+    }
     let model = a.model.clone().unwrap_or_else(|| "nsection".into());
     let n = match model.as_str() {
         "nsection" => a.with.n.or(Some(2)),

@@ -74,11 +74,17 @@ pub fn run(a: &FitArgs) -> anyhow::Result<()> {
     if let Some(dir) = &a.plot {
         files::prepare_dir(dir, &FIGURES, a.force, "--plot")?;
     }
-    let (data, lines) = common::read_record(&a.data, a.drop_outliers)?;
+    let (data, lines) = common::read_record(
+        &a.data,
+        a.drop_outliers,
+        (a.train.as_deref(), a.holdout.as_deref()),
+    )?;
     check_uniform(&data, Some(&lines))?;
     let (train, holdout) = common::blocks(a.train.as_deref(), a.holdout.as_deref(), &data, 0.7)?;
     let model = stirling_models::build(&a.model, a.with.n, Closure::Full)?;
+    common::check_channels(&a.model, model.as_ref(), &data)?;
     let p0 = a.with.load(model.as_ref())?;
+    common::check_sampling(model.as_ref(), &p0, &data, train, 0.7)?;
     let bounds = common::bounds_file(model.as_ref(), a.bounds.as_deref())?;
     let opts = FitOptions {
         free: a.free.clone(),
@@ -107,13 +113,42 @@ pub fn run(a: &FitArgs) -> anyhow::Result<()> {
     for st in [&res.stage1, &res.stage2].into_iter().flatten() {
         if !st.converged {
             anyhow::bail!(
-                "{} did not converge in {} iterations: the estimates above are not an optimum (a longer record, more excitation or better starting values may help)",
+                "{} did not converge in {} iterations: the estimates above are not an optimum ({})",
                 st.stage,
-                st.iterations
+                st.iterations,
+                likely_cause(st)
             );
         }
     }
     Ok(())
+}
+
+/// Least training fit (%) of a channel the stage fits, below which a stage that did not
+/// converge is blamed on the record's columns rather than on its length.
+const POOR_FIT: f64 = 50.0;
+
+/// What to do about a stage that did not converge: when it fits no channel even roughly
+/// (sign-flipped or swapped positions ended here with "a longer record may help"), the
+/// columns are the likely cause; otherwise more data or better starting values.
+fn likely_cause(st: &stirling_models::fit::StageFit) -> String {
+    let train: Vec<(&str, f64)> = st
+        .fits
+        .iter()
+        .filter(|f| f.block == "train")
+        .map(|f| (f.channel.as_str(), f.fit_percent))
+        .collect();
+    let best = train.iter().map(|c| c.1).fold(f64::NEG_INFINITY, f64::max);
+    if best.is_finite() && best < POOR_FIT {
+        let list: Vec<String> = train.iter().map(|(c, f)| format!("{c} {f:.0} %")).collect();
+        return format!(
+            "it fits no channel even roughly: {} on the training block; a longer record will not \
+             help. Likely causes: a position channel sign-flipped (measured in the other \
+             direction), x and y swapped, positions not in m or a pressure not of the cold side: \
+             check the columns against `stirling info` and the rig's sign convention",
+            list.join(", ")
+        );
+    }
+    "a longer record, more excitation or better starting values may help".into()
 }
 
 fn plot_series(path: &Path, title: &str, s: &Series) -> anyhow::Result<()> {

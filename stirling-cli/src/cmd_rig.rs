@@ -7,7 +7,7 @@ use std::io::Write;
 use clap::Args;
 use stirling_models::rig::{self, RigConfig};
 
-use crate::common::ranges;
+use crate::common::{self, ranges};
 
 /// Arguments of `stirling rig`.
 #[derive(Args, Debug)]
@@ -58,7 +58,7 @@ pub struct RigArgs {
     #[arg(long, default_value_t = 2e-3, allow_negative_numbers = true, value_parser = ranges::finite)]
     pub x0: f64,
     /// Noise seed
-    #[arg(long, default_value_t = 1)]
+    #[arg(long, default_value_t = 1, allow_negative_numbers = true, value_parser = ranges::seed)]
     pub seed: u64,
     /// Channels to write besides t: the seed's sensors p (cold side), x, y by default; add
     /// p_hot (hot-side pressure, multi-CV models) for a richer rig than the seed's engine had
@@ -76,6 +76,10 @@ pub struct RigArgs {
 }
 
 pub fn run(a: &RigArgs) -> anyhow::Result<()> {
+    let name = |s: &String| s.split('=').next().unwrap_or("").trim().to_string();
+    common::unique("--channels", &a.channels, |c| c.trim().to_string())?;
+    common::unique("--effect", &a.effect, name)?;
+    common::unique("--noise", &a.noise, |(c, _)| c.clone())?;
     let cfg = RigConfig {
         model: a.model.clone(),
         n: a.with.n,
@@ -97,7 +101,16 @@ pub fn run(a: &RigArgs) -> anyhow::Result<()> {
         truth: a.truth.clone(),
     };
     // refuse before the (long) simulation
+    // both files of the pair: a folder in the sidecar's place would leave the record alone
     for f in [a.out.clone(), rig::sidecar_path(&a.out)] {
+        if f.is_dir() {
+            anyhow::bail!(
+                "`{}` is a folder: the record and its truth sidecar ({}) must both be files; \
+                 choose another --out or move the folder",
+                f.display(),
+                rig::sidecar_path(&a.out).display()
+            );
+        }
         if f.exists() && !a.force {
             anyhow::bail!("`{}` exists: pass --force to overwrite", f.display());
         }

@@ -32,10 +32,10 @@ pub struct SimulateArgs {
     /// Number of output samples (2 to 1e6)
     #[arg(long, default_value_t = 2000, allow_negative_numbers = true, value_parser = ranges::samples)]
     pub samples: usize,
-    /// Relative tolerance, in (0, 0.1]
+    /// Relative tolerance, in [1e-14, 0.1]
     #[arg(long, default_value_t = 1e-7, allow_negative_numbers = true, value_parser = ranges::tolerance)]
     pub rtol: f64,
-    /// Scaled absolute tolerance, in (0, 0.1] (default: --rtol)
+    /// Scaled absolute tolerance, in [1e-14, 0.1] (default: --rtol)
     #[arg(long, allow_negative_numbers = true, value_parser = ranges::tolerance)]
     pub atol: Option<f64>,
     /// Write the sampled trajectory as CSV (folders created if missing)
@@ -143,7 +143,14 @@ fn simulate(
             shooting,
             Some(progress),
         )
+        .map_err(|e| match common::rest::stable_at_rest(model, p) {
+            // its "run longer" would not help
+            Some(re) => anyhow::anyhow!("no limit cycle: {}", common::rest::no_cycle(re)),
+            None => e.into(),
+        })
         .with_context(|| format!("limit cycle of `{}`", model.name()))?;
+        common::rest::check_cycle(model, p, &lc)
+            .with_context(|| format!("limit cycle of `{}`", model.name()))?;
         let tr = lc.settled.trajectory.clone();
         let s = SimSummary::from_run(model, &tr).with_cycle(&lc);
         return Ok((tr, s, Some(lc)));

@@ -9,9 +9,13 @@ mod blocks;
 pub mod files;
 /// Value parsers for the numeric options.
 pub mod ranges;
+/// A limit cycle asked of an engine stable at rest.
+pub mod rest;
+mod sampling;
 mod stdout;
 
 pub use blocks::blocks;
+pub use sampling::check_sampling;
 pub use stdout::{is_stdout_closed, note, print, print_json, stdout};
 
 use std::path::PathBuf;
@@ -20,13 +24,25 @@ use anyhow::Context;
 use clap::Args;
 use stirling_dsl::{Closure, Model};
 
-/// Read a record (`--data`) and the file line of each sample; with `drop` (`--drop-outliers`)
-/// its outliers are replaced by their neighbours' interpolation, each named on stderr.
+/// Bytes a fit or a diagnosis takes per sample of its record beyond the record itself (1.8 kB
+/// measured on a 10-million-row fit, issue 38).
+pub const ANALYSIS_BYTES_PER_ROW: f64 = 2000.0;
+
+/// Read a record (`--data`) and the file line of each sample: only the rows from the start of
+/// `--train` to the end of `--holdout` when both are given ([`blocks::window`]), under the
+/// memory limit of `STIRLING_MAX_RECORD_MB`; with `drop` (`--drop-outliers`) its outliers are
+/// replaced by their neighbours' interpolation, each named on stderr.
 pub fn read_record(
     path: &std::path::Path,
     drop: bool,
+    (train, holdout): (Option<&str>, Option<&str>),
 ) -> anyhow::Result<(stirling_models::data::Measured, Vec<usize>)> {
-    let (mut data, lines) = stirling_models::data::read_csv_lines(path)?;
+    let lim = stirling_models::data::ReadLimits {
+        keep: blocks::window(train, holdout),
+        work_per_row: ANALYSIS_BYTES_PER_ROW,
+        ..Default::default()
+    };
+    let (mut data, lines) = stirling_models::data::read_csv_within(path, &lim)?;
     if drop {
         for o in stirling_models::data::outliers::repair(&mut data) {
             let line = lines.get(o.index).copied().unwrap_or(0);
@@ -37,6 +53,58 @@ pub fn read_record(
         }
     }
     Ok((data, lines))
+}
+
+/// A list option names each item once: `--channels x,x` or `--effect leak=1 --effect leak=2`
+/// is refused (which one would count?). `key` gives an item's name (`NAME` of `NAME=VALUE`).
+pub fn unique<'a, T: 'a>(
+    option: &str,
+    items: impl IntoIterator<Item = &'a T>,
+    key: impl Fn(&T) -> String,
+) -> anyhow::Result<()> {
+    let mut seen = std::collections::HashSet::new();
+    for it in items {
+        let k = key(it);
+        if !seen.insert(k.clone()) {
+            anyhow::bail!("{option}: `{k}` is named twice: name each once");
+        }
+    }
+    Ok(())
+}
+
+/// The record holds a channel the model reads: one of p, p_hot, x, y or a sensor it declares
+/// (a record with other columns only would end in a misleading "fewer than two cycles").
+pub fn check_channels(
+    name: &str,
+    model: &dyn Model,
+    data: &stirling_models::data::Measured,
+) -> anyhow::Result<()> {
+    let sensors: Vec<&str> = model.sensors().iter().map(|s| s.name).collect();
+    let has_sensor = data
+        .others
+        .iter()
+        .any(|(n, _)| sensors.contains(&n.as_str()));
+    if !data
+        .channels()
+        .iter()
+        .any(|c| stirling_models::data::CHANNELS.contains(c))
+        && !has_sensor
+    {
+        let mut reads: Vec<&str> = stirling_models::data::CHANNELS.to_vec();
+        for s in sensors {
+            if !reads.contains(&s) {
+                reads.push(s);
+            }
+        }
+        anyhow::bail!(
+            "{}: none of its columns ({}) is a channel `{}` reads ({}): name the columns in the header, e.g. t,p,x,y",
+            data.source,
+            data.channels().join(", "),
+            name,
+            reads.join(", ")
+        );
+    }
+    Ok(())
 }
 
 /// The bounds of `--bounds FILE` (none without the option).

@@ -118,3 +118,23 @@ fn two_rigs_on_one_path_never_mix_their_files() {
         .collect();
     assert!(left.is_empty(), "temporary files left: {left:?}");
 }
+
+#[test]
+fn a_folder_in_the_sidecars_place_leaves_no_record_alone() {
+    // it wrote r.csv, then failed on r.csv.truth.json ("Is a directory"): a record without
+    // its truth file
+    let dir = scratch("atomic_side_folder");
+    let out = dir.join("r.csv");
+    std::fs::create_dir_all(dir.join("r.csv.truth.json")).unwrap();
+    for force in [false, true] {
+        let mut args = vec!["rig", "cv1", "--t-end", "0.5", "--out", s(&out)];
+        if force {
+            args.push("--force");
+        }
+        support::fails_with(
+            &args,
+            &["r.csv.truth.json` is a folder", "choose another --out"],
+        );
+        assert!(!out.exists());
+    }
+}

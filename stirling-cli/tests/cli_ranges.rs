@@ -14,18 +14,19 @@ fn refused(args: &[&str], option: &str, value: &str, why: &str) {
 
 #[test]
 fn tolerances() {
-    for v in ["1", "-1", "0", "0.5"] {
+    // 1e-30 ended in "step size collapsed ... the solution is singular", blaming the model
+    for v in ["1", "-1", "0", "0.5", "1e-30"] {
         refused(
             &["simulate", "schmidt", "--t-end", "1", "--rtol", v],
             "--rtol",
             v,
-            "(0, 0.1]",
+            "[1e-14, 0.1]",
         );
         refused(
             &["simulate", "schmidt", "--t-end", "1", "--atol", v],
             "--atol",
             v,
-            "(0, 0.1]",
+            "[1e-14, 0.1]",
         );
     }
     refused(

@@ -19,6 +19,8 @@ pub enum OutputError {
     Exists(PathBuf),
     #[error("{}: another run is writing it (lock {}); if none is, remove the lock", .0.display(), .1.display())]
     Locked(PathBuf, PathBuf),
+    #[error("{}: is a folder, a file cannot replace it; choose another name", .0.display())]
+    Folder(PathBuf),
     #[error("{}: {}", .0.display(), .1)]
     Io(PathBuf, #[source] io::Error),
 }
@@ -47,6 +49,9 @@ fn temp_name(dest: &Path) -> PathBuf {
 impl Staged {
     /// Start writing `dest` (refused up front when it exists and `force` is off).
     pub fn new(dest: &Path, force: bool) -> Result<Self, OutputError> {
+        if dest.is_dir() {
+            return Err(OutputError::Folder(dest.to_path_buf()));
+        }
         if !force && dest.exists() {
             return Err(OutputError::Exists(dest.to_path_buf()));
         }
@@ -163,6 +168,10 @@ pub fn commit_all(files: Vec<Staged>, force: bool) -> Result<(), OutputError> {
 }
 
 fn publish_each(mut files: Vec<Staged>, force: bool) -> Result<(), OutputError> {
+    // every destination checked before the first is published: the pair goes whole or not
+    if let Some(f) = files.iter().find(|f| f.dest.is_dir()) {
+        return Err(OutputError::Folder(f.dest.clone()));
+    }
     if !force {
         if let Some(f) = files.iter().find(|f| f.dest.exists()) {
             return Err(OutputError::Exists(f.dest.clone()));
@@ -249,5 +258,19 @@ mod tests {
         let a = Staged::new(&csv, true).unwrap();
         let e = commit_all(vec![a], true).unwrap_err();
         assert!(matches!(e, OutputError::Locked(..)), "{e}");
+        fs::remove_file(&lock).unwrap();
+        // the sidecar's name became a folder while the run worked: nothing published, even
+        // with force (it left the record without its truth file)
+        let (csv2, side2) = (d.join("s.csv"), d.join("s.csv.truth.json"));
+        let a = Staged::new(&csv2, true).unwrap();
+        let b = Staged::new(&side2, true).unwrap();
+        fs::create_dir_all(&side2).unwrap();
+        let e = commit_all(vec![a, b], true).unwrap_err();
+        assert!(matches!(e, OutputError::Folder(_)), "{e}");
+        assert!(!csv2.exists());
+        assert!(matches!(
+            Staged::new(&side2, true),
+            Err(OutputError::Folder(_))
+        ));
     }
 }

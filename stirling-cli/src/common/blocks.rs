@@ -52,6 +52,24 @@ pub fn blocks(
     Ok((tr, ho))
 }
 
+/// The rows a command needs when both blocks are given: from the start of `--train` to the end
+/// of `--holdout` (an empty end reaches the record's end); `None` (every row) otherwise, or when
+/// either does not parse (its error comes from [`blocks`] once the record is read).
+pub fn window(train: Option<&str>, holdout: Option<&str>) -> Option<(f64, f64)> {
+    let end = |s: &str, first: bool, open: f64| -> Option<f64> {
+        let (a, b) = s.split_once(':')?;
+        let v = if first { a } else { b }.trim();
+        if v.is_empty() {
+            Some(open)
+        } else {
+            v.parse::<f64>().ok().filter(|v| v.is_finite())
+        }
+    };
+    let a = end(train?, true, f64::NEG_INFINITY)?;
+    let b = end(holdout?, false, f64::INFINITY)?;
+    (b > a).then_some((a, b))
+}
+
 /// Six decimals, no trailing zeros.
 fn short(v: f64) -> String {
     let s = format!("{:.6}", v);

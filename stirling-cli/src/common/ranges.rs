@@ -67,9 +67,20 @@ pub fn non_negative(s: &str) -> Parsed<f64> {
     Ok(v)
 }
 
-/// A solver tolerance in (0, 0.1].
+/// The smallest solver tolerance: 100 times the resolution of a double (the tolerances are
+/// scaled by each state's size); below it no step meets the tolerance and the solver's step
+/// collapses, which would read as a fault of the model.
+pub const MIN_TOLERANCE: f64 = 1e-14;
+
+/// A solver tolerance in [MIN_TOLERANCE, 0.1].
 pub fn tolerance(s: &str) -> Parsed<f64> {
-    above_zero_to(s, 0.1, "a tolerance must lie in (0, 0.1], e.g. 1e-7")
+    let why = "a tolerance must lie in [1e-14, 0.1], e.g. 1e-7 (below 1e-14, about 100 times the \
+               resolution of a double, no solver step can meet it)";
+    let v = above_zero_to(s, 0.1, why)?;
+    if v < MIN_TOLERANCE {
+        return Err(RangeError::Outside(why));
+    }
+    Ok(v)
 }
 
 /// A finite number in `(0, hi]`; `why` otherwise.
@@ -91,6 +102,26 @@ pub fn at_least_one(s: &str) -> Parsed<usize> {
         return Err(RangeError::Outside("is too large"));
     }
     Ok(v as usize)
+}
+
+/// A noise seed: a whole number from 0 to 2^64 - 1 (a negative one is refused by this range,
+/// not taken for an option).
+pub fn seed(s: &str) -> Parsed<u64> {
+    if let Ok(v) = s.trim().parse::<u64>() {
+        return Ok(v);
+    }
+    let v = integer(s)?;
+    if v < 0.0 {
+        return Err(RangeError::Outside(
+            "a seed is a whole number from 0 to 2^64 - 1, e.g. --seed 1",
+        ));
+    }
+    if v >= 1.8446744073709552e19 {
+        return Err(RangeError::Outside(
+            "is too large (a seed is at most 2^64 - 1)",
+        ));
+    }
+    Ok(v as u64)
 }
 
 /// A number of output samples in [2, MAX_SAMPLES].
@@ -159,6 +190,7 @@ mod tests {
         assert_eq!(tolerance("1e-7"), Ok(1e-7));
         assert!(tolerance("0").is_err() && tolerance("1").is_err() && tolerance("-1").is_err());
         assert!(tolerance("nan").is_err());
+        assert!(tolerance("1e-30").is_err() && tolerance("1e-14").is_ok());
         assert_eq!(samples("1e5"), Ok(100_000));
         assert!(samples("1e8").is_err() && samples("1").is_err() && samples("2.5").is_err());
         assert_eq!(at_least_one("3"), Ok(3));

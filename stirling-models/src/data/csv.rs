@@ -3,51 +3,47 @@
 use std::io::Write;
 use std::path::Path;
 
+use super::stream::{Estimate, Lines, ReadLimits};
 use super::text::{fixed4, format_hint, names as list, quote, short};
 use super::{DataError, Measured, CHANNELS};
 
-/// Read a measured record from a file.
+/// Read a measured record from a file (every row, under the default memory limit).
 pub fn read_csv(path: &Path) -> Result<Measured, DataError> {
     read_csv_lines(path).map(|(m, _)| m)
 }
 
 /// Read a measured record and the file line of each sample (for messages about samples).
 pub fn read_csv_lines(path: &Path) -> Result<(Measured, Vec<usize>), DataError> {
+    read_csv_within(path, &ReadLimits::default())
+}
+
+/// Read the rows of a record that `lim` keeps, and the file line of each: the file is read
+/// line by line, the other rows are checked and dropped, and a record whose kept rows would
+/// pass the memory limit is refused after its first rows.
+pub fn read_csv_within(path: &Path, lim: &ReadLimits) -> Result<(Measured, Vec<usize>), DataError> {
     let file = path.display().to_string();
-    let bytes = std::fs::read(path).map_err(|e| DataError {
+    let cannot = |e: std::io::Error| DataError {
         file: file.clone(),
         row: 0,
         column: String::new(),
         message: format!("cannot read the file: {e}"),
-    })?;
-    parse(&file, text(&file, &bytes)?)
+    };
+    let f = std::fs::File::open(path).map_err(cannot)?;
+    let size = f.metadata().map_err(cannot)?.len();
+    let mut lines = Lines::new(&file, std::io::BufReader::new(f));
+    parse(&file, &mut lines, Some(size), lim)
 }
 
 /// Parse a measured record from bytes (UTF-8, an optional byte-order mark); `file` labels
 /// the errors.
 pub fn parse_csv_bytes(file: &str, bytes: &[u8]) -> Result<Measured, DataError> {
-    parse(file, text(file, bytes)?).map(|(m, _)| m)
+    let mut lines = Lines::new(file, bytes);
+    parse(file, &mut lines, None, &ReadLimits::default()).map(|(m, _)| m)
 }
 
 /// Parse a measured record; `file` labels the errors.
 pub fn parse_csv(file: &str, text: &str) -> Result<Measured, DataError> {
-    parse(file, text).map(|(m, _)| m)
-}
-
-fn text<'a>(file: &str, bytes: &'a [u8]) -> Result<&'a str, DataError> {
-    std::str::from_utf8(bytes).map_err(|e| {
-        let at = e.valid_up_to();
-        let line = 1 + bytes[..at].iter().filter(|&&b| b == b'\n').count();
-        DataError {
-            file: file.to_string(),
-            row: line,
-            column: String::new(),
-            message: format!(
-                "not a text file: invalid UTF-8 at byte {at}{}",
-                format_hint(file, "")
-            ),
-        }
-    })
+    parse_csv_bytes(file, text.as_bytes())
 }
 
 /// Builds the errors of one file.
@@ -66,11 +62,8 @@ impl Errors<'_> {
     }
 
     /// The header line's row and column names (no column `t` or channel twice).
-    fn header<'t>(
-        &self,
-        lines: &mut impl Iterator<Item = (usize, &'t str)>,
-    ) -> Result<(usize, Vec<String>), DataError> {
-        let Some((hrow, header)) = lines.next() else {
+    fn header(&self, first: Option<(usize, String)>) -> Result<(usize, Vec<String>), DataError> {
+        let Some((hrow, header)) = first else {
             return Err(self.err(
                 1,
                 "t",
@@ -220,25 +213,60 @@ impl Errors<'_> {
     }
 }
 
-fn parse(file: &str, text: &str) -> Result<(Measured, Vec<usize>), DataError> {
+/// The next line that is neither blank nor a comment, trimmed.
+fn next<R: std::io::BufRead>(source: &mut Lines<R>) -> Result<Option<(usize, String)>, DataError> {
+    for r in source.by_ref() {
+        let (i, l) = r?;
+        let l = l.trim();
+        if !l.is_empty() && !l.starts_with('#') {
+            return Ok(Some((i, l.to_string())));
+        }
+    }
+    Ok(None)
+}
+
+/// The rows of a record: comment and blank lines skipped, each row's time checked against
+/// the previous row's, the rows inside `lim.keep` stored.
+fn parse<R: std::io::BufRead>(
+    file: &str,
+    source: &mut Lines<R>,
+    size: Option<u64>,
+    lim: &ReadLimits,
+) -> Result<(Measured, Vec<usize>), DataError> {
     let e = Errors { file };
-    // an invisible byte-order mark would otherwise glue itself to the first column name
-    let body = text.strip_prefix('\u{feff}').unwrap_or(text);
-    let mut lines = body
-        .lines()
-        .enumerate()
-        .map(|(i, l)| (i + 1, l.trim()))
-        .filter(|(_, l)| !l.is_empty() && !l.starts_with('#'));
-    let (hrow, names) = e.header(&mut lines)?;
-    let (it, cols) = e.columns(hrow, &names, body)?;
+    let first_line = next(source)?;
+    let raw = first_line
+        .as_ref()
+        .map(|(_, l)| l.clone())
+        .unwrap_or_default();
+    let (hrow, names) = e.header(first_line)?;
+    let (it, cols) = e.columns(hrow, &names, &raw)?;
+    let estimate = Estimate {
+        size,
+        columns: cols.len(),
+    };
     let mut t = Vec::new();
     let mut data: Vec<Vec<f64>> = vec![Vec::new(); cols.len()];
     let mut bad: Vec<Option<DataError>> = vec![None; cols.len()];
     let mut rows = Vec::new();
-    for (row, line) in lines {
+    let (mut read, mut first, mut prev) = (0usize, None, None);
+    let mut last_row = hrow;
+    while let Some((row, line)) = next(source)? {
         let fields: Vec<&str> = line.split(',').map(str::trim).collect();
         let tv = e.field(row, &fields, names.len(), (it, "t"))?;
-        e.check_time(row, tv, t.last().copied())?;
+        e.check_time(row, tv, prev)?;
+        prev = Some(tv);
+        let t0 = *first.get_or_insert(tv);
+        read += 1;
+        last_row = row;
+        if Estimate::due(read) {
+            estimate
+                .check(lim, read, source.bytes, (t0, tv))
+                .map_err(|m| e.err(row, "t", m))?;
+        }
+        if lim.keep.is_some_and(|(a, b)| tv < a || tv > b) {
+            continue;
+        }
         t.push(tv);
         for (k, &col) in cols.iter().enumerate() {
             match e.field(row, &fields, names.len(), col) {
@@ -252,8 +280,23 @@ fn parse(file: &str, text: &str) -> Result<(Measured, Vec<usize>), DataError> {
         }
         rows.push(row);
     }
-    if t.is_empty() {
+    if read == 0 {
         return Err(e.err(hrow + 1, "t", "no data rows after the header".into()));
+    }
+    if let (Some((a, b)), true) = (lim.keep, t.len() < 2) {
+        return Err(e.err(
+            last_row,
+            "t",
+            format!(
+                "only {} samples with t in {}:{} s, where the record runs from {} s to {} s: \
+                 the blocks must lie inside the record",
+                t.len(),
+                short(a),
+                short(b),
+                short(first.unwrap_or(0.0)),
+                short(prev.unwrap_or(0.0))
+            ),
+        ));
     }
     if t.len() < 2 {
         return Err(e.err(

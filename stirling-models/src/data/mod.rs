@@ -14,11 +14,16 @@ pub mod offsets;
 /// Isolated outlier samples: found, refused by the fit, or replaced on request.
 pub mod outliers;
 mod sampling;
+/// Reading a record line by line, under a memory limit.
+pub mod stream;
 mod text;
 
-pub use csv::{parse_csv, parse_csv_bytes, read_csv, read_csv_lines, write_csv, write_csv_to};
+pub use csv::{
+    parse_csv, parse_csv_bytes, read_csv, read_csv_lines, read_csv_within, write_csv, write_csv_to,
+};
 pub use offsets::{cycle_mean, remove_position_offsets, PositionOffsets};
 pub use sampling::{check_uniform, UNIFORM_TOLERANCE};
+pub use stream::ReadLimits;
 
 use std::fmt;
 

@@ -61,10 +61,17 @@ pub fn locus(
     }
     let mut q = p.to_vec();
     let mut points = Vec::with_capacity(values.len());
-    for &v in values {
+    for (i, &v) in values.iter().enumerate() {
         q[k] = v;
-        crate::params::validate(model, &q).map_err(|e| LinearError::Param(e.to_string()))?;
-        let d = dynamic_poles(model, &q, newton)?;
+        let at = |e: LinearError| LinearError::AtValue {
+            param: param.to_string(),
+            value: v,
+            point: i + 1,
+            points: values.len(),
+            source: Box::new(e),
+        };
+        crate::params::validate(model, &q).map_err(|e| at(LinearError::Param(e.to_string())))?;
+        let d = dynamic_poles(model, &q, newton).map_err(at)?;
         points.push(LocusPoint {
             value: v,
             poles: d.poles,

@@ -106,6 +106,15 @@ pub enum LinearError {
     },
     #[error("the parameter range is empty (use at least one step)")]
     EmptyRange,
+    /// A locus point failed: at which value of the parameter swept.
+    #[error("at {param} = {value:e} (point {point} of {points}): {source}; a locus cannot pass this value: sweep a range that ends before it")]
+    AtValue {
+        param: String,
+        value: f64,
+        point: usize,
+        points: usize,
+        source: Box<LinearError>,
+    },
     #[error("{0}")]
     Param(String),
     #[error("eigenvalue computation failed: {0}")]

@@ -41,6 +41,14 @@ impl Axis {
                 .ok()
                 .filter(|&k| k >= 1)
                 .ok_or_else(|| bad("the count k of a:b:k must be a whole number >= 1"))?;
+            if k > super::MAX_POINTS {
+                // the axis's values are held in memory before anything runs
+                return Err(bad(&format!(
+                    "{k} values on one axis, more than the {} a sweep holds (8 bytes each, \
+                     before any point runs): use fewer values, or sweep the range in parts",
+                    super::MAX_POINTS
+                )));
+            }
             let (a, b) = (num(a)?, num(b)?);
             let step = if k > 1 { (b - a) / (k - 1) as f64 } else { 0.0 };
             (0..k).map(|i| a + step * i as f64).collect()
@@ -92,7 +100,9 @@ pub fn default_ties(axes: &[Axis], has: impl Fn(&str) -> bool) -> Vec<Tie> {
 
 /// The number of points of the product of `axes`.
 pub fn count(axes: &[Axis]) -> usize {
-    axes.iter().map(|a| a.values.len()).product()
+    // saturating: a product past usize is refused as too large, not wrapped around
+    axes.iter()
+        .fold(1usize, |n, a| n.saturating_mul(a.values.len()))
 }
 
 /// Point `k` of the product (the last axis varies fastest).
@@ -150,6 +160,11 @@ mod tests {
             Axis::parse("b=10,20,30").unwrap(),
         ];
         assert_eq!(count(&axes), 6);
+        // one axis past the cap is refused before its values are made
+        let e = Axis::parse("Th=500:700:1000000000")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("1000000000 values on one axis"), "{e}");
         assert_eq!(point(&axes, 0), vec![1.0, 10.0]);
         assert_eq!(point(&axes, 4), vec![2.0, 20.0]);
         let mut all: Vec<usize> = (1..=4).flat_map(|i| shard(6, i, 4)).collect();
