@@ -18,7 +18,7 @@ pub struct Restarts {
     pub states: Vec<Vec<f64>>,
     /// The channel each free state is read from (a position and its velocity from the
     /// position's channel): a gain on that sensor divides the restart state as it divides
-    /// the measurement ([`Stage::apply_sensors`]).
+    /// the measurement (as `Stage::apply_sensors` does).
     pub channels: Vec<&'static str>,
 }
 
