@@ -242,4 +242,21 @@ fn swapped_position_columns_are_named_as_the_likely_cause() {
         stdout.contains("not to be trusted") && stdout.contains("x and y columns swapped"),
         "{stdout}"
     );
+    // the diagnosis said `no_significant_gap` on it while printing a held-out error of 4733
+    // noise variances: a gross gap is never read as no gap
+    let out = support::stirling(&[
+        "diagnose",
+        "cv1",
+        "--data",
+        s(&swapped),
+        "--effects",
+        "leak,coulomb",
+        "--json",
+    ]);
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_ne!(
+        v["verdict"]["verdict"], "no_significant_gap",
+        "{}",
+        v["verdict"]
+    );
 }
