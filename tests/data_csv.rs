@@ -141,16 +141,16 @@ fn short_row() {
 #[test]
 fn pressure_in_kpa_or_bar() {
     let kpa = "t,p\n0,101.3\n0.001,101.5\n0.002,101.1\n";
-    assert_eq!(err(kpa), "rec.csv: row 2, column `p`: pressure looks like kPa (median 101.3000): expected absolute pressure in Pa, e.g. 101325 (rows 2-4)");
+    assert_eq!(err(kpa), "rec.csv: row 2, column `p`: pressure looks like kPa (median 101.3000): expected absolute pressure in Pa, e.g. 101325, or the unit named in the header, e.g. `p [kPa]` (rows 2-4)");
     let bar = "t,p_hot\n0,1.013\n0.001,1.015\n";
-    assert_eq!(err(bar), "rec.csv: row 2, column `p_hot`: pressure looks like bar or MPa (median 1.0150): expected absolute pressure in Pa, e.g. 101325 (rows 2-3)");
+    assert_eq!(err(bar), "rec.csv: row 2, column `p_hot`: pressure looks like bar or MPa (median 1.0150): expected absolute pressure in Pa, e.g. 101325, or the unit named in the header, e.g. `p_hot [bar]` (rows 2-3)");
     assert!(err("t,p\n0,-200\n0.001,300\n0.002,-100\n").contains("pressure must be absolute"));
 }
 
 #[test]
 fn positions_in_mm() {
     let s = err("t,x,y\n0,5.0,0.001\n0.001,-4.0,0.001\n");
-    assert_eq!(s, "rec.csv: row 2, column `x`: position looks like mm (largest magnitude 5.0000): expected metres, e.g. 0.005 for 5 mm (rows 2-3)");
+    assert_eq!(s, "rec.csv: row 2, column `x`: position looks like mm (largest magnitude 5.0000): expected metres, e.g. 0.005 for 5 mm, or the unit named in the header, e.g. `x [mm]` (rows 2-3)");
 }
 
 #[test]

@@ -5,6 +5,7 @@ use std::path::Path;
 
 use super::stream::{Estimate, Lines, ReadLimits};
 use super::text::{fixed4, format_hint, names as list, quote, short};
+use super::units::{self, Unit};
 use super::{DataError, Measured, CHANNELS};
 
 /// Read a measured record from a file (every row, under the default memory limit).
@@ -46,6 +47,20 @@ pub fn parse_csv(file: &str, text: &str) -> Result<Measured, DataError> {
     parse_csv_bytes(file, text.as_bytes())
 }
 
+/// A record's header: its row, the column names and each column's unit, if given.
+struct Header {
+    row: usize,
+    names: Vec<String>,
+    units: Vec<Option<Unit>>,
+}
+
+impl Header {
+    /// Column `i`'s value `v` in SI units.
+    fn si(&self, i: usize, v: f64) -> f64 {
+        self.units[i].as_ref().map_or(v, |u| u.si(v))
+    }
+}
+
 /// Builds the errors of one file.
 struct Errors<'a> {
     file: &'a str,
@@ -61,8 +76,9 @@ impl Errors<'_> {
         }
     }
 
-    /// The header line's row and column names (no column `t` or channel twice).
-    fn header(&self, first: Option<(usize, String)>) -> Result<(usize, Vec<String>), DataError> {
+    /// The header line's row, column names and units (no column `t` or channel twice; a
+    /// unit after a name, `p [kPa]`, must be one [`units::parse`] reads and fit the column).
+    fn header(&self, first: Option<(usize, String)>) -> Result<Header, DataError> {
         let Some((hrow, header)) = first else {
             return Err(self.err(
                 1,
@@ -71,16 +87,23 @@ impl Errors<'_> {
                     .into(),
             ));
         };
-        let names: Vec<String> = header
-            .split(',')
-            .map(|s| s.trim().trim_matches('"').to_string())
-            .collect();
+        let mut names = Vec::new();
+        let mut units = Vec::new();
+        for cell in header.split(',').map(|s| s.trim().trim_matches('"')) {
+            let (name, unit) = units::split(cell);
+            let unit = unit
+                .map(|u| units::for_column(name, u))
+                .transpose()
+                .map_err(|m| self.err(hrow, cell, format!("the header's unit: {m}")))?;
+            names.push(name.to_string());
+            units.push(unit);
+        }
         for (i, n) in names.iter().enumerate() {
             if names[..i].contains(n) && (n == "t" || CHANNELS.contains(&n.as_str())) {
                 return Err(self.err(hrow, n, format!("column `{n}` appears twice in the header")));
             }
         }
-        Ok((hrow, names))
+        Ok(Header { row: hrow, names, units })
     }
 
     /// The position of column `t` and of each measured channel present (the seed's four,
@@ -239,8 +262,9 @@ fn parse<R: std::io::BufRead>(
         .as_ref()
         .map(|(_, l)| l.clone())
         .unwrap_or_default();
-    let (hrow, names) = e.header(first_line)?;
-    let (it, cols) = e.columns(hrow, &names, &raw)?;
+    let head = e.header(first_line)?;
+    let (hrow, names) = (head.row, &head.names);
+    let (it, cols) = e.columns(hrow, names, &raw)?;
     let estimate = Estimate {
         size,
         columns: cols.len(),
@@ -253,7 +277,7 @@ fn parse<R: std::io::BufRead>(
     let mut last_row = hrow;
     while let Some((row, line)) = next(source)? {
         let fields: Vec<&str> = line.split(',').map(str::trim).collect();
-        let tv = e.field(row, &fields, names.len(), (it, "t"))?;
+        let tv = head.si(it, e.field(row, &fields, names.len(), (it, "t"))?);
         e.check_time(row, tv, prev)?;
         prev = Some(tv);
         let t0 = *first.get_or_insert(tv);
@@ -270,7 +294,7 @@ fn parse<R: std::io::BufRead>(
         t.push(tv);
         for (k, &col) in cols.iter().enumerate() {
             match e.field(row, &fields, names.len(), col) {
-                Ok(v) => data[k].push(v),
+                Ok(v) => data[k].push(head.si(col.0, v)),
                 // another column: set aside at its first bad cell, the record still reads
                 Err(err) if !CHANNELS.contains(&col.1) => {
                     bad[k].get_or_insert(err);
@@ -356,11 +380,11 @@ fn check_units(name: &str, v: &[f64]) -> Result<(), (Option<usize>, String)> {
         "p" | "p_hot" => {
             let m = median(v);
             let whole = if m <= 0.0 {
-                Some(format!("pressure must be absolute (Pa, > 0); median is {}: gauge pressure? add the ambient pressure", fixed4(m)))
+                Some(format!("pressure must be absolute (Pa, > 0); median is {}: gauge pressure? name it in the header, e.g. `{name} [kPa gauge]` (the standard atmosphere is added), or add the ambient pressure", fixed4(m)))
             } else if m < 5.0e1 {
-                Some(format!("pressure looks like bar or MPa (median {}): expected absolute pressure in Pa, e.g. 101325", fixed4(m)))
+                Some(format!("pressure looks like bar or MPa (median {}): expected absolute pressure in Pa, e.g. 101325, or the unit named in the header, e.g. `{name} [bar]`", fixed4(m)))
             } else if m < 5.0e3 {
-                Some(format!("pressure looks like kPa (median {}): expected absolute pressure in Pa, e.g. 101325", fixed4(m)))
+                Some(format!("pressure looks like kPa (median {}): expected absolute pressure in Pa, e.g. 101325, or the unit named in the header, e.g. `{name} [kPa]`", fixed4(m)))
             } else if m > 5.0e7 {
                 Some(format!("pressure too large for Pa (median {:.4e}): expected absolute pressure in Pa, e.g. 101325", m))
             } else {
@@ -387,7 +411,7 @@ fn check_units(name: &str, v: &[f64]) -> Result<(), (Option<usize>, String)> {
             let mags: Vec<f64> = v.iter().map(|x| x.abs()).collect();
             if median(&mags) > X_MAX {
                 let peak = mags.iter().fold(0.0f64, |a, &b| a.max(b));
-                return Err((None, format!("position looks like mm (largest magnitude {}): expected metres, e.g. 0.005 for 5 mm", fixed4(peak))));
+                return Err((None, format!("position looks like mm (largest magnitude {}): expected metres, e.g. 0.005 for 5 mm, or the unit named in the header, e.g. `{name} [mm]`", fixed4(peak))));
             }
             if let Some(i) = first(&|x| x.abs() > X_MAX) {
                 return Err((Some(i), format!("position {} m is out of range (|{name}| <= {X_MAX} m; the median magnitude is {}): a corrupt value?", short(v[i]), fixed4(median(&mags)))));

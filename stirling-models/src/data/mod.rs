@@ -1,5 +1,7 @@
 //! Measured data: a CSV with a header, `t` \[s\] and any of `p` (cold-side absolute pressure, Pa),
-//! `p_hot` (Pa), `x`, `y` (m); `#` comment lines. Other columns are kept by name when every row
+//! `p_hot` (Pa), `x`, `y` (m); `#` comment lines. A column may name its unit after its name
+//! (`t [ms]`, `p [kPa gauge]`, `x [mm]`, `dV [cm^3]`, `theta [deg]`: [`units`]); it is then
+//! converted to SI as it is read. Other columns are kept by name when every row
 //! holds a number there ([`crate::data::Measured::others`]: a channel a model declares with `sensor
 //! name: STATE;`), and set aside with the first bad cell otherwise
 //! ([`crate::data::Measured::unread`]), so that a fit asking for one can say where it failed.
@@ -17,6 +19,8 @@ mod sampling;
 /// Reading a record line by line, under a memory limit.
 pub mod stream;
 mod text;
+/// Units named in the header (`p [kPa gauge]`, `x [mm]`), converted to SI on reading.
+pub mod units;
 
 pub use csv::{
     parse_csv, parse_csv_bytes, read_csv, read_csv_lines, read_csv_within, write_csv, write_csv_to,
