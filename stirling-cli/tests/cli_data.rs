@@ -42,3 +42,17 @@ fn a_json_file_is_named_as_read_as_csv() {
         &["missing column `t`", "read as CSV", "looks like JSON"],
     );
 }
+
+#[test]
+fn a_unit_the_reader_does_not_know_is_refused_at_the_header() {
+    let dir = scratch("data_units");
+    let f = dir.join("lab.csv");
+    std::fs::write(&f, "t [ms],p [kPa gauge],x [inch],y [mm]\n0,1.5,0.1,2\n1,1.6,0.1,2\n").unwrap();
+    let at = format!("{}: row 1, column `x [inch]`", f.display());
+    for cmd in ["fit", "diagnose"] {
+        fails_with(
+            &[cmd, "cv1", "--data", s(&f)],
+            &[&at, "unknown unit `inch`", "mm"],
+        );
+    }
+}
