@@ -23,6 +23,19 @@ pub const MIN_SIGNAL_TO_NOISE: f64 = 5.0;
 /// Refuse the training block `tr` (inclusive sample indices) of `data` if it cannot carry a
 /// fit (interval `dt`).
 pub fn check(data: &Measured, tr: (usize, usize), dt: f64) -> Result<(), FitError> {
+    check_motion(data, tr)?;
+    let Some(freq) = record_frequency(data, tr, dt) else {
+        return Err(FitError::TooFewCycles {
+            file: data.source.clone(),
+            seconds: (tr.1 - tr.0) as f64 * dt,
+        });
+    };
+    check_rate(data, freq, dt)
+}
+
+/// Every measured channel moves well above its noise on the training block `tr` (a still
+/// engine, or a record of noise, has no cycle to fit).
+pub fn check_motion(data: &Measured, tr: (usize, usize)) -> Result<(), FitError> {
     for ch in ["p", "p_hot", "x", "y"] {
         let Some(v) = data.channel(ch) else { continue };
         let seg = &v[tr.0..=tr.1];
@@ -39,13 +52,7 @@ pub fn check(data: &Measured, tr: (usize, usize), dt: f64) -> Result<(), FitErro
             });
         }
     }
-    let Some(freq) = record_frequency(data, tr, dt) else {
-        return Err(FitError::TooFewCycles {
-            file: data.source.clone(),
-            seconds: (tr.1 - tr.0) as f64 * dt,
-        });
-    };
-    check_rate(data, freq, dt)
+    Ok(())
 }
 
 /// The record's cycle frequency on the training block `tr`, when it has one.
@@ -75,18 +82,15 @@ pub fn check_model_frequency(
     let Some(rec) = record_frequency(data, tr, dt) else {
         return Ok(());
     };
-    let Ok(d) = dynamic_poles(model, p, &NewtonOptions::default()) else {
+    let Some(f_model) = model_frequency(model, p) else {
         return Ok(());
     };
-    let Some(f_model) = d
-        .poles
-        .iter()
-        .filter(|q| q.im > 0.0)
-        .max_by(|a, b| a.re.total_cmp(&b.re))
-        .map(|q| q.freq_hz)
-    else {
+    // a record that does not move above its noise, sampled fast enough for the model's
+    // cycle, is a still engine (or noise), which [`check`] names; sampled too slowly, its
+    // samples are an alias of the motion (they look like noise to the motion check)
+    if check_motion(data, tr).is_err() && dt * f_model * MIN_SAMPLES_PER_CYCLE <= 1.0 {
         return Ok(());
-    };
+    }
     let ratio = rec / f_model;
     if (1.0 / MAX_FREQUENCY_RATIO..=MAX_FREQUENCY_RATIO).contains(&ratio) {
         return Ok(());
@@ -106,6 +110,16 @@ pub fn check_model_frequency(
         model: f_model,
         hint: hint.into(),
     })
+}
+
+/// The model's own cycle frequency at `p` (Hz): its dominant oscillatory pole at rest.
+fn model_frequency(model: &dyn Model, p: &[f64]) -> Option<f64> {
+    let d = dynamic_poles(model, p, &NewtonOptions::default()).ok()?;
+    d.poles
+        .iter()
+        .filter(|q| q.im > 0.0)
+        .max_by(|a, b| a.re.total_cmp(&b.re))
+        .map(|q| q.freq_hz)
 }
 
 fn check_rate(data: &Measured, freq: f64, dt: f64) -> Result<(), FitError> {

@@ -83,6 +83,7 @@ impl<'a> Record<'a> {
         }
         // the cycle against the model's first: an aliased record (sampled at 1 s for a 13 Hz
         // engine) shows a slow cycle that the excitation check would blame on a still engine
+        // (a record without motion passes it, and the excitation check names it)
         super::excitation::check_model_frequency(model, p, data, tr, dt)?;
         super::excitation::check(data, tr, dt)?;
         let outliers = crate::data::outliers::find(data);
