@@ -1,6 +1,6 @@
 //! Measured data: a CSV with a header, `t` \[s\] and any of `p` (cold-side absolute pressure, Pa),
 //! `p_hot` (Pa), `x`, `y` (m); `#` comment lines. A column may name its unit after its name
-//! (`t [ms]`, `p [kPa gauge]`, `x [mm]`, `dV [cm^3]`, `theta [deg]`: [`units`]); it is then
+//! (`t [ms]`, `p [kPa gauge]`, `x [mm]`, `dV [cm^3]`, `theta [deg]`: [`units`](crate::data::units)); it is then
 //! converted to SI as it is read. Other columns are kept by name when every row
 //! holds a number there ([`crate::data::Measured::others`]: a channel a model declares with `sensor
 //! name: STATE;`), and set aside with the first bad cell otherwise

@@ -1,7 +1,7 @@
 //! Units named in a record's header: `p [kPa]`, `p [kPa gauge]`, `x [mm]`, `t [ms]`,
 //! `dV [cm^3]`, `theta [deg]`. Each column is converted to SI on reading (the model's units:
 //! Pa absolute, m, s, m^3, rad), so a lab record is read as it was logged. A gauge pressure
-//! gets the standard atmosphere ([`AMBIENT`]) added; the fit's free pressure offset
+//! gets the standard atmosphere ([`AMBIENT`](crate::data::units::AMBIENT)) added; the fit's free pressure offset
 //! (`p_offset`) takes the difference to the day's ambient pressure.
 
 /// The ambient pressure added to a gauge pressure (Pa): the standard atmosphere.

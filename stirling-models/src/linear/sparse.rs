@@ -6,7 +6,6 @@
 //! pattern.
 
 use faer::linalg::solvers::Solve;
-use faer::reborrow::Reborrow;
 use faer::sparse::linalg::solvers::{Lu, SymbolicLu};
 use faer::sparse::{SparseColMat, SparseColMatRef, Triplet};
 use faer::{c64, Mat};
