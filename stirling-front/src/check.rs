@@ -89,6 +89,8 @@ pub(crate) struct Lower {
     bodies: HashMap<String, usize>,
     /// Declared cranks and linkages: their index in `Topology::mechanisms`.
     mechanisms: HashMap<String, usize>,
+    /// Mechanisms refused at their declaration: faces on them report nothing more.
+    refused_mechanisms: std::collections::HashSet<String>,
     pub(crate) vessels: HashMap<String, Vessel>,
     cv_arrays: Vec<bool>,
     /// Declared walls: index and whether an array.

@@ -57,6 +57,9 @@ impl Lower {
     pub(super) fn declare_mechanism(&mut self, m: &MechanismAst) {
         let ok = self.declare(&m.name) & self.declare(&m.pos);
         let body = self.flywheel_ref(&m.on, &m.name);
+        if body.is_none() {
+            self.refused_mechanisms.insert(m.name.to_string());
+        }
         if let (true, Some(body)) = (ok, body) {
             let zero = self.topo.arena.num(0.0);
             self.mechanisms

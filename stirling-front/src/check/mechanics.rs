@@ -87,6 +87,9 @@ impl Lower {
     pub(super) fn faces(&mut self, faces: &[Field], owner: &str) -> Vec<FaceDecl> {
         let mut out = Vec::new();
         for f in faces {
+            if self.refused_mechanisms.contains(&f.name.to_string()) {
+                continue;
+            }
             let mechanism = self.mechanisms.get(&f.name.to_string()).copied();
             let body = match mechanism {
                 Some(m) => Some(self.topo.mechanisms[m].body),
