@@ -10,6 +10,8 @@
 mod common;
 #[path = "kinematic/models.rs"]
 mod models;
+#[path = "kinematic/run.rs"]
+mod run;
 
 use std::path::Path;
 
@@ -29,28 +31,6 @@ fn from_file() -> Box<dyn Model> {
 
 fn from_macro() -> models::GammaLtd {
     models::GammaLtd::new(1, Closure::Full).unwrap()
-}
-
-/// States all round the crank: angle in [0, 2 pi), speed within +-20 rad/s, pressures
-/// within +-5 % of the charge and 2 to 200 Pa apart, masses within +-5 % of rest.
-fn states(m: &dyn Model, p: &[f64], seed: u64, count: usize) -> Vec<Vec<f64>> {
-    let mut rng = common::rng(seed);
-    let mut x0 = vec![0.0; m.n_states()];
-    m.equilibrium_guess(p, &mut x0);
-    (0..count)
-        .map(|_| {
-            let mut x = x0.clone();
-            x[0] = rng.gen_range(0.0..2.0 * std::f64::consts::PI);
-            x[1] = rng.gen_range(-20.0..20.0);
-            let dp = rng.gen_range(2.0..200.0) * if rng.gen_bool(0.5) { 1.0 } else { -1.0 };
-            let level = 1.0 + 0.05 * rng.gen_range(-1.0..1.0);
-            x[2] *= level;
-            x[3] = x[2] + dp;
-            x[4] *= 1.0 + 0.05 * rng.gen_range(-1.0..1.0);
-            x[5] *= 1.0 + 0.05 * rng.gen_range(-1.0..1.0);
-            x
-        })
-        .collect()
 }
 
 fn rel(a: &[f64], b: &[f64]) -> f64 {
@@ -107,7 +87,7 @@ fn file_and_macro_are_one_model() {
             p.iter_mut()
                 .for_each(|v| *v *= 1.0 + 0.05 * rng.gen_range(-1.0..1.0));
         }
-        for x in states(&m, &p, 100 + k, 8) {
+        for x in run::round_the_crank(&m, &p, 100 + k, 8) {
             let (mut a, mut b) = (vec![0.0; n], vec![0.0; n]);
             f.rhs(&p, &x, 0.0, &mut a);
             m.rhs(&p, &x, 0.0, &mut b);
@@ -145,7 +125,7 @@ fn jacobians_match_finite_differences() {
         let p = model.default_params();
         let mut report = Vec::new();
         let mut worst = (0.0f64, String::new());
-        for (k, x) in states(model, &p, 11, 24).into_iter().enumerate() {
+        for (k, x) in run::round_the_crank(model, &p, 11, 24).into_iter().enumerate() {
             // rows as large as `|P'| ~ 1e8 Pa/s` (the short regenerator link at these spreads)
             // next to entries of ~1e2 near a dead centre: upper steps 10 and 100 times the
             // default resolve them (tests/common/mod.rs, `check_jacobians_from`)
@@ -176,7 +156,7 @@ fn energy_budget_closes_at_states_all_round_the_crank() {
     let p = m.default_params();
     let n = m.n_states();
     let mut worst = 0.0f64;
-    for x in states(&m, &p, 21, 40) {
+    for x in run::round_the_crank(&m, &p, 21, 40) {
         let mut f = vec![0.0; n];
         m.rhs(&p, &x, 0.0, &mut f);
         let e = |s: f64| {

@@ -1,6 +1,6 @@
 //! The kinematic base and the gamma LTD engine of `examples/engines/kinematic.stirling` and
-//! `gamma_ltd.stirling`, declared with the macro (the same text: the files' equivalence test
-//! holds the two to the same equations).
+//! `gamma_ltd.stirling`, declared with the macro (the same text: `tests/kinematic_dsl.rs`
+//! checks that it has not drifted from the files, and that the two are one model).
 #![allow(dead_code)]
 
 use stirling::stirling_model;
@@ -106,8 +106,9 @@ stirling_model! {
             port cylinder { h: hs, area: pi * Dp * (Vpd / Ap - y), wall: Tk },
         }
         link hot -> cold { resistance: Rf }
-        // the room pushes on the power piston's outer face, and takes the leak
-        space room { pressure: Pb, temperature: Tk, faces { piston: Ap } }
+        // the room pushes on the power piston's outer face, and takes the leak (its volume, 1 L
+        // of the room near the engine, is a nominal one: the pressure is given)
+        space room { pressure: Pb, volume: 1.0e-3, temperature: Tk, faces { piston: Ap } }
         link cold -> room { conductance: Gleak }
         sensor p: P_cold "Pa";
     }

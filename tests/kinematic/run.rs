@@ -2,6 +2,7 @@
 //! last whole revolutions (shared by the kinematic tests).
 #![allow(dead_code)]
 
+use rand::Rng;
 use stirling::dsl::Model;
 use stirling::models::sim::{self, SimOptions};
 
@@ -82,3 +83,26 @@ pub fn run(m: &dyn Model, p: &[f64], x0: &[f64], t_end: f64, revs: usize) -> Run
         hz_before: revs_f / (tr.t[ka] - tr.t[k0]),
     }
 }
+
+/// States all round the crank: angle in [0, 2 pi), speed within +-20 rad/s, pressures
+/// within +-5 % of the charge and 2 to 200 Pa apart, masses within +-5 % of rest.
+pub fn round_the_crank(m: &dyn Model, p: &[f64], seed: u64, count: usize) -> Vec<Vec<f64>> {
+    let mut rng: rand::rngs::StdRng = rand::SeedableRng::seed_from_u64(seed);
+    let mut x0 = vec![0.0; m.n_states()];
+    m.equilibrium_guess(p, &mut x0);
+    (0..count)
+        .map(|_| {
+            let mut x = x0.clone();
+            x[0] = rng.gen_range(0.0..2.0 * std::f64::consts::PI);
+            x[1] = rng.gen_range(-20.0..20.0);
+            let dp = rng.gen_range(2.0..200.0) * if rng.gen_bool(0.5) { 1.0 } else { -1.0 };
+            let level = 1.0 + 0.05 * rng.gen_range(-1.0..1.0);
+            x[2] *= level;
+            x[3] = x[2] + dp;
+            x[4] *= 1.0 + 0.05 * rng.gen_range(-1.0..1.0);
+            x[5] *= 1.0 + 0.05 * rng.gen_range(-1.0..1.0);
+            x
+        })
+        .collect()
+}
+
