@@ -1,5 +1,5 @@
 //! Kinematics in the DSL (docs/physics.md section 12), on the gamma LTD engine declared twice,
-//! in `examples/engines/gamma_ltd.stirling` (extending `kinematic.stirling`; loaded, compiled
+//! in `examples/engines/gamma_ltd.stirling` (extending `bases/kinematic.stirling`; loaded, compiled
 //! to tapes and run by the JIT) and with the macro (`tests/kinematic/models.rs`, extending the
 //! same base as a macro base): the two are one model; their analytic Jacobians match finite
 //! differences at states all round the crank; the energy budget `d/dt (gas + J omega^2/2) =
@@ -54,13 +54,13 @@ fn the_macro_declares_the_files_text() {
     let squash = |s: &str| s.split_whitespace().collect::<Vec<_>>().join(" ");
     let macro_text = squash(include_str!("kinematic/models.rs"));
     for (file, from) in [
-        ("kinematic.stirling", "/// A flywheel driving"),
+        ("bases/kinematic.stirling", "/// A flywheel driving"),
         ("gamma_ltd.stirling", "/// Gamma-type LTD engine"),
     ] {
         let text = std::fs::read_to_string(engines_dir().join(file)).unwrap();
         let body = &text[text.find(from).unwrap()..];
         let body = body.replace(
-            "model GammaLtd extends \"kinematic.stirling\"",
+            "model GammaLtd extends \"bases/kinematic.stirling\"",
             "pub model GammaLtd extends kinematic_engine",
         );
         assert!(

@@ -1,5 +1,5 @@
 //! The beta and alpha kinematic engines of `examples/engines/` (each extending
-//! `kinematic.stirling`, as the gamma LTD does): pushed from rest at 5 Hz they settle on a
+//! `bases/kinematic.stirling`, as the gamma LTD does): pushed from rest at 5 Hz they settle on a
 //! steady rotation with positive indicated power (beta 6.03 Hz, 8.6 mJ per revolution, 52 mW;
 //! alpha 6.41 Hz, 15.1 mJ, 97 mW, with their estimated geometry and friction); their
 //! Jacobians match finite differences all round the crank; their bond graphs are causal with

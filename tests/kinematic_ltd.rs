@@ -1,5 +1,5 @@
 //! The gamma-type LTD engine of `examples/engines/gamma_ltd.stirling` (extending
-//! `kinematic.stirling`): pushed from rest at 1 Hz it settles on a steady rotation, its
+//! `bases/kinematic.stirling`): pushed from rest at 1 Hz it settles on a steady rotation, its
 //! limit cycle, at about 2.8 Hz (170 rpm; such engines run at about 150 rpm on a cup of hot
 //! water), with positive indicated power (the gas's closed-integral `P dV` per revolution
 //! times the speed, about 2.2 mW); with the same push and a brake on the flywheel it turns

@@ -1,4 +1,4 @@
-//! The kinematic base and the gamma LTD engine of `examples/engines/kinematic.stirling` and
+//! The kinematic base and the gamma LTD engine of `examples/engines/bases/kinematic.stirling` and
 //! `gamma_ltd.stirling`, declared with the macro (the same text: `tests/kinematic_dsl.rs`
 //! checks that it has not drifted from the files, and that the two are one model).
 #![allow(dead_code)]
