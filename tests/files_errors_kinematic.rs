@@ -77,6 +77,22 @@ fn the_good_engine_loads() {
     assert!(topo.bodies[0].rotary);
 }
 
+/// A sensor on the flywheel reads its angle in rad and its speed in rad/s by default.
+#[test]
+fn flywheel_sensors_default_to_radians() {
+    let text = edit(
+        "    cv gas {",
+        "    sensor angle: theta;\n    sensor speed: omega;\n    cv gas {",
+    );
+    let topo = load_str(&PathBuf::from("good/sensed.stirling"), &text, BASES).expect("loads");
+    let units: Vec<(&str, &str)> = topo
+        .sensors
+        .iter()
+        .map(|s| (s.name.as_str(), s.unit.as_str()))
+        .collect();
+    assert_eq!(units, [("angle", "rad"), ("speed", "rad/s")]);
+}
+
 #[test]
 fn crank_on_an_unknown_flywheel() {
     let text = edit("on wheel {", "on wheeel {");
