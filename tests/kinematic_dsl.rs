@@ -289,3 +289,35 @@ fn bond_graph_shows_the_mechanism_as_mtf() {
         assert!(!cg.graph.nodes.iter().any(|n| n.kind == Kind::Tf));
     }
 }
+
+/// `modify body` changes a crank's fields like a body's: a file extending the gamma engine
+/// with a longer displacer rod moves the hot volume as the slider-crank law says at that rod.
+#[test]
+fn modify_changes_a_cranks_rod() {
+    let dir = std::path::PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("kinematic_modify");
+    std::fs::create_dir_all(&dir).unwrap();
+    let file = dir.join("longer_rod.stirling");
+    let base = engines_dir().join("gamma_ltd.stirling");
+    let text = format!(
+        "model Longer extends \"{}\" {{\n    name \"longer\";\n    modify body displacer {{ rod: 3.0 * Ld }}\n}}\n",
+        base.display()
+    );
+    std::fs::write(&file, text).unwrap();
+    let m = files::build(&file, 1, Closure::Full).unwrap();
+    let p = m.default_params();
+    let get = |name: &str| p[m.param_index(name).unwrap()];
+    let (ad, ch, rd, ld) = (get("Ad"), get("ch"), get("rd"), 3.0 * get("Ld"));
+    let mut x = vec![0.0; m.n_states()];
+    m.equilibrium_guess(&p, &mut x);
+    x[0] = 1.0;
+    let nv = m.vessel_names().len();
+    let (mut pr, mut v) = (vec![0.0; nv], vec![0.0; nv]);
+    m.pv(&p, &x, &mut pr, &mut v);
+    let s = rd * 1f64.cos() + (ld * ld - (rd * 1f64.sin()).powi(2)).sqrt() - ld;
+    let want = ad * (ch + rd) - ad * s;
+    assert!((v[0] - want).abs() <= 1e-15 * want, "V_hot {} vs {want}", v[0]);
+    // and not the base's rod
+    let base_rod = get("Ld");
+    let s0 = rd * 1f64.cos() + (base_rod * base_rod - (rd * 1f64.sin()).powi(2)).sqrt() - base_rod;
+    assert!((ad * (ch + rd) - ad * s0 - want).abs() > 1e-12);
+}
