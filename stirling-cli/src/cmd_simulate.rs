@@ -132,6 +132,14 @@ fn simulate(
         ..Default::default()
     };
     if args.limit_cycle {
+        // a flywheel's angle grows by 2 pi a revolution: no closed orbit of every state to shoot
+        if let Some(s) = model.states().iter().find(|s| s.unit == "rad") {
+            anyhow::bail!(
+                "limit cycle of `{}`: `--limit-cycle` shoots a closed orbit of every state, but the flywheel's angle `{}` grows by 2 pi a revolution (a kinematic engine, docs/physics.md section 12); run without it from a push (`--x0` with the speed > 0) and read the speed from the trajectory",
+                model.name(),
+                s.name
+            );
+        }
         let shooting = args.shooting.into();
         let lc = sim::limit_cycle_with(
             model,

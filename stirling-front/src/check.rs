@@ -15,6 +15,7 @@ use crate::expr::{convert, Scope};
 mod declare;
 mod fields;
 mod flow;
+mod kinematics;
 mod links;
 mod mechanics;
 mod sensors;
@@ -86,6 +87,10 @@ pub(crate) struct Lower {
     lets: HashMap<String, Id>,
     pub(crate) states: HashMap<String, Sym>,
     bodies: HashMap<String, usize>,
+    /// Declared cranks and linkages: their index in `Topology::mechanisms`.
+    mechanisms: HashMap<String, usize>,
+    /// Mechanisms refused at their declaration: faces on them report nothing more.
+    refused_mechanisms: std::collections::HashSet<String>,
     pub(crate) vessels: HashMap<String, Vessel>,
     cv_arrays: Vec<bool>,
     /// Declared walls: index and whether an array.
@@ -136,6 +141,11 @@ impl Lower {
             }
         }
         for it in &ast.items {
+            if let Item::Mechanism(m) = it {
+                self.declare_mechanism(m);
+            }
+        }
+        for it in &ast.items {
             if let Item::Space(v) | Item::Cv(v) = it {
                 self.declare_vessel(v, matches!(it, Item::Cv(_)));
             }
@@ -143,6 +153,12 @@ impl Lower {
         for it in &ast.items {
             if let Item::Wall(v) = it {
                 self.declare_wall(v);
+            }
+        }
+        // a mechanism's position is bound before any item reads it (parameters only inside)
+        for it in &ast.items {
+            if let Item::Mechanism(m) = it {
+                self.mechanism(m);
             }
         }
         for it in &ast.items {
@@ -155,7 +171,11 @@ impl Lower {
                 Item::Cv(v) => self.cv(v),
                 Item::Wall(v) => self.wall(v),
                 Item::Link(l) => self.link(l),
-                Item::Name(_) | Item::Params(_) | Item::Sensor(_) | Item::Effect(_) => {}
+                Item::Name(_)
+                | Item::Params(_)
+                | Item::Sensor(_)
+                | Item::Effect(_)
+                | Item::Mechanism(_) => {}
                 Item::Free(_, names) => self.free(names),
             }
         }

@@ -30,7 +30,12 @@ impl Builder<'_> {
                     let Some(k) = topo.bodies.iter().position(|b| *b == f.body) else {
                         continue;
                     };
-                    let tf = self.g.node(Kind::Tf, f.coeff);
+                    let tf = if f.modulus.is_empty() {
+                        self.g.node(Kind::Tf, f.coeff)
+                    } else {
+                        // a face on a mechanism: modulated by the flywheel's angle
+                        self.g.node(Kind::Mtf, format!("{} * {}", f.coeff, f.modulus))
+                    };
                     self.g.bond(tf, self.bodies[k], Domain::Mechanical);
                     p.volume.push((tf, true));
                 }

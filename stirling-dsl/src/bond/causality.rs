@@ -150,7 +150,7 @@ fn propagate(g: &mut BondGraph) -> Result<(), BondError> {
             changed |= match g.nodes[n].kind {
                 Kind::Zero => junction(g, n, true)?,
                 Kind::One => junction(g, n, false)?,
-                Kind::Tf => junction(g, n, false)?,
+                Kind::Tf | Kind::Mtf => junction(g, n, false)?,
                 _ => false,
             };
         }

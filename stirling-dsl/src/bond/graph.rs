@@ -12,6 +12,9 @@ pub enum Kind {
     One,
     /// A transformer (a piston face: `F = a P`, `dV/dt = a v`).
     Tf,
+    /// A modulated transformer (a face on a mechanism: `T = a ds/dtheta P`,
+    /// `dV/dt = a ds/dtheta omega`, the modulus a function of the flywheel's angle).
+    Mtf,
     /// An inertia (a body's mass).
     I,
     /// A capacitance: a spring, a wall's heat capacity, or a gas control volume's multiport
@@ -28,12 +31,13 @@ pub enum Kind {
 }
 
 impl Kind {
-    /// The label's prefix: `0`, `1`, `TF`, `I`, `C`, `R`, `Se`, `MSe`, `Sf`.
+    /// The label's prefix: `0`, `1`, `TF`, `MTF`, `I`, `C`, `R`, `Se`, `MSe`, `Sf`.
     pub fn symbol(self) -> &'static str {
         match self {
             Kind::Zero => "0",
             Kind::One => "1",
             Kind::Tf => "TF",
+            Kind::Mtf => "MTF",
             Kind::I => "I",
             Kind::C => "C",
             Kind::R => "R",

@@ -85,15 +85,23 @@ pub(crate) fn block_meaning(
     match kind {
         BlockKind::Position(k) => (
             "Position",
-            "m",
-            format!("position of the {}", topo.bodies[k].name),
+            if topo.bodies[k].rotary { "rad" } else { "m" },
+            if topo.bodies[k].rotary {
+                format!("angle of the flywheel {}", topo.bodies[k].name)
+            } else {
+                format!("position of the {}", topo.bodies[k].name)
+            },
             (k, 0),
             true,
         ),
         BlockKind::Velocity(k) => (
             "Velocity",
-            "m/s",
-            format!("velocity of the {}", topo.bodies[k].name),
+            if topo.bodies[k].rotary { "rad/s" } else { "m/s" },
+            if topo.bodies[k].rotary {
+                format!("angular velocity of the flywheel {}", topo.bodies[k].name)
+            } else {
+                format!("velocity of the {}", topo.bodies[k].name)
+            },
             (k, 0),
             true,
         ),
@@ -174,12 +182,12 @@ pub fn vessel_names(topo: &Topology) -> TokenStream {
 /// The strings of a `TopologyInfo`, as the emitted static and the run-time model
 /// (`crate::compiled`) both hold them.
 pub(crate) struct TopologyText {
-    /// `(name, is_cv, array, faces (body, coeff), ports (name, wall, wall_ref))`.
+    /// `(name, is_cv, array, faces (body, coeff, modulus), ports (name, wall, wall_ref))`.
     pub vessels: Vec<(
         String,
         bool,
         bool,
-        Vec<(String, String)>,
+        Vec<(String, String, String)>,
         Vec<(String, String, Option<String>)>,
     )>,
     /// `(from, to, resistance, chain)`.
@@ -198,7 +206,14 @@ pub(crate) fn topology_text(topo: &Topology, lay: &Layout) -> TopologyText {
     let namer = |s| lay.name(s);
     let p = Printer::new(&topo.arena, Style::Text, &namer);
     let body_name = |k: usize| topo.bodies[k].name.clone();
-    let face = |f: &crate::topology::FaceDecl| (body_name(f.body), p.expr(f.coeff));
+    // a face on a mechanism: its modulus `ds/dtheta`, printed (empty for a plain face)
+    let face = |f: &crate::topology::FaceDecl| {
+        let modulus = f.mechanism.map_or(String::new(), |m| {
+            let m = &topo.mechanisms[m];
+            format!("{}({})", p.expr(m.ratio), topo.bodies[m.body].pos)
+        });
+        (body_name(f.body), p.expr(f.coeff), modulus)
+    };
     let mut vessels = Vec::new();
     for c in &topo.cvs {
         let faces = c.faces.iter().map(face).collect();
@@ -274,7 +289,7 @@ pub fn topology(topo: &Topology, lay: &Layout, krate: &TokenStream) -> TokenStre
     let vessels = t.vessels.iter().map(|(name, is_cv, array, faces, ports)| {
         let faces = faces
             .iter()
-            .map(|(b, c)| quote! { #krate::FaceInfo { body: #b, coeff: #c } });
+            .map(|(b, c, m)| quote! { #krate::FaceInfo { body: #b, coeff: #c, modulus: #m } });
         let ports = ports.iter().map(|(n, w, r)| {
             let r = match r {
                 Some(name) => quote!(Some(#name)),

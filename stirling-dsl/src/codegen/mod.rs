@@ -104,6 +104,8 @@ fn items(topo: &Topology, spec: &ModelSpec, st: &Statics, parts: &[TokenStream])
 
         impl #ident {
             /// The declared parameters, in slice order.
+            // a default may be a constant of `pi` (a crank's phase `-pi / 2.0`)
+            #[allow(clippy::approx_constant)]
             pub const PARAMS: &'static [#krate::ParamInfo] = #p;
             /// The bodies, in state order.
             pub const BODIES: &'static [#krate::BodyInfo] = #b;
@@ -162,6 +164,7 @@ fn params_struct(topo: &Topology, spec: &ModelSpec) -> TokenStream {
         }
 
         impl ::core::default::Default for #ps {
+            #[allow(clippy::approx_constant)]
             fn default() -> Self {
                 Self { #( #fields: #defaults, )* }
             }

@@ -106,9 +106,10 @@ fn topology(topo: &Topology, sys: &System) -> TopologyInfo {
             faces: list(
                 faces
                     .iter()
-                    .map(|(b, c)| FaceInfo {
+                    .map(|(b, c, m)| FaceInfo {
                         body: s(b),
                         coeff: s(c),
+                        modulus: s(m),
                     })
                     .collect(),
             ),

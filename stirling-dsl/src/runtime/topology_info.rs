@@ -40,6 +40,10 @@ pub struct FaceInfo {
     pub body: &'static str,
     /// The coefficient `a`, as declared.
     pub coeff: &'static str,
+    /// A face on a mechanism (docs/physics.md section 12): its `ds/dtheta` as a function of
+    /// the flywheel's angle (`ds_piston(theta)`), the modulus of the modulated transformer;
+    /// empty for a plain face (a constant `TF`).
+    pub modulus: &'static str,
 }
 
 /// A gas vessel: a CV (or array of CVs) or a given-pressure space.

@@ -45,6 +45,29 @@ pub struct BodyDecl {
     pub quad_damper: Id,
     /// Any further force (a load, friction, an end stop), an expression of states and parameters.
     pub force: Id,
+    /// A flywheel (`flywheel wheel(theta, omega) { .. }`): the position is an angle (rad),
+    /// the mass an inertia (kg m^2) and the forces torques (docs/physics.md section 12).
+    pub rotary: bool,
+}
+
+/// A mechanism (docs/physics.md section 12): a position `s(theta)` driven by the angle of a
+/// flywheel, a slider-crank (`crank piston(y) on wheel { radius, rod, phase }`) or any
+/// expression of the angle (`linkage displacer(x) on wheel { position: .. }`). A face on it
+/// changes a volume by `a s(theta)` and puts the torque `a P ds/dtheta` on the flywheel: a
+/// modulated transformer.
+#[derive(Clone, Debug)]
+pub struct MechanismDecl {
+    pub name: String,
+    /// The position's name (`y`), usable in expressions as `s(theta)`.
+    pub pos: String,
+    /// `crank` or `linkage`, as declared.
+    pub kind: String,
+    /// The flywheel (a body with `rotary`) whose angle drives it.
+    pub body: usize,
+    /// `s(theta)`.
+    pub position: Id,
+    /// `ds/dtheta`, the transformer's modulus.
+    pub ratio: Id,
 }
 
 /// A damper between two bodies: force `c (v_b - v_a)` on `a` and the opposite on `b`.
@@ -60,6 +83,9 @@ pub struct CouplingDecl {
 pub struct FaceDecl {
     pub body: usize,
     pub coeff: Id,
+    /// A face on a mechanism ([`MechanismDecl`]): `body` is its flywheel and the volume
+    /// changes by `coeff * s(theta)`, not `coeff * q_body`.
+    pub mechanism: Option<usize>,
 }
 
 /// A heat port: `Q = h area (wall - T)`.
@@ -243,6 +269,8 @@ pub struct Topology {
     pub params: Vec<ParamDecl>,
     pub gas: Option<GasDecl>,
     pub bodies: Vec<BodyDecl>,
+    /// Positions driven by a flywheel's angle (no state of their own).
+    pub mechanisms: Vec<MechanismDecl>,
     pub couplings: Vec<CouplingDecl>,
     pub spaces: Vec<SpaceDecl>,
     pub cvs: Vec<CvDecl>,

@@ -15,11 +15,37 @@ impl Assembler<'_> {
         )
     }
 
-    /// `sum coeff * q` and `sum coeff * v` over faces.
+    /// The displacement and velocity a face moves with: the body's `(q, v)`, or a
+    /// mechanism's `(s(theta), ds/dtheta omega)` (docs/physics.md section 12).
+    fn face_motion(&mut self, f: &super::decl::FaceDecl) -> (Id, Id) {
+        let (q, v) = self.body_syms(f.body);
+        match f.mechanism {
+            None => (q, v),
+            Some(m) => {
+                let m = &self.t.mechanisms[m];
+                let (s, ratio) = (m.position, m.ratio);
+                (s, self.t.arena.mul(ratio, v))
+            }
+        }
+    }
+
+    /// The transformer modulus of a face: 1, or a mechanism's `ds/dtheta`.
+    fn face_ratio(&mut self, f: &super::decl::FaceDecl) -> Id {
+        match f.mechanism {
+            None => f.coeff,
+            Some(m) => {
+                let ratio = self.t.mechanisms[m].ratio;
+                self.t.arena.mul(f.coeff, ratio)
+            }
+        }
+    }
+
+    /// `sum coeff * q` and `sum coeff * v` over faces (a mechanism's face: `coeff * s(theta)`
+    /// and `coeff * ds/dtheta * omega`).
     pub(super) fn face_sums(&mut self, faces: &[super::decl::FaceDecl]) -> (Id, Id) {
         let (mut dv, mut vdot) = (self.t.arena.num(0.0), self.t.arena.num(0.0));
         for f in faces.iter().cloned() {
-            let (q, v) = self.body_syms(f.body);
+            let (q, v) = self.face_motion(&f);
             let a = &mut self.t.arena;
             let (cq, cv) = (a.mul(f.coeff, q), a.mul(f.coeff, v));
             dv = a.add(dv, cq);
@@ -28,19 +54,24 @@ impl Assembler<'_> {
         (dv, vdot)
     }
 
-    /// Pressure force on body `k`: `sum_i a_ik P_i` over CV and space faces.
+    /// Pressure force on body `k`: `sum_i a_ik P_i` over CV and space faces (on a flywheel
+    /// the torque `sum_i a_ik ds_m/dtheta P_i` of the faces on its mechanisms).
     pub(super) fn force(&mut self, k: usize) -> Id {
-        let mut terms = Vec::new();
+        let mut faces = Vec::new();
         for (i, c) in self.t.cvs.iter().enumerate() {
             for f in c.faces.iter().filter(|f| f.body == k) {
-                terms.push((f.coeff, self.cv[i].p));
+                faces.push((f.clone(), self.cv[i].p));
             }
         }
         for s in &self.t.spaces {
             for f in s.faces.iter().filter(|f| f.body == k) {
-                terms.push((f.coeff, s.pressure));
+                faces.push((f.clone(), s.pressure));
             }
         }
+        let terms: Vec<(Id, Id)> = faces
+            .into_iter()
+            .map(|(f, p)| (self.face_ratio(&f), p))
+            .collect();
         let name = format!("F_{}", self.t.bodies[k].name);
         let a = &mut self.t.arena;
         let products: Vec<Id> = terms.into_iter().map(|(c, p)| a.mul(c, p)).collect();

@@ -11,6 +11,9 @@
 //!     gas { R: R, gamma: gamma, charge: Pmean, mdot_eps: mdot_eps }
 //!     body displacer(x, v) { mass: md, spring: kd, damper: bd, quad_damper: bqd, force: .. }
 //!     coupling displacer, piston { damper: b }
+//!     flywheel wheel(theta, omega) { inertia: J, damper: c, friction: Tc, omega_eps: w0, load: Tl }
+//!     crank piston(y) on wheel { radius: r, rod: L, phase: phi }   // y = s(theta), no state
+//!     linkage displacer(x) on wheel { position: r * sin(theta) }     // any s(theta)
 //!     space bounce { pressure: Pb, volume: Vb0, temperature: Tk, faces { displacer: Ar } }
 //!     cv hot { volume: Vh0, faces { displacer: -A }, port hot { h: hh, area: Awh, wall: Th } }
 //!     cv regen[n] { volume: Vr / n, port wall { h: hr, area: Awr / n, wall: Th - (j + 0.5) * (Th - Tk) / n } }
@@ -132,6 +135,21 @@ pub struct BodyAst {
     pub pos: Ident,
     pub vel: Ident,
     pub fields: Vec<Field>,
+    /// Declared with `flywheel` (an angle, an inertia, torques) rather than `body`.
+    pub rotary: bool,
+}
+
+/// A position driven by a flywheel's angle (docs/physics.md section 12):
+/// `crank piston(y) on wheel { radius: r, rod: L, phase: phi }` or
+/// `linkage displacer(x) on wheel { position: <expression of the angle> }`.
+pub struct MechanismAst {
+    /// `crank` or `linkage`.
+    pub kind: Ident,
+    pub name: Ident,
+    pub pos: Ident,
+    /// The flywheel.
+    pub on: Ident,
+    pub fields: Vec<Field>,
 }
 
 pub struct CouplingAst {
@@ -213,6 +231,8 @@ pub enum Item {
     Let(Ident, Box<Expr>),
     Gas(Span, Vec<Field>),
     Body(BodyAst),
+    /// A crank or linkage on a flywheel.
+    Mechanism(MechanismAst),
     Coupling(CouplingAst),
     Space(VesselAst),
     Cv(VesselAst),
@@ -307,7 +327,9 @@ pub fn item(input: ParseStream) -> syn::Result<Item> {
             Item::Params(Punctuated::<ParamAst, Token![,]>::parse_terminated(&content)?.into_iter().collect())
         }
         "gas" => Item::Gas(kw.span(), fields(input)?),
-        "body" => body(input)?,
+        "body" => body(input, false)?,
+        "flywheel" => body(input, true)?,
+        "crank" | "linkage" => mechanism(input, kw)?,
         "coupling" => {
             let a = input.parse()?;
             input.parse::<Token![,]>()?;
@@ -328,14 +350,14 @@ pub fn item(input: ParseStream) -> syn::Result<Item> {
         other => {
             return Err(syn::Error::new(
                 kw.span(),
-                format!("unknown item `{other}`: expected one of name, params, let, gas, body, coupling, space, cv, wall, link, sensor, free, effect"),
+                format!("unknown item `{other}`: expected one of name, params, let, gas, body, flywheel, crank, linkage, coupling, space, cv, wall, link, sensor, free, effect"),
             ))
         }
     };
     Ok(item)
 }
 
-fn body(input: ParseStream) -> syn::Result<Item> {
+fn body(input: ParseStream, rotary: bool) -> syn::Result<Item> {
     let name = input.parse()?;
     let content;
     parenthesized!(content in input);
@@ -346,6 +368,29 @@ fn body(input: ParseStream) -> syn::Result<Item> {
         name,
         pos,
         vel,
+        fields: fields(input)?,
+        rotary,
+    }))
+}
+
+fn mechanism(input: ParseStream, kind: Ident) -> syn::Result<Item> {
+    let name = input.parse()?;
+    let content;
+    parenthesized!(content in input);
+    let pos = content.parse()?;
+    let on: Ident = input.parse()?;
+    if on != "on" {
+        return Err(syn::Error::new(
+            on.span(),
+            format!("expected `on <flywheel>` after `{kind} {name}({pos})`, found `{on}`"),
+        ));
+    }
+    let on = input.parse()?;
+    Ok(Item::Mechanism(MechanismAst {
+        kind,
+        name,
+        pos,
+        on,
         fields: fields(input)?,
     }))
 }

@@ -84,6 +84,7 @@ impl Lower {
             damper: zero,
             quad_damper: zero,
             force: zero,
+            rotary: b.rotary,
         });
     }
 

@@ -26,6 +26,9 @@ impl Lower {
         let Some(&k) = self.bodies.get(&b.name.to_string()) else {
             return;
         };
+        if b.rotary {
+            return self.flywheel(b, k);
+        }
         let what = format!("body `{}`", b.name);
         let f = self.fields(
             &b.fields,
@@ -51,7 +54,8 @@ impl Lower {
     pub(super) fn body_ref(&mut self, id: &Ident) -> Option<usize> {
         let found = self.bodies.get(&id.to_string()).copied();
         if found.is_none() {
-            let mut names: Vec<&String> = self.bodies.keys().collect();
+            let mut names: Vec<&String> =
+                self.bodies.keys().chain(self.mechanisms.keys()).collect();
             names.sort();
             let list = names
                 .iter()
@@ -68,6 +72,11 @@ impl Lower {
 
     pub(super) fn coupling(&mut self, c: &crate::ast::CouplingAst) {
         let (a, b) = (self.body_ref(&c.a), self.body_ref(&c.b));
+        for (id, k) in [(&c.a, a), (&c.b, b)] {
+            if k.is_some_and(|k| self.topo.bodies[k].rotary) {
+                self.cx.error(id.span(), format!("`{id}` is a flywheel: a coupling damper joins two bodies on one axis (a flywheel's friction is its `damper` and `friction`)"));
+            }
+        }
         let f = self.fields(&c.fields, &["damper"], "`coupling`");
         let damper = self.required(&f, "damper", c.a.span(), "`coupling`", None);
         if let (Some(a), Some(b)) = (a, b) {
@@ -78,15 +87,29 @@ impl Lower {
     pub(super) fn faces(&mut self, faces: &[Field], owner: &str) -> Vec<FaceDecl> {
         let mut out = Vec::new();
         for f in faces {
-            let body = self.body_ref(&f.name);
+            if self.refused_mechanisms.contains(&f.name.to_string()) {
+                continue;
+            }
+            let mechanism = self.mechanisms.get(&f.name.to_string()).copied();
+            let body = match mechanism {
+                Some(m) => Some(self.topo.mechanisms[m].body),
+                None => self.body_ref(&f.name),
+            };
             let coeff = self.static_expr(
                 &f.value,
                 None,
                 &format!("the face coefficient of `{owner}` on `{}`", f.name),
             );
-            if let Some(body) = body {
-                out.push(FaceDecl { body, coeff });
+            let Some(body) = body else { continue };
+            if mechanism.is_none() && self.topo.bodies[body].rotary {
+                self.cx.error(f.name.span(), format!("`{}` is a flywheel: a face acts on a body or on a crank or linkage driven by it (`crank piston(y) on {} {{ .. }}`)", f.name, f.name));
+                continue;
             }
+            out.push(FaceDecl {
+                body,
+                coeff,
+                mechanism,
+            });
         }
         out
     }

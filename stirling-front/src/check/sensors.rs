@@ -223,11 +223,12 @@ impl Lower {
 
     /// Whether `state` names a declared state: `(is an array, its unit)`.
     fn sensed_state(&self, state: &str) -> Option<(bool, &'static str)> {
-        if self.topo.bodies.iter().any(|b| b.pos == state) {
-            return Some((false, "m"));
+        // a flywheel's angle and speed (docs/physics.md section 12) in rad and rad/s
+        if let Some(b) = self.topo.bodies.iter().find(|b| b.pos == state) {
+            return Some((false, if b.rotary { "rad" } else { "m" }));
         }
-        if self.topo.bodies.iter().any(|b| b.vel == state) {
-            return Some((false, "m/s"));
+        if let Some(b) = self.topo.bodies.iter().find(|b| b.vel == state) {
+            return Some((false, if b.rotary { "rad/s" } else { "m/s" }));
         }
         let cv = |name: &str| match self.vessels.get(name) {
             Some(Vessel::Cv(i)) => Some(self.topo.cvs[*i].array),

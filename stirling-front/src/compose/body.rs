@@ -38,6 +38,7 @@ pub(super) fn entry(input: ParseStream) -> syn::Result<Entry> {
         Item::Let(n, _) => (Key::Let(n.to_string()), n.span()),
         Item::Gas(span, _) => (Key::Gas, *span),
         Item::Body(b) => (Key::Body(b.name.to_string()), b.name.span()),
+        Item::Mechanism(m) => (Key::Body(m.name.to_string()), m.name.span()),
         Item::Coupling(c) => (Key::Coupling(c.a.to_string(), c.b.to_string()), c.a.span()),
         Item::Space(v) | Item::Cv(v) | Item::Wall(v) => {
             (Key::Vessel(v.name.to_string()), v.name.span())

@@ -71,7 +71,7 @@ pub(super) fn target(input: ParseStream, verb: &str) -> syn::Result<(Key, Span)>
         }
         "gas" => (Key::Gas, kw.span()),
         "free" => (Key::Free, kw.span()),
-        "body" => {
+        "body" | "flywheel" | "crank" | "linkage" => {
             let n = named(input)?;
             (Key::Body(n.to_string()), n.span())
         }
@@ -98,7 +98,7 @@ pub(super) fn target(input: ParseStream, verb: &str) -> syn::Result<(Key, Span)>
         other => {
             return Err(syn::Error::new(
                 kw.span(),
-                format!("`{verb} {other}`: expected one of param, let, gas, body, coupling, space, cv, wall, link, sensor, free"),
+                format!("`{verb} {other}`: expected one of param, let, gas, body, flywheel, crank, linkage, coupling, space, cv, wall, link, sensor, free"),
             ))
         }
     })

@@ -172,7 +172,7 @@ pub fn apply_override(model: &dyn Model, s: &str, p: &mut [f64]) -> Result<(), P
 
 /// Physical ranges: finite values; positive masses, volumes, areas, temperatures,
 /// pressures, gas constants; `Th > Tk`, `Ar < A`, `gamma > 1`; non-negative springs,
-/// dampers, heat-transfer coefficients and resistances.
+/// dampers, heat-transfer coefficients and resistances (angles, unit `rad`, of any sign).
 pub fn validate(model: &dyn Model, p: &[f64]) -> Result<(), ParamError> {
     let get = |n: &str| model.param_index(n).map(|k| p[k]);
     for (info, &v) in model.params().iter().zip(p) {
@@ -193,7 +193,9 @@ pub fn validate(model: &dyn Model, p: &[f64]) -> Result<(), ParamError> {
         if must_be_positive && v <= 0.0 {
             return bad(&format!("must be positive (unit {})", info.unit));
         }
-        if !must_be_positive && info.unit != "-" && v < 0.0 && info.name != "Vb0" {
+        // an angle (a crank's phase, docs/physics.md section 12) may have either sign
+        let signed = matches!(info.unit, "-" | "rad");
+        if !must_be_positive && !signed && v < 0.0 && info.name != "Vb0" {
             return bad(&format!("must not be negative (unit {})", info.unit));
         }
         if let Some(why) = out_of_scale(v, info.default) {
