@@ -3,31 +3,17 @@
 //! `simulate` runs one from a push (`--x0`) and it keeps turning; `--limit-cycle`, which shoots a closed orbit of every
 //! state, is refused by name (the flywheel's angle grows a revolution at a time).
 
+mod support;
+
 use std::path::PathBuf;
-use std::process::{Command, Output};
+
+use support::{prints as ok, stirling};
 
 fn engine(name: &str) -> String {
     let p: PathBuf = [env!("CARGO_MANIFEST_DIR"), "..", "examples", "engines", name]
         .iter()
         .collect();
     p.display().to_string()
-}
-
-fn stirling(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_stirling"))
-        .args(args)
-        .output()
-        .expect("run stirling")
-}
-
-fn ok(args: &[&str]) -> String {
-    let out = stirling(args);
-    assert!(
-        out.status.success(),
-        "{args:?}: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    String::from_utf8(out.stdout).unwrap()
 }
 
 #[test]

@@ -22,6 +22,17 @@ pub fn succeeds(args: &[&str]) -> String {
     err
 }
 
+/// `args` succeed; their stdout.
+pub fn prints(args: &[&str]) -> String {
+    let out = stirling(args);
+    assert!(
+        out.status.success(),
+        "{args:?} failed: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    String::from_utf8(out.stdout).expect("stdout is UTF-8")
+}
+
 /// `args` fail (non-zero exit, no panic) with every one of `needles` in stderr.
 pub fn fails_with(args: &[&str], needles: &[&str]) -> String {
     let out = stirling(args);
