@@ -60,7 +60,7 @@ fn the_macro_declares_the_files_text() {
         let text = std::fs::read_to_string(engines_dir().join(file)).unwrap();
         let body = &text[text.find(from).unwrap()..];
         let body = body.replace(
-            "model GammaLtd extends \"bases/kinematic.stirling\"",
+            "model GammaLtd extends kinematic_engine",
             "pub model GammaLtd extends kinematic_engine",
         );
         assert!(

@@ -1,7 +1,9 @@
-//! `stirling models`: the family and its aliases.
+//! `stirling models`: the family and its aliases, registered engines, and the bases an
+//! engine file may extend by name.
 
 use std::io::Write;
 
+use stirling_models::model::files::BASES;
 use stirling_models::{user_models, FAMILY};
 
 use crate::common;
@@ -14,6 +16,7 @@ pub fn run(json: bool) -> anyhow::Result<()> {
             .iter()
             .map(|e| serde_json::json!({ "name": e.name, "aliases": e.aliases, "summary": e.summary }))
             .chain(user.iter().map(|u| serde_json::json!({ "name": u.name, "aliases": [], "summary": u.summary, "registered": true })))
+            .chain(BASES.iter().map(|b| serde_json::json!({ "name": b.name, "aliases": [], "summary": base_summary(b.text), "base": true })))
             .collect();
         return common::print_json(&list);
     }
@@ -24,5 +27,25 @@ pub fn run(json: bool) -> anyhow::Result<()> {
     for u in &user {
         writeln!(o, "{:<9} {:<16} {} (registered)", u.name, "", u.summary)?;
     }
+    writeln!(o, "\nbases an engine file extends by name (`model Mine extends NAME {{ .. }}`):")?;
+    for b in BASES {
+        writeln!(o, "  {:<17} {}", b.name, base_summary(b.text))?;
+    }
     Ok(())
+}
+
+/// A base's summary: the first sentence of the doc comment on its declaration.
+fn base_summary(text: &str) -> String {
+    let doc = text
+        .lines()
+        .map(str::trim)
+        .skip_while(|l| !l.starts_with("///"))
+        .map_while(|l| l.strip_prefix("///"))
+        .map(str::trim)
+        .collect::<Vec<_>>()
+        .join(" ");
+    match doc.find(". ") {
+        Some(end) => doc[..=end].to_string(),
+        None => doc,
+    }
 }

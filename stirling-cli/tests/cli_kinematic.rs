@@ -53,3 +53,16 @@ fn simulate_runs_from_a_push_and_refuses_the_limit_cycle() {
     assert!(err.contains("the flywheel's angle `theta` grows by 2 pi a revolution"), "{err}");
     assert!(!err.contains("panicked"), "{err}");
 }
+
+/// The kinematic base is built in: `stirling models` lists it among the bases, and a copy of
+/// the gamma engine's file in a folder of its own (no `bases/` beside it) loads and runs.
+#[test]
+fn the_kinematic_base_is_built_in() {
+    let models = ok(&["models"]);
+    assert!(models.contains("kinematic_engine") && models.contains("nsection_engine"), "{models}");
+    let dir = support::scratch("kinematic_copy");
+    let copy = dir.join("my_ltd.stirling");
+    std::fs::copy(engine("gamma_ltd.stirling"), &copy).unwrap();
+    let info = ok(&["info", support::s(&copy)]);
+    assert!(info.contains("theta") && info.contains("omega"), "{info}");
+}

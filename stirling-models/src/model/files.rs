@@ -21,7 +21,9 @@ use stirling_front::load::{load_detached, load_file, BuiltinBase, LoadError};
 pub const EXTENSION: &str = "stirling";
 
 /// The bases a file extends by name: the family's engine and its `nsection` gas (the same
-/// declarations as the family's `stirling_model!` bases).
+/// declarations as the family's `stirling_model!` bases), and the kinematic engines' common
+/// base (a flywheel and two cranks: `examples/engines/bases/kinematic.stirling`, docs/physics.md
+/// section 12), so that a user's file starts from any of them wherever it lies.
 pub const BASES: &[BuiltinBase] = &[
     BuiltinBase {
         name: "default_engine",
@@ -32,6 +34,11 @@ pub const BASES: &[BuiltinBase] = &[
         name: "nsection_engine",
         path: "<stirling>/nsection_engine.stirling",
         text: include_str!("family/nsection_engine.stirling"),
+    },
+    BuiltinBase {
+        name: "kinematic_engine",
+        path: "<stirling>/kinematic_engine.stirling",
+        text: include_str!("../../../examples/engines/bases/kinematic.stirling"),
     },
 ];
 
