@@ -42,7 +42,10 @@ fn close(a: &[f64], b: &[f64]) -> bool {
 fn same(a: &Measured, b: &Measured) {
     assert!(close(&a.t, &b.t), "t differs");
     for c in ["p", "x", "y"] {
-        assert!(close(a.channel(c).unwrap(), b.channel(c).unwrap()), "{c} differs");
+        assert!(
+            close(a.channel(c).unwrap(), b.channel(c).unwrap()),
+            "{c} differs"
+        );
     }
 }
 
@@ -57,7 +60,12 @@ fn a_lab_record_in_ms_kpa_gauge_and_mm_reads_as_the_si_record() {
         [0.0, AMBIENT, 0.0, 0.0],
     );
     same(&parse_csv("lab.csv", &lab).unwrap(), &si);
-    let bar = csv("t [s],p [bar],x [cm],y [m]", &rows, [1.0, 1e5, 1e-2, 1.0], [0.0; 4]);
+    let bar = csv(
+        "t [s],p [bar],x [cm],y [m]",
+        &rows,
+        [1.0, 1e5, 1e-2, 1.0],
+        [0.0; 4],
+    );
     same(&parse_csv("bar.csv", &bar).unwrap(), &si);
     let psig = csv(
         "t,p [psig],x [um],y [mm]",
@@ -70,13 +78,20 @@ fn a_lab_record_in_ms_kpa_gauge_and_mm_reads_as_the_si_record() {
 
 #[test]
 fn a_kinematic_record_keeps_its_volume_and_angle_in_si() {
-    let text = "t [ms],p [kPa gauge],dV [cm^3],theta [deg]\n0,1.5,-2.0,0\n10,1.7,0.5,36\n20,1.2,2.0,72\n";
+    let text =
+        "t [ms],p [kPa gauge],dV [cm^3],theta [deg]\n0,1.5,-2.0,0\n10,1.7,0.5,36\n20,1.2,2.0,72\n";
     let m = parse_csv("ltd.csv", text).unwrap();
     assert!(close(&m.t, &[0.0, 0.01, 0.02]));
-    assert!(close(m.p.as_deref().unwrap(), &[AMBIENT + 1500.0, AMBIENT + 1700.0, AMBIENT + 1200.0]));
+    assert!(close(
+        m.p.as_deref().unwrap(),
+        &[AMBIENT + 1500.0, AMBIENT + 1700.0, AMBIENT + 1200.0]
+    ));
     assert!(close(m.channel("dV").unwrap(), &[-2e-6, 0.5e-6, 2e-6]));
     let pi = std::f64::consts::PI;
-    assert!(close(m.channel("theta").unwrap(), &[0.0, pi / 5.0, 2.0 * pi / 5.0]));
+    assert!(close(
+        m.channel("theta").unwrap(),
+        &[0.0, pi / 5.0, 2.0 * pi / 5.0]
+    ));
 }
 
 #[test]
@@ -85,7 +100,10 @@ fn a_bad_unit_is_refused_at_the_header_with_what_would_do() {
     let rows = "0,101,1,2\n0.001,102,1,2\n";
     let e = err(&format!("t,p [kPaa],x,y\n{rows}"));
     assert!(
-        e.contains("row 1") && e.contains("`p [kPaa]`") && e.contains("unknown unit `kPaa`") && e.contains("kPa"),
+        e.contains("row 1")
+            && e.contains("`p [kPaa]`")
+            && e.contains("unknown unit `kPaa`")
+            && e.contains("kPa"),
         "{e}"
     );
     let e = err(&format!("t,p,x [kPa],y\n{rows}"));
@@ -100,7 +118,10 @@ fn a_bad_unit_is_refused_at_the_header_with_what_would_do() {
 fn a_record_in_kpa_without_a_unit_is_told_how_to_name_it() {
     let text = "t,p,x,y\n0,101.3,0.001,0.002\n0.001,101.4,0.001,0.002\n0.002,101.2,0.001,0.002\n";
     let e = parse_csv("rec.csv", text).unwrap_err().to_string();
-    assert!(e.contains("looks like kPa") && e.contains("`p [kPa]`"), "{e}");
+    assert!(
+        e.contains("looks like kPa") && e.contains("`p [kPa]`"),
+        "{e}"
+    );
     let text = "t,p,x,y\n0,-0.3,0.001,0.002\n0.001,0.2,0.001,0.002\n0.002,-1.2,0.001,0.002\n";
     let e = parse_csv("rec.csv", text).unwrap_err().to_string();
     assert!(e.contains("`p [kPa gauge]`"), "{e}");

@@ -96,7 +96,13 @@ fn flywheel_sensors_default_to_radians() {
 #[test]
 fn crank_on_an_unknown_flywheel() {
     let text = edit("on wheel {", "on wheeel {");
-    check("crank_unknown_flywheel", &text, 24, 24, "unknown flywheel `wheeel`: expected `wheel`");
+    check(
+        "crank_unknown_flywheel",
+        &text,
+        24,
+        24,
+        "unknown flywheel `wheeel`: expected `wheel`",
+    );
 }
 
 #[test]
@@ -112,7 +118,13 @@ fn crank_on_a_body() {
 #[test]
 fn rod_shorter_than_the_crank() {
     let text = edit("rod: L,", "rod: 0.5 * r,");
-    check("crank_rod_too_short", &text, 24, 48, "must be longer than the crank radius");
+    check(
+        "crank_rod_too_short",
+        &text,
+        24,
+        48,
+        "must be longer than the crank radius",
+    );
 }
 
 #[test]
@@ -127,7 +139,13 @@ fn linkage_reading_another_state() {
         "crank piston(y) on wheel { radius: r, rod: L, phase: 0.0 }",
         "linkage piston(y) on wheel { position: r * sin(theta) * omega }",
     );
-    check("linkage_reads_speed", &text, 24, 44, "an expression of the angle `theta`");
+    check(
+        "linkage_reads_speed",
+        &text,
+        24,
+        44,
+        "an expression of the angle `theta`",
+    );
 }
 
 #[test]
@@ -139,5 +157,11 @@ fn face_on_the_flywheel() {
 #[test]
 fn flywheel_friction_without_its_scale() {
     let text = edit("damper: 1.0e-5 }", "damper: 1.0e-5, friction: 1.0e-4 }");
-    check("flywheel_friction_without_scale", &text, 23, 64, "needs `omega_eps`");
+    check(
+        "flywheel_friction_without_scale",
+        &text,
+        23,
+        64,
+        "needs `omega_eps`",
+    );
 }

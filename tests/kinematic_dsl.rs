@@ -80,11 +80,15 @@ fn file_and_macro_are_one_model() {
         .unwrap()
         .model(1, Closure::Full)
         .unwrap();
-    let runs: [(&str, Box<dyn Model>); 2] = [("jit", from_file()), ("interpreter", Box::new(interpreted))];
+    let runs: [(&str, Box<dyn Model>); 2] =
+        [("jit", from_file()), ("interpreter", Box::new(interpreted))];
     for (route, f) in runs {
         let worst = agree(f.as_ref(), &m);
         eprintln!("file ({route}) vs macro: worst relative difference {worst:.2e}");
-        assert!(worst < 1e-12, "file ({route}) and macro differ by {worst:e}");
+        assert!(
+            worst < 1e-12,
+            "file ({route}) and macro differ by {worst:e}"
+        );
     }
 }
 
@@ -105,7 +109,10 @@ fn agree(f: &dyn Model, m: &models::GammaLtd) -> f64 {
             f.rhs(&p, &x, 0.0, &mut a);
             m.rhs(&p, &x, 0.0, &mut b);
             worst = worst.max(rel(&a, &b));
-            worst = worst.max(rel(&f.jacobian_dense(&p, &x, 0.0), &m.jacobian_dense(&p, &x, 0.0)));
+            worst = worst.max(rel(
+                &f.jacobian_dense(&p, &x, 0.0),
+                &m.jacobian_dense(&p, &x, 0.0),
+            ));
             worst = worst.max(rel(
                 &f.param_jacobian_dense(&p, &x, 0.0),
                 &m.param_jacobian_dense(&p, &x, 0.0),
@@ -137,7 +144,10 @@ fn jacobians_match_finite_differences() {
         let p = model.default_params();
         let mut report = Vec::new();
         let mut worst = (0.0f64, String::new());
-        for (k, x) in run::round_the_crank(model, &p, 11, 24).into_iter().enumerate() {
+        for (k, x) in run::round_the_crank(model, &p, 11, 24)
+            .into_iter()
+            .enumerate()
+        {
             // rows as large as `|P'| ~ 1e8 Pa/s` (the short regenerator link at these spreads)
             // next to entries of ~1e2 near a dead centre: upper steps 10 and 100 times the
             // default resolve them (tests/common/mod.rs, `check_jacobians_from`)
@@ -152,7 +162,12 @@ fn jacobians_match_finite_differences() {
                 worst = w;
             }
         }
-        eprintln!("{}: worst FD relative error {:.2e} at {}", model.name(), worst.0, worst.1);
+        eprintln!(
+            "{}: worst FD relative error {:.2e} at {}",
+            model.name(),
+            worst.0,
+            worst.1
+        );
         assert!(report.is_empty(), "{}", report.join("\n"));
         assert!(worst.0 < 1e-6);
     }
@@ -217,7 +232,10 @@ fn energy_budget_closes_along_a_run() {
     let mut z0 = x0.clone();
     z0.push(0.0);
     let sys = EnergySystem {
-        inner: ModelSystem { model: m.as_ref(), p: &p },
+        inner: ModelSystem {
+            model: m.as_ref(),
+            p: &p,
+        },
     };
     for rtol in [1e-6, 1e-9] {
         let opts = SimOptions {
@@ -235,7 +253,10 @@ fn energy_budget_closes_along_a_run() {
         }
         eprintln!("rtol {rtol:e}: |dE - integral| <= {worst:.3e} J (E0 = {e0:.4} J, max |dE| = {swing:.3e} J, flywheel swing {kinetic:.3e} J)");
         assert!(swing > 1e-3 && kinetic > 1e-4, "the run exchanges energy");
-        assert!(worst < 100.0 * rtol * e0, "budget gap {worst:e} J at rtol {rtol:e}");
+        assert!(
+            worst < 100.0 * rtol * e0,
+            "budget gap {worst:e} J at rtol {rtol:e}"
+        );
     }
 }
 
@@ -257,9 +278,15 @@ fn cranks_follow_the_slider_crank_law() {
         let (mut pr, mut v) = (vec![0.0; nv], vec![0.0; nv]);
         m.pv(&p, &x, &mut pr, &mut v);
         let want = ad * (ch + rd) - ad * s(rd, ld, x[0]);
-        assert!((v[0] - want).abs() <= 1e-15 * want.abs() + 1e-18, "V_hot {} vs {want}", v[0]);
+        assert!(
+            (v[0] - want).abs() <= 1e-15 * want.abs() + 1e-18,
+            "V_hot {} vs {want}",
+            v[0]
+        );
     }
-    assert!((s(rd, ld, 0.0) - rd).abs() < 1e-15 && (s(rd, ld, std::f64::consts::PI) + rd).abs() < 1e-15);
+    assert!(
+        (s(rd, ld, 0.0) - rd).abs() < 1e-15 && (s(rd, ld, std::f64::consts::PI) + rd).abs() < 1e-15
+    );
 }
 
 /// The bond graph: causal, its states one to one with the model's, and each face on a crank
@@ -315,7 +342,11 @@ fn modify_changes_a_cranks_rod() {
     m.pv(&p, &x, &mut pr, &mut v);
     let s = rd * 1f64.cos() + (ld * ld - (rd * 1f64.sin()).powi(2)).sqrt() - ld;
     let want = ad * (ch + rd) - ad * s;
-    assert!((v[0] - want).abs() <= 1e-15 * want, "V_hot {} vs {want}", v[0]);
+    assert!(
+        (v[0] - want).abs() <= 1e-15 * want,
+        "V_hot {} vs {want}",
+        v[0]
+    );
     // and not the base's rod
     let base_rod = get("Ld");
     let s0 = rd * 1f64.cos() + (base_rod * base_rod - (rd * 1f64.sin()).powi(2)).sqrt() - base_rod;

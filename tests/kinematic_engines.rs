@@ -34,9 +34,15 @@ fn beta_and_alpha_turn_steadily_with_positive_indicated_power() {
         let r = run::run(m.as_ref(), &p, &x0, 20.0, 10);
         let w = r.work * r.hz;
         eprintln!("{name}: {r:?}: indicated power {:.3} mW", 1e3 * w);
-        assert!((r.hz - r.hz_before).abs() < 1e-3 * r.hz, "{name} settled: {r:?}");
+        assert!(
+            (r.hz - r.hz_before).abs() < 1e-3 * r.hz,
+            "{name} settled: {r:?}"
+        );
         assert!((r.hz - hz).abs() < 0.02 * hz, "{name}: {} Hz", r.hz);
-        assert!(r.work > 0.0 && (w - power).abs() < 0.05 * power, "{name}: {w} W");
+        assert!(
+            r.work > 0.0 && (w - power).abs() < 0.05 * power,
+            "{name}: {w} W"
+        );
     }
 }
 
@@ -48,10 +54,16 @@ fn jacobians_match_finite_differences() {
         let mut report = Vec::new();
         let mut worst = 0.0f64;
         for x in run::round_the_crank(m.as_ref(), &p, 5, 12) {
-            for b in common::check_jacobians_from(m.as_ref(), &p, &x, &[1.0, 10.0, 100.0], common::REL) {
-                report.push(format!("{name} theta {:.3}: d {}/d {}: {:e} vs {:e}", x[0], b.row, b.col, b.analytic, b.fd));
+            for b in
+                common::check_jacobians_from(m.as_ref(), &p, &x, &[1.0, 10.0, 100.0], common::REL)
+            {
+                report.push(format!(
+                    "{name} theta {:.3}: d {}/d {}: {:e} vs {:e}",
+                    x[0], b.row, b.col, b.analytic, b.fd
+                ));
             }
-            worst = worst.max(common::worst_jacobian_error(m.as_ref(), &p, &x, &[1.0, 10.0, 100.0]).0);
+            worst =
+                worst.max(common::worst_jacobian_error(m.as_ref(), &p, &x, &[1.0, 10.0, 100.0]).0);
         }
         eprintln!("{name}: worst FD relative error {worst:.2e}");
         assert!(report.is_empty(), "{}", report.join("\n"));
@@ -63,7 +75,12 @@ fn bond_graphs_are_causal_with_an_mtf_per_crank_face() {
     for (name, faces) in [("beta", 4), ("alpha", 4)] {
         let m = engine(name);
         let cg = common::bond::check(m.as_ref());
-        let mtf = cg.graph.nodes.iter().filter(|n| n.kind == Kind::Mtf).count();
+        let mtf = cg
+            .graph
+            .nodes
+            .iter()
+            .filter(|n| n.kind == Kind::Mtf)
+            .count();
         assert_eq!(mtf, faces, "{name}");
     }
 }

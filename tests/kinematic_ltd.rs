@@ -39,7 +39,10 @@ fn gamma_ltd_turns_steadily_with_positive_indicated_power() {
     assert!(r.omega.1 - r.omega.0 < 0.02 * r.omega.1, "{r:?}");
     // indicated work and power: positive, of the order of a hobby LTD's milliwatts
     assert!(r.work > 0.0, "{r:?}");
-    assert!((power - 2.24e-3).abs() < 0.1e-3, "indicated power {power:e} W");
+    assert!(
+        (power - 2.24e-3).abs() < 0.1e-3,
+        "indicated power {power:e} W"
+    );
     // a hobby transducer's pressure swing: about 1 kPa
     assert!((0.8e3..1.4e3).contains(&r.swing), "{r:?}");
 }
@@ -59,7 +62,15 @@ fn a_brake_slows_it_and_no_temperature_difference_stops_it() {
     let tk = cold[m.param_index("Tk").unwrap()];
     set(m.as_ref(), &mut cold, "Th", tk + 1e-6);
     let samples = [0.0, 20.0];
-    let tr = stirling::models::sim::simulate(m.as_ref(), &cold, &x0, 20.0, &samples, &Default::default()).unwrap();
+    let tr = stirling::models::sim::simulate(
+        m.as_ref(),
+        &cold,
+        &x0,
+        20.0,
+        &samples,
+        &Default::default(),
+    )
+    .unwrap();
     let omega = tr.x.last().unwrap()[1];
     eprintln!("no temperature difference: omega {omega:e} rad/s after 20 s");
     assert!(omega.abs() < 0.05, "it still turns: {omega} rad/s");

@@ -27,7 +27,10 @@ pub fn run(json: bool) -> anyhow::Result<()> {
     for u in &user {
         writeln!(o, "{:<9} {:<16} {} (registered)", u.name, "", u.summary)?;
     }
-    writeln!(o, "\nbases an engine file extends by name (`model Mine extends NAME {{ .. }}`):")?;
+    writeln!(
+        o,
+        "\nbases an engine file extends by name (`model Mine extends NAME {{ .. }}`):"
+    )?;
     for b in BASES {
         writeln!(o, "  {:<17} {}", b.name, base_summary(b.text))?;
     }

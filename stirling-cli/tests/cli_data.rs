@@ -47,7 +47,11 @@ fn a_json_file_is_named_as_read_as_csv() {
 fn a_unit_the_reader_does_not_know_is_refused_at_the_header() {
     let dir = scratch("data_units");
     let f = dir.join("lab.csv");
-    std::fs::write(&f, "t [ms],p [kPa gauge],x [inch],y [mm]\n0,1.5,0.1,2\n1,1.6,0.1,2\n").unwrap();
+    std::fs::write(
+        &f,
+        "t [ms],p [kPa gauge],x [inch],y [mm]\n0,1.5,0.1,2\n1,1.6,0.1,2\n",
+    )
+    .unwrap();
     let at = format!("{}: row 1, column `x [inch]`", f.display());
     for cmd in ["fit", "diagnose"] {
         fails_with(

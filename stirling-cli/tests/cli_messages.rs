@@ -205,37 +205,15 @@ fn a_limit_cycle_of_an_engine_stable_at_rest_is_refused_with_the_cause() {
 fn sign_flipped_positions_are_named_when_the_fit_fails() {
     // x and y measured in the other direction: it ended in "did not converge ... a longer
     // record may help"
-    let dir = scratch("msg_flipped");
-    let rec = dir.join("rig.csv");
-    support::succeeds(&[
-        "rig",
-        "cv1",
-        "--settle",
-        "2",
-        "--t-end",
-        "2",
-        "--out",
-        s(&rec),
-    ]);
-    let mut text = String::new();
-    for line in std::fs::read_to_string(&rec).unwrap().lines() {
-        if line.starts_with('#') || line.starts_with('t') {
-            text.push_str(line);
-        } else {
-            let f: Vec<String> = line
-                .split(',')
-                .enumerate()
-                .map(|(i, v)| match i {
-                    2 | 3 => format!("{}", -v.parse::<f64>().unwrap()),
-                    _ => v.to_string(),
-                })
-                .collect();
-            text.push_str(&f.join(","));
-        }
-        text.push('\n');
-    }
-    let flipped = dir.join("flipped.csv");
-    std::fs::write(&flipped, text).unwrap();
+    let flipped = support::edited_rig_record(&scratch("msg_flipped"), "flipped.csv", |f| {
+        f.iter()
+            .enumerate()
+            .map(|(i, v)| match i {
+                2 | 3 => format!("{}", -v.parse::<f64>().unwrap()),
+                _ => v.to_string(),
+            })
+            .collect()
+    });
     let err = fails_with(
         &["fit", "cv1", "--data", s(&flipped)],
         &[

@@ -211,31 +211,10 @@ fn an_outlier_sample_is_refused_by_name_not_fitted() {
 fn swapped_position_columns_are_named_as_the_likely_cause() {
     // x and y swapped gave kp 3233 (truth 61.5) at a 97 % position fit and a -177 % pressure
     // fit, with nothing said
-    let dir = scratch("swapped");
-    let rec = dir.join("rig.csv");
-    support::succeeds(&[
-        "rig",
-        "cv1",
-        "--settle",
-        "2",
-        "--t-end",
-        "2",
-        "--out",
-        s(&rec),
-    ]);
-    let mut text = String::new();
-    for line in std::fs::read_to_string(&rec).unwrap().lines() {
-        if line.starts_with('#') || line.starts_with('t') {
-            text.push_str(line);
-        } else {
-            let mut f: Vec<&str> = line.split(',').collect();
-            f.swap(2, 3);
-            text.push_str(&f.join(","));
-        }
-        text.push('\n');
-    }
-    let swapped = dir.join("swapped.csv");
-    std::fs::write(&swapped, text).unwrap();
+    let swapped = support::edited_rig_record(&scratch("swapped"), "swapped.csv", |mut f| {
+        f.swap(2, 3);
+        f.into_iter().map(String::from).collect()
+    });
     let out = support::stirling(&["fit", "cv1", "--data", s(&swapped)]);
     let stdout = String::from_utf8_lossy(&out.stdout);
     assert!(

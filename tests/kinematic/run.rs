@@ -42,7 +42,10 @@ pub fn run(m: &dyn Model, p: &[f64], x0: &[f64], t_end: f64, revs: usize) -> Run
     let two_pi = 2.0 * std::f64::consts::PI;
     let last = tr.x.last().unwrap()[0];
     let turns = (last / two_pi).floor();
-    assert!(turns >= 2.0 * revs as f64, "only {turns} revolutions in {t_end} s");
+    assert!(
+        turns >= 2.0 * revs as f64,
+        "only {turns} revolutions in {t_end} s"
+    );
     let (a, b) = ((turns - revs as f64) * two_pi, turns * two_pi);
     let (a0, _) = ((turns - 2.0 * revs as f64) * two_pi, a);
     let at = |angle: f64| tr.x.iter().position(|x| x[0] >= angle).unwrap();
@@ -105,4 +108,3 @@ pub fn round_the_crank(m: &dyn Model, p: &[f64], seed: u64, count: usize) -> Vec
         })
         .collect()
 }
-

@@ -75,3 +75,35 @@ pub fn write_record(path: &Path) {
     }
     std::fs::write(path, text).unwrap();
 }
+
+/// A 2 s `cv1` rig record (settled 2 s) in `dir`, each data row's fields passed through
+/// `row` (comment and header lines kept), written as `dir/name`.
+pub fn edited_rig_record(
+    dir: &Path,
+    name: &str,
+    row: impl Fn(Vec<&str>) -> Vec<String>,
+) -> PathBuf {
+    let rec = dir.join("rig.csv");
+    succeeds(&[
+        "rig",
+        "cv1",
+        "--settle",
+        "2",
+        "--t-end",
+        "2",
+        "--out",
+        s(&rec),
+    ]);
+    let mut text = String::new();
+    for line in std::fs::read_to_string(&rec).unwrap().lines() {
+        if line.starts_with('#') || line.starts_with('t') {
+            text.push_str(line);
+        } else {
+            text.push_str(&row(line.split(',').collect()).join(","));
+        }
+        text.push('\n');
+    }
+    let out = dir.join(name);
+    std::fs::write(&out, text).unwrap();
+    out
+}

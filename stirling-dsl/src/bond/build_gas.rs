@@ -34,7 +34,8 @@ impl Builder<'_> {
                         self.g.node(Kind::Tf, f.coeff)
                     } else {
                         // a face on a mechanism: modulated by the flywheel's angle
-                        self.g.node(Kind::Mtf, format!("{} * {}", f.coeff, f.modulus))
+                        self.g
+                            .node(Kind::Mtf, format!("{} * {}", f.coeff, f.modulus))
                     };
                     self.g.bond(tf, self.bodies[k], Domain::Mechanical);
                     p.volume.push((tf, true));

@@ -96,7 +96,11 @@ pub(crate) fn block_meaning(
         ),
         BlockKind::Velocity(k) => (
             "Velocity",
-            if topo.bodies[k].rotary { "rad/s" } else { "m/s" },
+            if topo.bodies[k].rotary {
+                "rad/s"
+            } else {
+                "m/s"
+            },
             if topo.bodies[k].rotary {
                 format!("angular velocity of the flywheel {}", topo.bodies[k].name)
             } else {

@@ -15,7 +15,7 @@ mod walls;
 pub use assemble::assemble;
 pub use decl::{
     BodyDecl, ConductionDecl, CouplingDecl, CvDecl, EffectSiteDecl, End, FaceDecl, GasDecl,
-    HeatEnd, LinkDecl, MechanismDecl, ParamDecl, PortDecl, SensorDecl, SensorExpr, SpaceDecl, Topology, Vessel,
-    WallDecl,
+    HeatEnd, LinkDecl, MechanismDecl, ParamDecl, PortDecl, SensorDecl, SensorExpr, SpaceDecl,
+    Topology, Vessel, WallDecl,
 };
 pub use system::{BlockInfo, BlockKind, Row, System, Variant, VesselTerms, WallTerms, VARIANTS};

@@ -15,7 +15,14 @@ impl Lower {
         let what = format!("flywheel `{}`", b.name);
         let f = self.fields(
             &b.fields,
-            &["inertia", "damper", "friction", "omega_eps", "load", "force"],
+            &[
+                "inertia",
+                "damper",
+                "friction",
+                "omega_eps",
+                "load",
+                "force",
+            ],
             &what,
         );
         let inertia = self.required(&f, "inertia", b.name.span(), &what, None);
@@ -30,7 +37,10 @@ impl Lower {
                 zero
             }
             (None, Some(e)) => {
-                self.cx.error(e.name.span(), format!("{what}: `omega_eps` without `friction`"));
+                self.cx.error(
+                    e.name.span(),
+                    format!("{what}: `omega_eps` without `friction`"),
+                );
                 zero
             }
             (Some(fc), Some(e)) => {
@@ -180,7 +190,8 @@ impl Lower {
             .into_iter()
             .any(|x| matches!(x, Sym::State(..)) && x != angle);
         if other {
-            let wheel = &self.topo.bodies[self.topo.mechanisms[self.mechanisms[&m.name.to_string()]].body];
+            let wheel =
+                &self.topo.bodies[self.topo.mechanisms[self.mechanisms[&m.name.to_string()]].body];
             let msg = format!("{what}: the position must be an expression of the angle `{}` of `{}` and parameters only", wheel.pos, wheel.name);
             self.cx.error(field.value.span(), msg);
         }
@@ -197,7 +208,10 @@ impl Lower {
         match f.get(key) {
             Some(field) => self.static_expr(&field.value, None, &format!("the `{key}` of {what}")),
             None => {
-                self.cx.error(span, format!("{what} has no `{key}`: expected `{key}: <expression>`"));
+                self.cx.error(
+                    span,
+                    format!("{what} has no `{key}`: expected `{key}: <expression>`"),
+                );
                 self.topo.arena.num(1.0)
             }
         }

@@ -103,7 +103,11 @@ impl Errors<'_> {
                 return Err(self.err(hrow, n, format!("column `{n}` appears twice in the header")));
             }
         }
-        Ok(Header { row: hrow, names, units })
+        Ok(Header {
+            row: hrow,
+            names,
+            units,
+        })
     }
 
     /// The position of column `t` and of each measured channel present (the seed's four,

@@ -30,11 +30,7 @@ impl Kind {
 
     /// The units of this kind, as a list for a message.
     fn known(self) -> String {
-        let names: Vec<&str> = UNITS
-            .iter()
-            .filter(|u| u.1 == self)
-            .map(|u| u.0)
-            .collect();
+        let names: Vec<&str> = UNITS.iter().filter(|u| u.1 == self).map(|u| u.0).collect();
         let gauge = if self == Kind::Pressure {
             " (gauge pressure: add `gauge`, e.g. `kPa gauge`, or write `psig`, `barg`)"
         } else {
@@ -207,7 +203,10 @@ mod tests {
         let close = |a: f64, b: f64| (a - b).abs() <= 1e-12 * b.abs().max(1.0);
         assert!(close(parse("kPa").unwrap().si(101.325), 101_325.0));
         assert!(close(parse("kPa gauge").unwrap().si(0.0), AMBIENT));
-        assert!(close(parse("psig").unwrap().si(1.0), AMBIENT + 6_894.757_293_168));
+        assert!(close(
+            parse("psig").unwrap().si(1.0),
+            AMBIENT + 6_894.757_293_168
+        ));
         assert!(close(parse("bar").unwrap().si(2.0), 2e5));
         assert!(close(parse("mm").unwrap().si(5.0), 5e-3));
         assert!(close(parse("ms").unwrap().si(250.0), 0.25));
@@ -220,7 +219,10 @@ mod tests {
     #[test]
     fn wrong_units_are_refused_with_what_would_do() {
         let e = parse("kPaa").unwrap_err();
-        assert!(e.contains("unknown unit `kPaa`") && e.contains("kPa"), "{e}");
+        assert!(
+            e.contains("unknown unit `kPaa`") && e.contains("kPa"),
+            "{e}"
+        );
         let e = for_column("x", "kPa").unwrap_err();
         assert!(e.contains("`x` is a length") && e.contains("mm"), "{e}");
         let e = for_column("p", "mm").unwrap_err();
