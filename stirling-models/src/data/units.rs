@@ -133,8 +133,31 @@ fn without_gauge(s: &str) -> Option<&str> {
         .then(|| &s[..s.len() - 1])
 }
 
+/// Why a header's unit cannot be read.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum UnitError {
+    #[error(
+        "unknown unit `{text}`: the units read are {known} (and `gauge` after a pressure unit)"
+    )]
+    Unknown { text: String, known: String },
+    #[error("`{text}`: only a pressure can be gauge, `{body}` is {noun}")]
+    GaugeNotPressure {
+        text: String,
+        body: String,
+        noun: &'static str,
+    },
+    #[error("`{column}` is {expected}, but `{text}` is {found}: use one of {known}")]
+    WrongKind {
+        column: String,
+        text: String,
+        expected: &'static str,
+        found: &'static str,
+        known: String,
+    },
+}
+
 /// The unit written as `text`, or why it is not one.
-pub fn parse(text: &str) -> Result<Unit, String> {
+pub fn parse(text: &str) -> Result<Unit, UnitError> {
     let (body, gauge) = match without_gauge(text) {
         Some(b) => (b, true),
         None => (text.trim(), false),
@@ -142,16 +165,17 @@ pub fn parse(text: &str) -> Result<Unit, String> {
     let c = canonical(body);
     let Some(&(_, kind, scale)) = UNITS.iter().find(|u| u.0 == c) else {
         let all: Vec<&str> = UNITS.iter().map(|u| u.0).collect();
-        return Err(format!(
-            "unknown unit `{text}`: the units read are {} (and `gauge` after a pressure unit)",
-            all.join(", ")
-        ));
+        return Err(UnitError::Unknown {
+            text: text.to_string(),
+            known: all.join(", "),
+        });
     };
     if gauge && kind != Kind::Pressure {
-        return Err(format!(
-            "`{text}`: only a pressure can be gauge, `{body}` is {}",
-            kind.noun()
-        ));
+        return Err(UnitError::GaugeNotPressure {
+            text: text.to_string(),
+            body: body.to_string(),
+            noun: kind.noun(),
+        });
     }
     Ok(Unit {
         text: text.trim().to_string(),
@@ -172,15 +196,16 @@ pub fn kind_of(name: &str) -> Option<Kind> {
 }
 
 /// The unit of column `name` written as `text`, checked against what the column measures.
-pub fn for_column(name: &str, text: &str) -> Result<Unit, String> {
+pub fn for_column(name: &str, text: &str) -> Result<Unit, UnitError> {
     let u = parse(text)?;
     match kind_of(name) {
-        Some(k) if k != u.kind => Err(format!(
-            "`{name}` is {}, but `{text}` is {}: use one of {}",
-            k.noun(),
-            u.kind.noun(),
-            k.known()
-        )),
+        Some(k) if k != u.kind => Err(UnitError::WrongKind {
+            column: name.to_string(),
+            text: text.to_string(),
+            expected: k.noun(),
+            found: u.kind.noun(),
+            known: k.known(),
+        }),
         _ => Ok(u),
     }
 }
@@ -218,16 +243,16 @@ mod tests {
 
     #[test]
     fn wrong_units_are_refused_with_what_would_do() {
-        let e = parse("kPaa").unwrap_err();
+        let e = parse("kPaa").unwrap_err().to_string();
         assert!(
             e.contains("unknown unit `kPaa`") && e.contains("kPa"),
             "{e}"
         );
-        let e = for_column("x", "kPa").unwrap_err();
+        let e = for_column("x", "kPa").unwrap_err().to_string();
         assert!(e.contains("`x` is a length") && e.contains("mm"), "{e}");
-        let e = for_column("p", "mm").unwrap_err();
+        let e = for_column("p", "mm").unwrap_err().to_string();
         assert!(e.contains("a pressure") && e.contains("gauge"), "{e}");
-        let e = parse("mm gauge").unwrap_err();
+        let e = parse("mm gauge").unwrap_err().to_string();
         assert!(e.contains("only a pressure can be gauge"), "{e}");
         // a column the format does not fix takes any unit
         assert_eq!(for_column("dV", "cm^3").unwrap().kind, Kind::Volume);
