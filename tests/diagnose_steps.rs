@@ -4,8 +4,10 @@
 //! `no_significant_gap` and names nothing. The wider self-check (every pair) is in
 //! docs/diagnosis.md, "Several effects at once".
 
-use stirling::models::diagnose::selfcheck::record::{seeded_start, through_csv};
+use stirling::models::diagnose::selfcheck::plan::plan;
+use stirling::models::diagnose::selfcheck::record::{record, seeded_start, through_csv};
 use stirling::models::diagnose::selfcheck::{settings, verdict_settings};
+use stirling::models::diagnose::selfcheck::{Split, VerdictOptions};
 use stirling::models::diagnose::{diagnose, nominal_model, DiagnoseOptions, Diagnosis};
 use stirling::models::rig::{self, RigConfig};
 
@@ -45,6 +47,7 @@ fn diagnosed_with(rate: f64, effects: Vec<String>, seed: u64, candidates: &[&str
     let opts = DiagnoseOptions {
         effects: Some(candidates.iter().map(|s| s.to_string()).collect()),
         bootstrap: 200,
+        progress: Some(|line: &str| eprintln!("  .. {line}")),
         ..Default::default()
     };
     let d = diagnose(model.as_ref(), &p0, &data, &opts).unwrap();
@@ -136,6 +139,52 @@ fn quadratic_regenerator_friction_and_a_pressure_lag_are_both_named() {
     check_steps(&d);
     let c = d.steps.last().unwrap().cumulative;
     assert!(c.ci_low > 0.5, "cumulative closure {c:?}");
+}
+
+#[test]
+fn a_leak_the_calibration_absorbed_is_named_after_a_pressure_lag() {
+    // the self-check's evaluation record of the pair (`--clean 4:20 --seeds 1:1`, run-h):
+    // the calibration takes the leak into the regenerator friction (`Rf` far below its
+    // estimate), so after the lag the leak's score is not significant (p 0.026); fitted from
+    // the nominal parameters' estimates it lowers the held-out BIC by more than ten times
+    // the usual bar (steps::RESET_P, docs/diagnosis.md). On five other records of the pair
+    // (seeds 47 to 51 of `diagnosed_at`) the leak stays unnamed: docs/diagnosis.md.
+    let opts = VerdictOptions {
+        clean: (4, 20),
+        seeds: (1, 1),
+        ..Default::default()
+    };
+    let case = plan(&opts)
+        .unwrap()
+        .into_iter()
+        .find(|c| c.split == Split::Eval && c.truth.label() == "leak+sensor_lag")
+        .unwrap();
+    let dir = tempdir(case.seed);
+    let data = record(&opts, &case, &dir).unwrap();
+    let (model, p_nom) = nominal_model("nsection", Some(2)).unwrap();
+    let p0 = seeded_start(model.as_ref(), &p_nom, opts.perturb, case.perturb_seed);
+    let d = diagnose(model.as_ref(), &p0, &data, &opts.diagnose).unwrap();
+    let _ = std::fs::remove_dir_all(&dir);
+    eprintln!("{}: {}", d.verdict.verdict, d.verdict.reason);
+    assert_eq!(d.verdict.verdict, "effect", "{}", d.verdict.reason);
+    assert_eq!(named(&d), ["leak", "sensor_lag"], "{}", d.verdict.reason);
+    check_steps(&d);
+    let last = d.steps.last().unwrap();
+    assert_eq!(last.effects, ["leak"]);
+    assert!(last.from_reset, "{}", d.verdict.reason);
+    assert!(
+        d.verdict.reason.contains("had absorbed it"),
+        "{}",
+        d.verdict.reason
+    );
+    // the leak's conductance, refitted with the lag, within a factor of 3 of the truth
+    // (the self-check's unit: `Gleak` 1e-8)
+    let g = last.params.iter().find(|q| q.name == "Gleak").unwrap();
+    assert!(
+        g.value > 1e-8 / 3.0 && g.value < 3e-8,
+        "Gleak {:e}",
+        g.value
+    );
 }
 
 #[test]

@@ -6,8 +6,9 @@ use std::time::Instant;
 
 use super::context::{Context, Eval};
 use super::rank::{self, On};
+use super::steps::RESET_P;
 use super::{closure, schedule, screen, DiagnoseOptions};
-use crate::effects::EffectInfo;
+use crate::effects::{EffectInfo, EffectTarget};
 use crate::fit::lm::LmOptions;
 
 /// A joint fit stops when an accepted step lowers the cost (half the chi-square of the
@@ -47,7 +48,17 @@ pub fn assess_all(
         .par_iter()
         .map(|e| screen::screen_candidate(ctx, on.nominal, on.s2, on.basis, e))
         .collect();
-    let fit = |s: &screen::Screened| opts.fit_all || s.significant(level);
+    // a later round on a calibration that absorbed something: a model effect whose score
+    // is near significance is also fitted from the reset start (`steps::RESET_P`)
+    let later = absorbed && !ctx.restarted && !on.basis.effects.is_empty();
+    let from_reset = |s: &screen::Screened| {
+        later
+            && !s.significant(level)
+            && s.entry.p_value < RESET_P
+            && s.effect.target == EffectTarget::Model
+            && !screen::has_travel(s.effect)
+    };
+    let fit = |s: &screen::Screened| opts.fit_all || s.significant(level) || from_reset(s);
     report(opts, || {
         let sig = screened.iter().filter(|s| s.significant(level)).count();
         let fitted = screened.iter().filter(|s| fit(s)).count();
@@ -55,8 +66,11 @@ pub fn assess_all(
     });
     let mut assessed = schedule::longest_first(screened, |s| {
         if fit(&s) {
-            let significant = s.significant(level);
-            rank::assess(ctx, on, s, &lm, significant)
+            let mode = rank::Mode {
+                significant: s.significant(level),
+                from_reset: from_reset(&s),
+            };
+            rank::assess(ctx, on, s, &lm, mode)
         } else {
             s.unfitted("not fitted: its score is not significant (--fit-all fits it)")
         }

@@ -88,8 +88,15 @@ fn try_pair(
     let mut entry = pair_entry(&a.entry, &b.entry, &score);
     let clock = std::time::Instant::now();
     ctx.fits.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-    let (eval, fit) =
-        rank::fit_set(ctx, on, &cands, &score, (&joint_lm(opts), true), &mut entry).ok()?;
+    let (eval, fit) = rank::fit_set(
+        ctx,
+        on,
+        &cands,
+        &score,
+        (&joint_lm(opts), rank::Mode::SIGNIFICANT),
+        &mut entry,
+    )
+    .ok()?;
     let c = closure::closure(
         ctx.data,
         on.base_eval,

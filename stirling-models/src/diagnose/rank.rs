@@ -59,17 +59,18 @@ fn estimates(joint: &Joint, res: &lm::LmResult, fixed: &[usize]) -> Vec<EffectEs
 }
 
 /// Fit one screened candidate jointly on `basis` (whose evaluation is `base_eval`) and
-/// evaluate it on the held-out block. `significant`: its score is; only such a candidate can
-/// be named and only those rank ahead of the others ([`sort`]), so its fit is taken to the
-/// fixed point of the two stages (`joint_fit::settle`), while the others (fitted for the
-/// report with `--fit-all`) keep the first fit but get the start in their own basin that the
-/// score cannot see (`starts`).
+/// evaluate it on the held-out block. `mode.significant`: its score is; only such a candidate
+/// (or one fitted `from_reset`, under a rule of its own: [`Mode`]) can be named and only the
+/// significant ones rank ahead of the others ([`sort`]), so their fits are taken to the fixed
+/// point of the two stages (`joint_fit::settle`), while the others (fitted for the report
+/// with `--fit-all`) keep the first fit but get the start in their own basin that the score
+/// cannot see (`starts`).
 pub fn assess(
     ctx: &Context,
     on: &On,
     screened: Screened,
     opts: &LmOptions,
-    significant: bool,
+    mode: Mode,
 ) -> Assessed {
     let Screened {
         effect: e,
@@ -87,7 +88,8 @@ pub fn assess(
     };
     let clock = std::time::Instant::now();
     let cands = [EffectAt { effect: e, shapes }];
-    let out = fit_set(ctx, on, &cands, &score, (opts, significant), &mut entry);
+    entry.from_reset = mode.from_reset;
+    let out = fit_set(ctx, on, &cands, &score, (opts, mode), &mut entry);
     entry.seconds += clock.elapsed().as_secs_f64();
     if let Some(progress) = ctx.progress {
         progress(&format!(
@@ -117,6 +119,23 @@ pub fn assess(
     }
 }
 
+/// How a candidate is fitted: `significant` (its score is: from the nominal optimum, taken
+/// to the two stages' fixed point), else also from the reset start (`starts`), and taken to
+/// the fixed point when it may be named from there (`from_reset`, [`super::steps::RESET_P`]).
+#[derive(Clone, Copy, Debug)]
+pub struct Mode {
+    pub significant: bool,
+    pub from_reset: bool,
+}
+
+impl Mode {
+    /// A significant candidate (or a set tried together).
+    pub const SIGNIFICANT: Mode = Mode {
+        significant: true,
+        from_reset: false,
+    };
+}
+
 /// What a candidate is fitted on: the nominal stages and their variance factors, and the
 /// basis (the effects accepted so far) with its evaluation.
 pub struct On<'s, 'a> {
@@ -134,13 +153,13 @@ pub fn fit_set(
     on: &On,
     cands: &[EffectAt],
     score: &Score,
-    (opts, significant): (&LmOptions, bool),
+    (opts, mode): (&LmOptions, Mode),
     entry: &mut RankEntry,
 ) -> Result<(Eval, SetFit), DiagnoseError> {
     let free_shapes = cands.iter().any(|c| !c.shapes.is_empty());
     let mut joint = Joint::new(ctx.model, on.nominal, on.s2, on.basis, cands, free_shapes)?;
-    let best = best_fit(ctx, &joint, cands, !significant, score, opts)?;
-    let (res, fixed) = if significant {
+    let best = best_fit(ctx, &joint, cands, !mode.significant, score, opts)?;
+    let (res, fixed) = if mode.significant {
         settle(&mut joint, best, opts)
     } else {
         best

@@ -76,6 +76,31 @@ pub struct StepRule {
 }
 
 impl StepRule {
+    /// Whether a step of held-out BIC change `bic`, closure lower bound `ci_low` and score
+    /// `p` (`moved`: fitted off its null) clears the rule at the per-candidate `level`.
+    /// `from_reset`: fitted from the reset start though its score is not significant
+    /// ([`RESET_P`], first pass only); the held-out evidence then carries the step, at the
+    /// bar of a step after the stops ([`RESTARTED_STEP_BIC`], ten times the usual one), with
+    /// the usual closure bound.
+    pub fn passes(
+        self,
+        moved: bool,
+        p: f64,
+        bic: Option<f64>,
+        ci_low: Option<f64>,
+        (level, from_reset): (f64, bool),
+    ) -> bool {
+        let (p_bar, bic_bar) = if from_reset {
+            (RESET_P, self.bic * RESTARTED_STEP_BIC / STRONG_BIC)
+        } else {
+            (level, self.bic)
+        };
+        moved
+            && p < p_bar
+            && bic.is_some_and(|d| d < bic_bar)
+            && ci_low.is_some_and(|c| c > self.min_closure)
+    }
+
     /// The rule of a step: [`STRONG_BIC`] and [`MIN_STEP_CLOSURE`]; after the first step of
     /// the second pass, [`RESTARTED_STEP_BIC`] and a positive closure.
     pub fn of(ctx: &Context, step: usize) -> Self {
@@ -100,13 +125,27 @@ impl StepRule {
     }
 }
 
+/// The score p-value below which a candidate that is not significant is still fitted from
+/// the reset start in a round after the first, when the calibration absorbed something
+/// (moved a parameter beyond two prior sd). Why: the score is a local test at the basis's
+/// optimum, and a calibration that took an effect into the nominal parameters leaves that
+/// effect's score near its null there (a leak beside a 2 ms pressure lag: the calibration
+/// cut the regenerator friction `Rf` to 0.02x, the leak's score after the lag was p 0.026
+/// against a level of 1.7e-3, yet fitted from the nominal parameters' estimates it lowered
+/// the held-out error from 1.300 to 1.196 noise variances). Such a candidate is named only
+/// under a rule of its own ([`StepRule::passes`]); `RESET_P` is the conventional 5 % and
+/// bounds the cost (each is a whole joint fit).
+pub const RESET_P: f64 = 0.05;
+
 /// Whether a fitted entry clears a step's `rule` at the per-candidate `level`.
 pub fn passes(e: &RankEntry, level: f64, rule: StepRule) -> bool {
-    e.fitted
-        && e.moved
-        && e.p_value < level
-        && e.delta_bic.is_some_and(|d| d < rule.bic)
-        && e.ci_low.is_some_and(|c| c > rule.min_closure)
+    rule.passes(
+        e.fitted && e.moved,
+        e.p_value,
+        e.delta_bic,
+        e.ci_low,
+        (level, e.from_reset),
+    )
 }
 
 /// Explain the gap of the nominal calibration (`nominal`, evaluated as `nominal_eval`) in
@@ -202,11 +241,15 @@ fn next(
     (level, rule): (f64, StepRule),
     opts: &DiagnoseOptions,
 ) -> Option<Named> {
-    if assessed
-        .first()
-        .is_some_and(|a| passes(&a.entry, level, rule))
-    {
-        let a = assessed.swap_remove(0);
+    // the leading candidate, else one fitted from the reset start (ranked after the
+    // significant ones: `rank::sort`)
+    let pick = assessed
+        .iter()
+        .enumerate()
+        .find(|(i, a)| (*i == 0 || a.entry.from_reset) && passes(&a.entry, level, rule))
+        .map(|(i, _)| i);
+    if let Some(i) = pick {
+        let a = assessed.swap_remove(i);
         let fit = a.fit?;
         return Some(Named {
             effects: fit.effects.clone(),
@@ -262,6 +305,7 @@ fn make_step(
         ranking,
         seconds: clock.elapsed().as_secs_f64(),
         after_stops: false,
+        from_reset: e.from_reset,
         eval: Some(named.eval.clone()),
     }
 }
@@ -269,8 +313,9 @@ fn make_step(
 /// The progress line of a step.
 fn step_line(s: &Step, clock: Instant) -> String {
     format!(
-        "step: {} closes {:.2} [{:.2}, {:.2}] of what remained, {:.2} [{:.2}, {:.2}] in all; held-out error {:.3} ({:.1} s)",
+        "step: {}{} closes {:.2} [{:.2}, {:.2}] of what remained, {:.2} [{:.2}, {:.2}] in all; held-out error {:.3} ({:.1} s)",
         s.effects.join(" + "),
+        if s.from_reset { " (from the reset start)" } else { "" },
         s.closure.value,
         s.closure.ci_low,
         s.closure.ci_high,
@@ -280,4 +325,58 @@ fn step_line(s: &Step, clock: Instant) -> String {
         s.holdout_error,
         clock.elapsed().as_secs_f64()
     )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const LEVEL: f64 = 1.7e-3;
+
+    fn clears(rule: StepRule, p: f64, bic: f64, ci_low: f64, from_reset: bool) -> bool {
+        rule.passes(true, p, Some(bic), Some(ci_low), (LEVEL, from_reset))
+    }
+
+    #[test]
+    fn a_step_needs_a_significant_score_a_strong_bic_and_a_closure() {
+        let rule = StepRule::at(STRONG_BIC, false);
+        assert!(clears(rule, 1e-4, -11.0, 0.21, false));
+        assert!(
+            !clears(rule, 2e-3, -500.0, 0.9, false),
+            "score not significant"
+        );
+        assert!(
+            !clears(rule, 1e-4, -9.0, 0.9, false),
+            "weak held-out evidence"
+        );
+        assert!(
+            !clears(rule, 1e-4, -500.0, 0.19, false),
+            "closure bound too low"
+        );
+        assert!(!rule.passes(false, 1e-4, Some(-500.0), Some(0.9), (LEVEL, false)));
+        assert!(!rule.passes(true, 1e-4, None, Some(0.9), (LEVEL, false)));
+    }
+
+    #[test]
+    fn a_step_from_the_reset_start_needs_ten_times_the_held_out_evidence() {
+        let rule = StepRule::at(STRONG_BIC, false);
+        // the leak beside a lag (docs/diagnosis.md): p 0.026, closure 0.32 [0.27, 0.39]
+        assert!(clears(rule, 0.026, -101.0, 0.27, true));
+        assert!(
+            !clears(rule, 0.026, -99.0, 0.27, true),
+            "BIC under ten times the bar"
+        );
+        assert!(
+            !clears(rule, RESET_P, -500.0, 0.27, true),
+            "score beyond RESET_P"
+        );
+        assert!(
+            !clears(rule, 0.026, -500.0, 0.19, true),
+            "closure bound too low"
+        );
+        // the bar follows a tuned first-pass bar
+        let tuned = StepRule::at(2.0 * STRONG_BIC, false);
+        assert!(!clears(tuned, 0.026, -150.0, 0.27, true));
+        assert!(clears(tuned, 0.026, -201.0, 0.27, true));
+    }
 }

@@ -72,6 +72,9 @@ pub struct RankEntry {
     /// The fit moved a strength off its null (else it is the nominal model again).
     #[serde(skip)]
     pub moved: bool,
+    /// Fitted from the reset start although its score is not significant: a later round on
+    /// a calibration that absorbed something ([`super::steps::RESET_P`]).
+    pub from_reset: bool,
 }
 
 impl RankEntry {
@@ -92,6 +95,7 @@ impl RankEntry {
             note: None,
             seconds: 0.0,
             moved: false,
+            from_reset: false,
         }
     }
 }
@@ -148,6 +152,9 @@ pub struct Step {
     /// A step after the end stops on the second pass (stage 1 restarted), named under that
     /// pass's rule ([`super::steps::StepRule`]).
     pub after_stops: bool,
+    /// Named from the reset start on a calibration that absorbed something, under that
+    /// rule ([`super::steps::StepRule::passes`]).
+    pub from_reset: bool,
     /// Residual series after this step, for the report.
     #[serde(skip)]
     pub eval: Option<Eval>,

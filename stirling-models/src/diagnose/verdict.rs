@@ -196,13 +196,18 @@ pub fn decide_steps(
         .iter()
         .map(|s| {
             format!(
-                "`{}` closes {:.2} [{:.2}, {:.2}] of what remained (p {:.1e}, BIC {:.0})",
+                "`{}` closes {:.2} [{:.2}, {:.2}] of what remained (p {:.1e}, BIC {:.0}{})",
                 s.effects.join("` + `"),
                 s.closure.value,
                 s.closure.ci_low,
                 s.closure.ci_high,
                 s.p_value,
-                s.delta_bic
+                s.delta_bic,
+                if s.from_reset {
+                    ", fitted from the nominal parameters' estimates: the calibration had absorbed it"
+                } else {
+                    ""
+                }
             )
         })
         .collect::<Vec<_>>()

@@ -67,6 +67,8 @@ pub struct StepBrief {
     pub cumulative_low: f64,
     /// Named after the stops on the second pass ([`StepRule::at`]).
     pub after_stops: bool,
+    /// Named from the reset start ([`StepRule::passes`]).
+    pub from_reset: bool,
 }
 
 /// The verdict label of a diagnosis: the set of named effects (`a+b`), `unexplained` or
@@ -104,7 +106,9 @@ impl Outcome {
         let mut cumulative = f64::NEG_INFINITY;
         for s in &self.steps {
             let rule = StepRule::at(th.strong_bic, s.after_stops);
-            if !(s.p_value < level && s.delta_bic < rule.bic && s.ci_low > rule.min_closure) {
+            let moved = true;
+            let at = (level, s.from_reset);
+            if !rule.passes(moved, s.p_value, Some(s.delta_bic), Some(s.ci_low), at) {
                 break;
             }
             named.extend(s.effects.iter().cloned());
@@ -167,6 +171,7 @@ impl Outcome {
                 ci_low: s.closure.ci_low,
                 cumulative_low: s.cumulative.ci_low,
                 after_stops: s.after_stops,
+                from_reset: s.from_reset,
             })
             .collect();
         self.tuned_verdict = self.verdict.clone();
