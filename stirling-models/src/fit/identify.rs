@@ -296,7 +296,7 @@ impl<'a> Run<'a, '_> {
 /// A note for each free parameter that ended at one of its bounds (within 1e-3 of the
 /// range): the data push it further, and its interval, cut by the bound, says less than it
 /// seems.
-fn at_bounds(
+pub(super) fn at_bounds(
     model: &dyn Model,
     p: &[f64],
     free: &[usize],
@@ -373,6 +373,7 @@ pub fn identify_stages<'a>(
 ) -> Result<(Identification, Vec<FittedStage<'a>>), FitError> {
     let clock = Instant::now();
     super::supported::check_sensors(model)?;
+    let angle = super::kinematic::measured_angle(model, data)?;
     let layout = StateLayout::working_gas(model);
     let rec = Record::new(model, &layout, p0, data, opts)?;
     let free = opts.free.clone().unwrap_or_else(|| default_free(model, p0));
@@ -382,6 +383,10 @@ pub fn identify_stages<'a>(
         return Err(FitError::DuplicateFree { name });
     }
     check_bounds(model, p0, &free, &opts.bounds)?;
+    if let Some(angle) = &angle {
+        let parts = (&layout, &rec);
+        return super::kinematic::identify(model, p0, parts, angle, &free, opts);
+    }
     let (mech, gas_free) = classify(model, p0, &free)?;
     let run = Run {
         model,
