@@ -186,7 +186,11 @@ fn a_record_without_the_angle_or_too_short_is_refused() {
         .iter_mut()
         .for_each(|v| *v = v.to_degrees());
     let e = refused(&degrees, &opts);
-    assert!(matches!(e, FitError::KinematicSpeed { .. }), "{e:?}");
+    let FitError::KinematicSpeed { turns, cycles, .. } = e else {
+        unreachable!()
+    };
+    let ratio = turns / cycles;
+    assert!((45.0..70.0).contains(&ratio), "{turns} rev/s, {cycles} Hz");
     assert!(e.to_string().contains("`theta [deg]`"), "{e}");
     // the flywheel's friction (the declared free parameters) is not fitted
     let e = refused(&rec, &FitOptions::default());
@@ -197,4 +201,34 @@ fn a_record_without_the_angle_or_too_short_is_refused() {
             && msg.contains("Rf"),
         "{msg}"
     );
+}
+
+/// An angle counter that wraps at a revolution (an encoder's `theta mod 2 pi`) is unwrapped:
+/// the fit is the one of the unwrapped angle (to a tenth of its standard error: the
+/// integrator's steps differ with the rounding).
+#[test]
+fn a_wrapped_angle_counter_is_fitted_as_the_angle() {
+    let m = gamma();
+    let p = truth(m.as_ref());
+    let rec = record(m.as_ref(), &p, 3.0);
+    let mut wrapped = rec.clone();
+    let tau = std::f64::consts::TAU;
+    wrapped.others[0]
+        .1
+        .iter_mut()
+        .for_each(|v| *v = v.rem_euclid(tau));
+    let opts = FitOptions {
+        free: Some(vec!["hp".into()]),
+        input_noise_draws: 0,
+        ..Default::default()
+    };
+    let hp = |r: &Measured| {
+        let id = fit::identify(m.as_ref(), &m.default_params(), r, &opts).expect("fitted");
+        let e = id.estimate("hp").expect("hp");
+        (e.value, e.std_error)
+    };
+    // the same up to the optimizer's tolerance (the angles differ by revolutions, so the
+    // rounding does)
+    let ((a, se), (b, _)) = (hp(&rec), hp(&wrapped));
+    assert!((a - b).abs() < 0.1 * se, "{a} vs {b} (std error {se})");
 }

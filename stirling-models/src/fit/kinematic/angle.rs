@@ -12,8 +12,9 @@ use crate::fit::FitError;
 use crate::layout::StateLayout;
 
 /// Most the angle's turning rate may differ from the pressure's cycle frequency (a factor
-/// either way; a record in degrees without `[deg]` turns 57 times too fast).
-pub const MAX_SPEED_RATIO: f64 = 1.25;
+/// either way; a record in degrees without `[deg]` turns 57 times too fast, and the cycle
+/// frequency from the pressure's crossings of its mean may be 10 % off on a noisy record).
+pub const MAX_SPEED_RATIO: f64 = 1.5;
 
 /// A kinematic engine's flywheel and its measured angle.
 #[derive(Clone, Debug)]
@@ -76,10 +77,30 @@ pub fn measured_angle(model: &dyn Model, data: &Measured) -> Result<Option<Angle
     }))
 }
 
+/// Unwrap the flywheel's angle column of `data` in place (a counter that wraps at a
+/// revolution, [`unwrap`]), if `model` is a kinematic engine and the record has the column:
+/// before the outliers are looked for, to which a wrap looks like a spike.
+pub fn unwrap_angle(model: &dyn Model, data: &mut Measured) {
+    let Some(&(angle, _)) = StateLayout::flywheels(model).first() else {
+        return;
+    };
+    let name = model.state_names()[angle].clone();
+    if let Some(v) = data.channel_mut(&name) {
+        *v = unwrap(v);
+    }
+}
+
 /// The angle with the jumps of a counter that wraps at a revolution (a step larger than
-/// pi) removed.
+/// pi) removed, when its values stay within one revolution (a counter's); an angle that
+/// spans more is left as it is (an angle in degrees read as rad must reach the speed check
+/// with its speed, not folded into another).
 pub fn unwrap(a: &[f64]) -> Vec<f64> {
     let tau = std::f64::consts::TAU;
+    let lo = a.iter().copied().fold(f64::INFINITY, f64::min);
+    let hi = a.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+    if !(hi - lo <= 1.01 * tau) {
+        return a.to_vec();
+    }
     let mut out = Vec::with_capacity(a.len());
     let mut shift = 0.0;
     for (k, &v) in a.iter().enumerate() {
@@ -131,7 +152,10 @@ mod tests {
         for (a, b) in un.iter().zip(&true_angle) {
             assert!((a - b - (un[0] - true_angle[0])).abs() < 1e-12, "{a} {b}");
         }
-        // an angle that never wraps is left alone
+        // an angle that never wraps is left alone, and so is one over many revolutions
+        // whose steps exceed pi (degrees read as rad)
         assert_eq!(unwrap(&true_angle), true_angle);
+        let degrees: Vec<f64> = true_angle.iter().map(|v| v.to_degrees()).collect();
+        assert_eq!(unwrap(&degrees), degrees);
     }
 }

@@ -25,7 +25,7 @@ pub mod stage;
 /// The gas's starting state, fitted before the parameters.
 pub mod start;
 
-pub use angle::{measured_angle, Angle};
+pub use angle::{measured_angle, unwrap_angle, Angle};
 
 /// The fit of a kinematic engine from the free parameters `free` (names), on the prepared
 /// record `rec`.
