@@ -65,6 +65,10 @@ fn a_rig_record_of_the_gamma_engine_is_fitted_and_the_intervals_cover_the_truth(
     let id = fit::identify(m.as_ref(), &m.default_params(), &rec, &opts).expect("fitted");
     let s2 = id.stage2.as_ref().expect("stage 2 ran");
     assert!(id.stage1.is_none() && s2.converged, "{s2:?}");
+    // what did not run is said
+    for note in ["stage 1", "free-run validation: not run"] {
+        assert!(id.notes.iter().any(|n| n.contains(note)), "{:?}", id.notes);
+    }
     eprintln!("fitted in {:.2} s", clock.elapsed().as_secs_f64());
 
     for name in ["hp", "hs", "Rf", "Gleak"] {

@@ -69,8 +69,17 @@ pub(super) fn identify<'a>(
          not run; the gas is driven by the measured angle `{}`",
         angle.name
     )];
-    if opts.multiple_shooting.is_some() {
-        notes.push("multiple shooting: not run on a kinematic engine".into());
+    for (asked, what) in [
+        (opts.multiple_shooting.is_some(), "multiple shooting"),
+        (
+            opts.restart_cycles.is_some(),
+            "restarts (--restart-cycles, a stage-1 option)",
+        ),
+        (opts.free_run.is_some(), "free-run validation"),
+    ] {
+        if asked {
+            notes.push(format!("{what}: not run on a kinematic engine"));
+        }
     }
     notes.extend(super::identify::at_bounds(model, &p, &gas, &opts.bounds));
     let id = Identification {
