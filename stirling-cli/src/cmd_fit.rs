@@ -74,14 +74,17 @@ pub fn run(a: &FitArgs) -> anyhow::Result<()> {
     if let Some(dir) = &a.plot {
         files::prepare_dir(dir, &FIGURES, a.force, "--plot")?;
     }
-    let (data, lines) = common::read_record(
-        &a.data,
-        a.drop_outliers,
-        (a.train.as_deref(), a.holdout.as_deref()),
-    )?;
+    // outliers are repaired once the model says which column is a flywheel's angle: a
+    // counter's wraps at a revolution are steps, not outliers
+    let (mut data, lines) =
+        common::read_record(&a.data, false, (a.train.as_deref(), a.holdout.as_deref()))?;
     check_uniform(&data, Some(&lines))?;
     let (train, holdout) = common::blocks(a.train.as_deref(), a.holdout.as_deref(), &data, 0.7)?;
     let model = stirling_models::build(&a.model, a.with.n, Closure::Full)?;
+    fit::kinematic::unwrap_angle(model.as_ref(), &mut data);
+    if a.drop_outliers {
+        common::repair_outliers(&a.data, &mut data, &lines);
+    }
     common::check_channels(&a.model, model.as_ref(), &data)?;
     let p0 = a.with.load(model.as_ref())?;
     common::check_sampling(model.as_ref(), &p0, &data, train, 0.7)?;

@@ -57,6 +57,10 @@ pub struct RigArgs {
     /// Initial displacer displacement from rest (m)
     #[arg(long, default_value_t = 2e-3, allow_negative_numbers = true, value_parser = ranges::finite)]
     pub x0: f64,
+    /// Starting value of a state by name, set after the rest state and the --x0 kick, e.g.
+    /// --start omega=18: a push start of a kinematic engine's flywheel (rad/s; repeatable)
+    #[arg(long, value_name = "STATE=VALUE", allow_hyphen_values = true, value_parser = ranges::state_value)]
+    pub start: Vec<(String, f64)>,
     /// Noise seed
     #[arg(long, default_value_t = 1, allow_negative_numbers = true, value_parser = ranges::seed)]
     pub seed: u64,
@@ -80,6 +84,7 @@ pub fn run(a: &RigArgs) -> anyhow::Result<()> {
     common::unique("--channels", &a.channels, |c| c.trim().to_string())?;
     common::unique("--effect", &a.effect, name)?;
     common::unique("--noise", &a.noise, |(c, _)| c.clone())?;
+    common::unique("--start", &a.start, |(c, _)| c.clone())?;
     let cfg = RigConfig {
         model: a.model.clone(),
         n: a.with.n,
@@ -96,6 +101,7 @@ pub fn run(a: &RigArgs) -> anyhow::Result<()> {
         offset_x: a.offset_x,
         offset_y: a.offset_y,
         x0: a.x0,
+        start: a.start.clone(),
         seed: a.seed,
         channels: a.channels.clone(),
         truth: a.truth.clone(),

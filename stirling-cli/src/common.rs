@@ -44,15 +44,25 @@ pub fn read_record(
     };
     let (mut data, lines) = stirling_models::data::read_csv_within(path, &lim)?;
     if drop {
-        for o in stirling_models::data::outliers::repair(&mut data) {
-            let line = lines.get(o.index).copied().unwrap_or(0);
-            note(format_args!(
-                "{}:{line}: dropped an outlier, {o}",
-                path.display()
-            ));
-        }
+        repair_outliers(path, &mut data, &lines);
     }
     Ok((data, lines))
+}
+
+/// Replace the isolated outliers of `data` (read from `path`, its rows at the file's
+/// `lines`), each named on stderr (`--drop-outliers`).
+pub fn repair_outliers(
+    path: &std::path::Path,
+    data: &mut stirling_models::data::Measured,
+    lines: &[usize],
+) {
+    for o in stirling_models::data::outliers::repair(data) {
+        let line = lines.get(o.index).copied().unwrap_or(0);
+        note(format_args!(
+            "{}:{line}: dropped an outlier, {o}",
+            path.display()
+        ));
+    }
 }
 
 /// A list option names each item once: `--channels x,x` or `--effect leak=1 --effect leak=2`

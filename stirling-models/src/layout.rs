@@ -94,6 +94,18 @@ impl StateLayout {
             .position(|s| matches!(s.kind, StateKind::Velocity(v) if v == b))
     }
 
+    /// The flywheels of a kinematic engine (docs/physics.md section 12): each a body whose
+    /// position is an angle (rad), as `(angle, speed)` states; empty for free bodies.
+    pub fn flywheels(model: &dyn Model) -> Vec<(usize, usize)> {
+        model
+            .states()
+            .iter()
+            .enumerate()
+            .filter(|(_, s)| matches!(s.kind, StateKind::Position(_)) && s.unit == "rad")
+            .filter_map(|(i, _)| Some((i, Self::velocity_of(model, i)?)))
+            .collect()
+    }
+
     /// The cold-side CV's pressure state (the last CV), if the model has gas.
     pub fn cold(&self) -> Option<usize> {
         self.pressures.last().copied()

@@ -84,6 +84,7 @@ pub fn rig<'py>(
         offset_x,
         offset_y,
         x0,
+        start: Vec::new(),
         seed,
         channels: channels.unwrap_or_else(|| RigConfig::default().channels),
         truth,

@@ -181,6 +181,20 @@ pub fn channel_noise(s: &str) -> Parsed<(String, f64)> {
     Ok((name.to_string(), v))
 }
 
+/// A state's starting value `NAME=VALUE` (VALUE a finite number), as `--start omega=18`.
+pub fn state_value(s: &str) -> Parsed<(String, f64)> {
+    let (name, v) = s.split_once('=').ok_or(RangeError::Outside(
+        "expected STATE=VALUE, such as omega=18 (the state's name as `stirling info` lists it)",
+    ))?;
+    let name = name.trim();
+    if name.is_empty() {
+        return Err(RangeError::Outside(
+            "the state's name is empty: expected STATE=VALUE",
+        ));
+    }
+    Ok((name.to_string(), number(v)?))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

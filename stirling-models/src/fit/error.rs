@@ -120,6 +120,32 @@ pub enum FitError {
         column: String,
         source: Box<stirling_dsl::ObserveError>,
     },
+    #[error("{file}: fit: a kinematic engine needs {what}: `{model}` is one, and {why}")]
+    KinematicColumn {
+        file: String,
+        model: String,
+        what: String,
+        why: String,
+    },
+    #[error("fit: a kinematic engine needs one flywheel and no free bodies (its angle drives the gas); `{model}` has {wheels} flywheel(s) and {bodies} free body(ies)")]
+    KinematicBodies {
+        model: String,
+        wheels: usize,
+        bodies: usize,
+    },
+    #[error("fit: a kinematic engine's fit drives the gas with the measured angle and identifies gas parameters only; `{names}` of `{model}` act on the flywheel (friction, damper, load), which it does not identify: free gas parameters instead (--free, some of: {gas})")]
+    KinematicMechanics {
+        model: String,
+        names: String,
+        gas: String,
+    },
+    #[error("{file}: fit: the angle `{angle}` turns at {turns:.4} rev/s on the training block but the pressure `p` cycles at {cycles:.4} Hz: the angle must be in rad (or carry its unit, `{angle} [deg]`) and be of the same record")]
+    KinematicSpeed {
+        file: String,
+        angle: String,
+        turns: f64,
+        cycles: f64,
+    },
     #[error("{stage} expects two bodies (displacer x, piston y); `{model}` has {found}")]
     Bodies {
         stage: &'static str,

@@ -112,8 +112,14 @@ pub fn check_model_frequency(
     })
 }
 
-/// The model's own cycle frequency at `p` (Hz): its dominant oscillatory pole at rest.
+/// The model's own cycle frequency at `p` (Hz): its dominant oscillatory pole at rest. A
+/// kinematic engine has none to compare: it cycles at its flywheel's speed, which its rest
+/// state does not set (the gamma LTD's pole at rest is 0.39 Hz, its running speed 2.8 Hz;
+/// its fit checks the measured angle's speed against the record's cycle instead).
 fn model_frequency(model: &dyn Model, p: &[f64]) -> Option<f64> {
+    if !crate::layout::StateLayout::flywheels(model).is_empty() {
+        return None;
+    }
     let d = dynamic_poles(model, p, &NewtonOptions::default()).ok()?;
     d.poles
         .iter()

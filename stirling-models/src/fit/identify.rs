@@ -14,6 +14,7 @@ use stirling_dsl::Model;
 use super::classify::{classify, default_free};
 use super::driven::Stage;
 use super::gas::{self, GasStage};
+use super::kinematic::unwrap_angle;
 use super::mechanics::{self, MechInputs};
 use super::record::Record;
 use super::sensitivity::Signal;
@@ -296,7 +297,7 @@ impl<'a> Run<'a, '_> {
 /// A note for each free parameter that ended at one of its bounds (within 1e-3 of the
 /// range): the data push it further, and its interval, cut by the bound, says less than it
 /// seems.
-fn at_bounds(
+pub(super) fn at_bounds(
     model: &dyn Model,
     p: &[f64],
     free: &[usize],
@@ -373,6 +374,19 @@ pub fn identify_stages<'a>(
 ) -> Result<(Identification, Vec<FittedStage<'a>>), FitError> {
     let clock = Instant::now();
     super::supported::check_sensors(model)?;
+    let angle = super::kinematic::measured_angle(model, data)?;
+    // a flywheel's angle counter unwrapped before the record's outliers are looked for
+    let unwrapped;
+    let data = match &angle {
+        Some(a) => {
+            let mut d = data.clone();
+            unwrap_angle(model, &mut d);
+            debug_assert_eq!(d.channel(&a.name), Some(a.data.as_slice()));
+            unwrapped = d;
+            &unwrapped
+        }
+        None => data,
+    };
     let layout = StateLayout::working_gas(model);
     let rec = Record::new(model, &layout, p0, data, opts)?;
     let free = opts.free.clone().unwrap_or_else(|| default_free(model, p0));
@@ -382,6 +396,10 @@ pub fn identify_stages<'a>(
         return Err(FitError::DuplicateFree { name });
     }
     check_bounds(model, p0, &free, &opts.bounds)?;
+    if let Some(angle) = &angle {
+        let parts = (&layout, &rec);
+        return super::kinematic::identify(model, p0, parts, angle, &free, opts);
+    }
     let (mech, gas_free) = classify(model, p0, &free)?;
     let run = Run {
         model,

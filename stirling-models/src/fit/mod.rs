@@ -25,6 +25,8 @@ pub mod gas;
 pub mod identify;
 /// Errors in variables: noise on the prescribed inputs.
 pub mod input_noise;
+/// The fit of a kinematic engine: the gas driven by the measured crank angle.
+pub mod kinematic;
 /// Levenberg-Marquardt.
 pub mod lm;
 /// The model state and channels a record gives: sensor offsets, measured channels, a state

@@ -23,6 +23,12 @@ pub enum RigError {
     UnknownChannel { channel: String, known: String },
     #[error("sensor `{channel}` is in {unit}: the rig knows the noise of pressures (Pa, --noise-p) and positions (m, --noise-x); give this one's with --noise {channel}=SD (in {unit})")]
     SensorUnit { channel: String, unit: String },
+    #[error("--start names `{state}`, which is not a state of `{model}`: its states are {known}")]
+    UnknownState {
+        state: String,
+        model: String,
+        known: String,
+    },
     #[error("--noise names `{channel}`, which is not among the channels written (--channels {channels})")]
     NoiseChannel { channel: String, channels: String },
     #[error("--channels is empty: name at least one of p, p_hot, x, y")]

@@ -11,8 +11,9 @@ use crate::effects::EffectSettings;
 use crate::layout::StateLayout;
 use crate::sim::{simulate, SimOptions};
 
-/// The clean run: from equilibrium with the first state (the displacer) kicked by `x0`, sampled at `rate`
-/// after `settle` (rows: the `count + 1` samples).
+/// The clean run: from equilibrium with the first state (the displacer) kicked by `x0` and the
+/// states `start` names set (a flywheel pushed), sampled at `rate` after `settle` (rows: the
+/// `count + 1` samples).
 fn clean_run(
     model: &dyn Model,
     p: &[f64],
@@ -22,6 +23,17 @@ fn clean_run(
     let mut x0 = vec![0.0; model.n_states()];
     model.equilibrium_guess(p, &mut x0);
     x0[0] += cfg.x0;
+    let names = model.state_names();
+    for (name, v) in &cfg.start {
+        let Some(i) = names.iter().position(|n| n == name) else {
+            return Err(RigError::UnknownState {
+                state: name.clone(),
+                model: model.name().into(),
+                known: names.join(", "),
+            });
+        };
+        x0[i] = *v;
+    }
     let dt = 1.0 / cfg.rate;
     let samples: Vec<f64> = (0..=count).map(|k| cfg.settle + k as f64 * dt).collect();
     let opts = SimOptions {
@@ -120,10 +132,14 @@ fn declared_channel(
             .join(", ")
     };
     let Some(sensor) = model.sensors().iter().find(|s| s.name == name) else {
-        return Err(RigError::UnknownChannel {
+        return state_channel(model, name, cfg).ok_or_else(|| RigError::UnknownChannel {
             channel: name.into(),
-            known: format!("{} (the sensors `{}` declares)", known(), model.name()),
-        });
+            known: format!(
+                "{} (the sensors `{}` declares), or one of its states",
+                known(),
+                model.name()
+            ),
+        })?;
     };
     let obs = Observation::sensor(model, name).map_err(|e| RigError::UnknownChannel {
         channel: name.into(),
@@ -161,4 +177,36 @@ fn declared_channel(
         sd,
         pressure,
     })
+}
+
+/// A channel reading state `name` directly (a flywheel's angle `theta`, as an encoder reads
+/// it): no lag, gain or offset; its noise is `--noise NAME=SD`, else `noise_x` for a position
+/// in m, else the state's unit must be given a level ([`RigError::SensorUnit`]). `None`: the
+/// model has no such state.
+fn state_channel(
+    model: &dyn Model,
+    name: &str,
+    cfg: &RigConfig,
+) -> Option<Result<sensors::Channel, RigError>> {
+    let i = model.states().iter().position(|s| s.name == name)?;
+    let unit = model.states()[i].unit;
+    let sd = match (unit, cfg.noise_of(name)) {
+        (_, Some(sd)) => sd,
+        ("m", None) => cfg.noise_x,
+        (unit, None) => {
+            return Some(Err(RigError::SensorUnit {
+                channel: name.into(),
+                unit: unit.into(),
+            }))
+        }
+    };
+    Some(Ok(sensors::Channel {
+        name: name.into(),
+        obs: Observation::state(i),
+        tau: 0.0,
+        gain: 0.0,
+        offset: 0.0,
+        sd,
+        pressure: false,
+    }))
 }

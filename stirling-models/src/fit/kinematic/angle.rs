@@ -1,0 +1,161 @@
+//! The measured crank angle of a kinematic engine: the flywheel it belongs to, the record's
+//! column (by the angle state's name, in rad after the header's unit), unwrapped where a
+//! counter wraps it at a revolution, and checked against the pressure's cycle: an angle
+//! that turns at another rate than the pressure cycles is in another unit, or from another
+//! record, and would drive the gas at a wrong speed.
+
+use stirling_dsl::Model;
+
+use crate::data::Measured;
+use crate::fit::excitation::record_frequency;
+use crate::fit::FitError;
+use crate::layout::StateLayout;
+
+/// Most the angle's turning rate may differ from the pressure's cycle frequency (a factor
+/// either way; a record in degrees without `[deg]` turns 57 times too fast, and the cycle
+/// frequency from the pressure's crossings of its mean may be 10 % off on a noisy record).
+pub const MAX_SPEED_RATIO: f64 = 1.5;
+
+/// A kinematic engine's flywheel and its measured angle.
+#[derive(Clone, Debug)]
+pub struct Angle {
+    /// The angle's and the speed's states.
+    pub angle: usize,
+    pub speed: usize,
+    /// The angle's name (the record's column).
+    pub name: String,
+    /// The measured angle (rad), unwrapped.
+    pub data: Vec<f64>,
+}
+
+/// The flywheel of `model`, if it is a kinematic engine (`None`: an engine of free bodies),
+/// with its angle read from `data`: refused when the model has several flywheels or free
+/// bodies besides one, or the record lacks the angle or the pressure `p`.
+pub fn measured_angle(model: &dyn Model, data: &Measured) -> Result<Option<Angle>, FitError> {
+    let wheels = StateLayout::flywheels(model);
+    let Some(&(angle, speed)) = wheels.first() else {
+        return Ok(None);
+    };
+    let positions = StateLayout::of(model).positions.len();
+    if wheels.len() > 1 || positions > 1 {
+        return Err(FitError::KinematicBodies {
+            model: model.name().into(),
+            wheels: wheels.len(),
+            bodies: positions - wheels.len(),
+        });
+    }
+    let name = model.state_names()[angle].clone();
+    let missing = |column: &str, what: &str| {
+        let why = match data.unread(column) {
+            Some(e) => format!("its column `{column}` could not be read ({e})"),
+            None => format!(
+                "the record has no column `{column}` (its columns: {})",
+                data.channels().join(", ")
+            ),
+        };
+        FitError::KinematicColumn {
+            file: data.source.clone(),
+            model: model.name().into(),
+            what: what.into(),
+            why,
+        }
+    };
+    if data.p.is_none() {
+        return Err(missing("p", "the pressure `p` its gas is fitted to"));
+    }
+    let Some(raw) = data.channel(&name) else {
+        let what = format!(
+            "the flywheel's angle `{name}` (rad, or `{name} [deg]`) that drives its cranks"
+        );
+        return Err(missing(&name, &what));
+    };
+    Ok(Some(Angle {
+        angle,
+        speed,
+        data: unwrap(raw),
+        name,
+    }))
+}
+
+/// Unwrap the flywheel's angle column of `data` in place (a counter that wraps at a
+/// revolution, [`unwrap`]), if `model` is a kinematic engine and the record has the column:
+/// before the outliers are looked for, to which a wrap looks like a spike.
+pub fn unwrap_angle(model: &dyn Model, data: &mut Measured) {
+    let Some(&(angle, _)) = StateLayout::flywheels(model).first() else {
+        return;
+    };
+    let name = model.state_names()[angle].clone();
+    if let Some(v) = data.channel_mut(&name) {
+        *v = unwrap(v);
+    }
+}
+
+/// The angle with the jumps of a counter that wraps at a revolution (a step larger than
+/// pi) removed, when its values stay within one revolution (a counter's); an angle that
+/// spans more is left as it is (an angle in degrees read as rad must reach the speed check
+/// with its speed, not folded into another).
+pub fn unwrap(a: &[f64]) -> Vec<f64> {
+    let tau = std::f64::consts::TAU;
+    let lo = a.iter().copied().fold(f64::INFINITY, f64::min);
+    let hi = a.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+    if !(hi - lo <= 1.01 * tau) {
+        return a.to_vec();
+    }
+    let mut out = Vec::with_capacity(a.len());
+    let mut shift = 0.0;
+    for (k, &v) in a.iter().enumerate() {
+        if k > 0 {
+            let step = v - a[k - 1];
+            shift -= tau * (step / tau).round();
+        }
+        out.push(v + shift);
+    }
+    out
+}
+
+/// Refuse an angle that turns at another rate than the pressure `p` cycles on the training
+/// block `tr` (inclusive sample indices, interval `dt`).
+pub fn check_speed(
+    angle: &Angle,
+    data: &Measured,
+    tr: (usize, usize),
+    dt: f64,
+) -> Result<(), FitError> {
+    let a = &angle.data;
+    let seconds = (tr.1 - tr.0) as f64 * dt;
+    let turns = (a[tr.1] - a[tr.0]).abs() / std::f64::consts::TAU / seconds;
+    let Some(cycles) = record_frequency(data, tr, dt) else {
+        return Ok(()); // the excitation check names a record without a cycle
+    };
+    let ratio = turns / cycles;
+    if !(ratio.is_finite() && (1.0 / MAX_SPEED_RATIO..=MAX_SPEED_RATIO).contains(&ratio)) {
+        return Err(FitError::KinematicSpeed {
+            file: data.source.clone(),
+            angle: angle.name.clone(),
+            turns,
+            cycles,
+        });
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_wrapped_counter_is_unwrapped() {
+        let tau = std::f64::consts::TAU;
+        let true_angle: Vec<f64> = (0..200).map(|k| 0.3 * k as f64 - 1.0).collect();
+        let wrapped: Vec<f64> = true_angle.iter().map(|v| v.rem_euclid(tau)).collect();
+        let un = unwrap(&wrapped);
+        for (a, b) in un.iter().zip(&true_angle) {
+            assert!((a - b - (un[0] - true_angle[0])).abs() < 1e-12, "{a} {b}");
+        }
+        // an angle that never wraps is left alone, and so is one over many revolutions
+        // whose steps exceed pi (degrees read as rad)
+        assert_eq!(unwrap(&true_angle), true_angle);
+        let degrees: Vec<f64> = true_angle.iter().map(|v| v.to_degrees()).collect();
+        assert_eq!(unwrap(&degrees), degrees);
+    }
+}

@@ -1,0 +1,130 @@
+//! The fit of a kinematic engine (a flywheel driving cranks, docs/physics.md section 12): the
+//! record gives the pressure `p` and the flywheel's angle; stage 2 drives the gas with the
+//! measured angle ([`stage`]) and identifies the free gas parameters and the pressure offset.
+//!
+//! Stage 1 (the mechanics driven by the measured pressure) does not run: the flywheel's
+//! friction and load are not identified, and freeing one is refused by name. The multiple
+//! shooting and the free run (simulations of the free engine) are skipped with a note.
+
+use std::time::Instant;
+
+use stirling_dsl::Model;
+
+use super::classify::classify;
+use super::free_run::SensorOffsets;
+use super::record::Record;
+use super::stage_fit::{fit_stage, FittedStage};
+use super::vars::VarKind;
+use super::{FitError, FitOptions, Identification};
+use crate::layout::StateLayout;
+
+/// The measured angle: the flywheel, the column, the unwrapping and the speed check.
+pub mod angle;
+/// Stage 2 driven by the measured angle.
+pub mod stage;
+/// The gas's starting state, fitted before the parameters.
+pub mod start;
+
+pub use angle::{measured_angle, unwrap_angle, Angle};
+
+/// The fit of a kinematic engine from the free parameters `free` (names), on the prepared
+/// record `rec`.
+pub(super) fn identify<'a>(
+    model: &'a dyn Model,
+    p0: &[f64],
+    (layout, rec): (&StateLayout, &Record),
+    angle: &Angle,
+    free: &[String],
+    opts: &FitOptions,
+) -> Result<(Identification, Vec<FittedStage<'a>>), FitError> {
+    let clock = Instant::now();
+    angle::check_speed(angle, rec.data, rec.tr, rec.dt)?;
+    let (mech, gas) = classify(model, p0, free)?;
+    if !mech.is_empty() {
+        return Err(mechanics_refused(model, p0, &mech));
+    }
+    let (stage, burn) = stage::stage(model, layout, rec, angle, p0, &gas, opts)?;
+    let stage = start::fitted_start(stage, rec, burn, opts)?;
+    let solved = fit_stage(&stage, rec.tr, rec.ho, burn, opts)?;
+    let mut p = p0.to_vec();
+    let mut offsets = SensorOffsets {
+        p: rec.p_off0,
+        p_hot: rec.have_hot.then_some(rec.ph_off0),
+        ..Default::default()
+    };
+    for (v, &val) in stage.vars.iter().zip(&solved.values) {
+        match v.kind {
+            VarKind::Param(j) => p[j] = val,
+            VarKind::Offset { out: 0, .. } => offsets.p = val,
+            VarKind::Offset { out: 1, .. } if rec.have_hot => offsets.p_hot = Some(val),
+            VarKind::Offset { .. } => {
+                let name = v.name.trim_end_matches("_offset").to_string();
+                offsets.others.push((name, val));
+            }
+            _ => {}
+        }
+    }
+    let mut notes = vec![format!(
+        "kinematic engine: stage 1 (the flywheel's mechanics from the measured pressure) does \
+         not run; the gas is driven by the measured angle `{}`",
+        angle.name
+    )];
+    for (asked, what) in [
+        (opts.multiple_shooting.is_some(), "multiple shooting"),
+        (
+            opts.restart_cycles.is_some(),
+            "restarts (--restart-cycles, a stage-1 option)",
+        ),
+        (opts.free_run.is_some(), "free-run validation"),
+    ] {
+        if asked {
+            notes.push(format!("{what}: not run on a kinematic engine"));
+        }
+    }
+    notes.extend(super::identify::at_bounds(model, &p, &gas, &opts.bounds));
+    let id = Identification {
+        model: model.name().into(),
+        n: model.n(),
+        params: crate::params::named(model, &p),
+        stage1: None,
+        stage2: Some(solved.fit.clone()),
+        train: rec.train,
+        holdout: rec.holdout,
+        seconds: clock.elapsed().as_secs_f64(),
+        offsets,
+        multiple_shooting: None,
+        free_run: None,
+        notes,
+    };
+    let fitted = FittedStage {
+        stage,
+        u: solved.lm.x.clone(),
+        first: rec.tr.0,
+        last: rec.tr.1,
+        keep: solved.keep,
+    };
+    Ok((id, vec![fitted]))
+}
+
+/// The error for free parameters that act on the flywheel (`mech`), naming the model's gas
+/// parameters that may be freed instead.
+fn mechanics_refused(model: &dyn Model, p0: &[f64], mech: &[usize]) -> FitError {
+    let names = |js: &[usize]| {
+        js.iter()
+            .map(|&j| model.params()[j].name.to_string())
+            .collect::<Vec<_>>()
+    };
+    let gas: Vec<String> = model
+        .params()
+        .iter()
+        .map(|i| i.name.to_string())
+        .filter(|n| {
+            matches!(classify(model, p0, std::slice::from_ref(n)), Ok((m, g)) if m.is_empty() && !g.is_empty())
+        })
+        .collect();
+    FitError::KinematicMechanics {
+        model: model.name().into(),
+        names: names(mech).join(", "),
+        gas: gas.join(","),
+    }
+}
