@@ -224,6 +224,16 @@ fn a_lab_record_of_the_gamma_engine_is_fitted_from_the_command_line() {
         &["fit", &gamma, "--data", support::s(&rec)],
         &["`cf, Tc` of `gamma_ltd` act on the flywheel", "--free"],
     );
+    // the diagnosis is refused up front, once, and points at the fit
+    let err = support::fails_with(
+        &["diagnose", &gamma, "--data", support::s(&rec)],
+        &[
+            "`gamma_ltd` is a kinematic engine",
+            "does not run on it yet",
+            "stirling fit",
+        ],
+    );
+    assert_eq!(err.matches("kinematic engine").count(), 1, "{err}");
     // the rig's push names a state
     support::fails_with(
         &[

@@ -56,8 +56,11 @@ pub enum DiagnoseError {
     },
     #[error(transparent)]
     Effect(#[from] EffectError),
+    // the cause in the message, not as a source: a chain printed by the caller showed it twice
     #[error("the nominal calibration failed: {0}")]
-    Nominal(#[from] FitError),
+    Nominal(FitError),
+    #[error("model `{model}` is a kinematic engine (a flywheel drives its cranks): the diagnosis does not run on it yet; it calibrates the mechanics from the measured pressure, which a kinematic record's fit does not identify (the flywheel's friction and load act as one torque). Fit the record with `stirling fit` (docs/custom-topologies.md, section 13)")]
+    Kinematic { model: String },
     #[error("model `{model}` has no parameter `{name}`")]
     UnknownParameter { name: String, model: String },
     #[error("`{param}` enters neither driven subsystem of `{model}`")]
@@ -98,4 +101,10 @@ pub enum DiagnoseError {
         #[source]
         source: std::io::Error,
     },
+}
+
+impl From<FitError> for DiagnoseError {
+    fn from(e: FitError) -> Self {
+        DiagnoseError::Nominal(e)
+    }
 }

@@ -26,6 +26,11 @@ pub fn diagnose(
     opts: &DiagnoseOptions,
 ) -> Result<Diagnosis, DiagnoseError> {
     let clock = Instant::now();
+    if !crate::layout::StateLayout::flywheels(model).is_empty() {
+        return Err(DiagnoseError::Kinematic {
+            model: model.name().into(),
+        });
+    }
     let first = diagnose_once(model, p0, data, opts)?;
     let mut d = super::restarted::second_pass(model, p0, data, opts, &first)
         .map_or(first, |second| *second);
