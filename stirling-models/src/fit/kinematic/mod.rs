@@ -1,6 +1,6 @@
 //! The fit of a kinematic engine (a flywheel driving cranks, docs/physics.md section 12): the
 //! record gives the pressure `p` and the flywheel's angle; stage 2 drives the gas with the
-//! measured angle ([`stage`]) and identifies the free gas parameters and the pressure offset.
+//! measured angle (`stage.rs`) and identifies the free gas parameters and the pressure offset.
 //!
 //! Stage 1 (the mechanics driven by the measured pressure) does not run: the flywheel's
 //! friction and load are not identified, and freeing one is refused by name. The multiple
