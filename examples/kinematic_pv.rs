@@ -89,6 +89,8 @@ pub struct Summary {
     /// Indicated work per revolution (J) of the record and of the model, and the revolutions.
     pub work_record: f64,
     pub work_model: f64,
+    /// The truth's, from the rig's run without noise over the same samples (J).
+    pub work_truth: f64,
     pub revolutions: usize,
     /// The noise level of the recorded pressure (Pa, from its third differences).
     pub noise: f64,
@@ -174,7 +176,7 @@ pub fn run(args: &Args) -> Result<Summary, Box<dyn Error>> {
         .channel(&angle_name)
         .ok_or("the record lost its angle")?;
     let dt = rec.dt();
-    let mut th = Vec::new();
+    let (mut th, mut idx) = (Vec::new(), Vec::new());
     let (mut pm, mut pf) = (Vec::new(), Vec::new());
     for (k, &t) in series.t.iter().enumerate() {
         if t < h0 - 0.5 * dt || t > h1 + 0.5 * dt {
@@ -186,6 +188,7 @@ pub fn run(args: &Args) -> Result<Summary, Box<dyn Error>> {
             .copied()
             .ok_or("the series outruns the record")?;
         th.push(a);
+        idx.push(i);
         pm.push(series.measured[k]);
         pf.push(series.model[k]);
     }
@@ -195,6 +198,27 @@ pub fn run(args: &Args) -> Result<Summary, Box<dyn Error>> {
     let dv = volume_slope_at_angles(m, &fitted, &th)?;
     let (work_record, revolutions) = work_per_revolution(&th, &dv, &pm)?;
     let (work_model, _) = work_per_revolution(&th, &dv, &pf)?;
+    // the truth's loop over the same samples: the rig's run without its noise
+    let clean_cfg = RigConfig {
+        noise_p: 0.0,
+        noise: vec![("theta".into(), 0.0)],
+        ..cfg.clone()
+    };
+    let clean = measure(m, &truth, &clean_cfg)?;
+    let (Some(cp), Some(ct)) = (clean.p.as_ref(), clean.channel(&angle_name)) else {
+        return Err("the noise-free record lacks `p` or the angle".into());
+    };
+    let at = |v: &[f64]| -> Result<Vec<f64>, String> {
+        idx.iter()
+            .map(|&i| {
+                v.get(i)
+                    .copied()
+                    .ok_or("the records differ in length".to_string())
+            })
+            .collect()
+    };
+    let (tc, pc) = (at(ct)?, at(cp)?);
+    let (work_truth, _) = work_per_revolution(&tc, &volume_slope_at_angles(m, &truth, &tc)?, &pc)?;
     // the figures show those whole revolutions
     let (_, end) = whole_revolutions(&th)?;
     let (th, v, pm, pf) = (&th[..end], &v[..end], &pm[..end], &pf[..end]);
@@ -244,6 +268,7 @@ pub fn run(args: &Args) -> Result<Summary, Box<dyn Error>> {
         truth,
         work_record,
         work_model,
+        work_truth,
         revolutions,
         noise,
         rms_difference,
@@ -293,6 +318,11 @@ fn print(s: &Summary) {
         1e3 * s.work_record,
         1e3 * s.work_model,
         s.work_model / s.work_record
+    );
+    println!(
+        "the truth's (the rig's run without noise, same samples): {:.4} mJ, record / truth {:.4}",
+        1e3 * s.work_truth,
+        s.work_record / s.work_truth
     );
     println!(
         "model - record: rms {:.2} Pa; the record's noise {:.2} Pa",

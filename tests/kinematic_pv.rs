@@ -1,8 +1,8 @@
 //! The worked example of docs/custom-topologies.md section 13 (`examples/kinematic_pv.rs`): a
 //! short record of the gamma LTD written as a lab would, read back, fitted, and its p-V loop
 //! drawn. The figures are written, a second run without `--force` is refused before it
-//! overwrites them, and the loop areas of record and model agree (the model is the truth's
-//! structure: only the noise separates them).
+//! overwrites them, and the loop areas of record and model agree with the truth's (the rig's
+//! run without noise).
 
 #[path = "../examples/kinematic_pv.rs"]
 #[allow(dead_code)]
@@ -39,13 +39,20 @@ fn the_worked_example_draws_its_figures_and_the_loops_agree() {
         );
     }
     eprintln!(
-        "record {:.4e} J, model {:.4e} J over {} revolutions; rms {:.2} Pa, noise {:.2} Pa",
-        s.work_record, s.work_model, s.revolutions, s.rms_difference, s.noise
+        "truth {:.4e} J, record {:.4e} J, model {:.4e} J over {} revolutions; rms {:.2} Pa, noise {:.2} Pa",
+        s.work_truth, s.work_record, s.work_model, s.revolutions, s.rms_difference, s.noise
     );
     assert!(s.revolutions >= 2, "{}", s.revolutions);
-    // positive work (the loop runs clockwise), model and record within 2 %
+    // positive work (the loop runs clockwise); record and model within 1 % of the truth's
+    // (the rig's run without noise: the noise's share is about 0.2 % on 3 revolutions)
     assert!(s.work_record > 0.0 && s.work_model > 0.0);
-    assert!((s.work_model / s.work_record - 1.0).abs() < 0.02);
+    for w in [s.work_record, s.work_model] {
+        assert!(
+            (w / s.work_truth - 1.0).abs() < 0.01,
+            "{w} against {}",
+            s.work_truth
+        );
+    }
     // the difference is the noise: its rms within 30 % of the record's noise level
     assert!((s.rms_difference / s.noise - 1.0).abs() < 0.3);
 
