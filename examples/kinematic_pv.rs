@@ -152,9 +152,11 @@ pub fn run(args: &Args) -> Result<Summary, Box<dyn Error>> {
     let raw = measure(m, &truth, &cfg)?;
     let angle = stirling::models::sim::indicated::angle_state(m)?;
     let angle_name = m.state_names()[angle].clone();
-    std::fs::create_dir_all(&args.out)?;
+    std::fs::create_dir_all(&args.out)
+        .map_err(|e| format!("cannot create {}: {e}", args.out.display()))?;
     let text = lab_csv(&raw, &angle_name)?;
-    std::fs::write(&csv_path, &text)?;
+    std::fs::write(&csv_path, &text)
+        .map_err(|e| format!("cannot write {}: {e}", csv_path.display()))?;
     // read back as any lab record: units to SI, the wrapping angle unwrapped
     let mut rec = parse_csv(&csv_path.display().to_string(), &text)?;
     fit::kinematic::unwrap_angle(m, &mut rec);
@@ -305,6 +307,12 @@ fn print(s: &Summary) {
         }
     }
     if let Some(s2) = &s.id.stage2 {
+        if !s2.converged {
+            println!(
+                "warning: {} did not converge in {} iterations: the estimates are not an optimum",
+                s2.stage, s2.iterations
+            );
+        }
         for block in ["train", "holdout"] {
             if let Some(f) = s2.fit_percent("p", block) {
                 println!("fit of p on the {block} block: {f:.2} %");
