@@ -19,6 +19,8 @@ pub mod phase_residual;
 pub mod poles;
 /// PV diagram per vessel over one cycle.
 pub mod pv;
+/// A record's p-V loop against a model's, and their pressure difference by crank angle.
+pub mod pv_record;
 /// Measured against model, with the residual below (fit figures).
 pub mod series;
 /// A two-parameter sweep as a map of power with the stability boundary.

@@ -104,7 +104,7 @@ fn vessel_panel(
 }
 
 /// The triangle of an arrowhead at pixel `pa` pointing towards `pb` (none if they coincide).
-fn arrowhead(pa: (i32, i32), pb: (i32, i32)) -> Option<Vec<(i32, i32)>> {
+pub(super) fn arrowhead(pa: (i32, i32), pb: (i32, i32)) -> Option<Vec<(i32, i32)>> {
     let (dx, dy) = ((pb.0 - pa.0) as f64, (pb.1 - pa.1) as f64);
     let len = dx.hypot(dy);
     if len < 1e-9 {

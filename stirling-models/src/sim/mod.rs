@@ -35,6 +35,8 @@ mod dense_output;
 pub mod floquet_arnoldi;
 /// Restarted GMRES on a matrix-free operator.
 pub mod gmres;
+/// The indicated work of a sampled p-V record (a kinematic engine's volume at its angle).
+pub mod indicated;
 /// The step loop.
 pub mod integrate;
 /// A process-wide request to stop the simulations in progress (Ctrl-C in an interactive
