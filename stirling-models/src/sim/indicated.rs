@@ -3,11 +3,11 @@
 //! integral `closed-integral p dV` over whole revolutions of a measured angle.
 //!
 //! The work is positive when the loop runs clockwise in the (V, p) plane (work done by the
-//! gas). [`loop_work`] is the area of the polygon through the samples, which cuts the loop's
+//! gas). `loop_work` is the area of the polygon through the samples, which cuts the loop's
 //! corners: an ellipse sampled at `N` points loses `1 - sin(2 pi / N) / (2 pi / N)` of its
-//! area (0.4 % at 39 samples a revolution, the gamma LTD at 100 Hz). [`work_per_revolution`]
+//! area (0.4 % at 39 samples a revolution, the gamma LTD at 100 Hz). `work_per_revolution`
 //! integrates `p dV/dtheta` over the angle instead, with the volume's slope from the model's
-//! expressions ([`volume_slope_at_angles`]): the trapezoid rule on a smooth periodic integrand,
+//! expressions (`volume_slope_at_angles`): the trapezoid rule on a smooth periodic integrand,
 //! exact to round-off for a sampled ellipse. Noise in `p` biases neither.
 
 use std::f64::consts::TAU;
@@ -169,7 +169,7 @@ pub fn whole_revolutions(theta: &[f64]) -> Result<(usize, usize), IndicatedError
 /// the increasing angle `theta` (rad) from its first sample ([`whole_revolutions`]), by the
 /// trapezoid rule in the angle; the integrand at the end angle (exactly a whole number of
 /// turns) is interpolated between its neighbours. `dv` is `dV/dtheta` at each sample
-/// ([`volume_slope_at_angles`]). Returns the work and the number of revolutions.
+/// (`volume_slope_at_angles`). Returns the work and the number of revolutions.
 pub fn work_per_revolution(
     theta: &[f64],
     dv: &[f64],
