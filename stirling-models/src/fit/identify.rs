@@ -14,7 +14,6 @@ use stirling_dsl::Model;
 use super::classify::{classify, default_free};
 use super::driven::Stage;
 use super::gas::{self, GasStage};
-use super::kinematic::unwrap_angle;
 use super::mechanics::{self, MechInputs};
 use super::record::Record;
 use super::sensitivity::Signal;
@@ -375,13 +374,15 @@ pub fn identify_stages<'a>(
     let clock = Instant::now();
     super::supported::check_sensors(model)?;
     let angle = super::kinematic::measured_angle(model, data)?;
-    // a flywheel's angle counter unwrapped before the record's outliers are looked for
+    // a flywheel's angle counter unwrapped (by `measured_angle`) before the record's
+    // outliers are looked for
     let unwrapped;
     let data = match &angle {
         Some(a) => {
             let mut d = data.clone();
-            unwrap_angle(model, &mut d);
-            debug_assert_eq!(d.channel(&a.name), Some(a.data.as_slice()));
+            if let Some(v) = d.channel_mut(&a.name) {
+                v.clone_from(&a.data);
+            }
             unwrapped = d;
             &unwrapped
         }
