@@ -4,6 +4,7 @@
 
 use stirling_dsl::Model;
 
+use super::memo::Memo;
 use super::{is_mechanics, EffectAt, EffectVar};
 use crate::diagnose::DiagnoseError;
 use crate::effects::{EffectInfo, EffectTarget};
@@ -26,7 +27,7 @@ impl EffectVars {
     /// enter.
     pub fn of(
         model: &dyn Model,
-        nominal: &[FittedStage],
+        (nominal, memo): (&[FittedStage], &Memo),
         base: &[EffectAt],
         cands: &[EffectAt],
         free_shapes: bool,
@@ -39,14 +40,20 @@ impl EffectVars {
         for a in base {
             v.add(
                 model,
-                nominal,
+                (nominal, memo),
                 a.effect,
                 &a.shapes,
                 (!a.shapes.is_empty(), true),
             )?;
         }
         for c in cands {
-            v.add(model, nominal, c.effect, &c.shapes, (free_shapes, false))?;
+            v.add(
+                model,
+                (nominal, memo),
+                c.effect,
+                &c.shapes,
+                (free_shapes, false),
+            )?;
         }
         Ok(v)
     }
@@ -56,7 +63,7 @@ impl EffectVars {
     fn add(
         &mut self,
         model: &dyn Model,
-        nominal: &[FittedStage],
+        (nominal, memo): (&[FittedStage], &Memo),
         e: &EffectInfo,
         shapes: &[(&str, f64)],
         (free_shapes, base): (bool, bool),
@@ -98,7 +105,7 @@ impl EffectVars {
                     v.adds.push((si, var));
                 }
             }
-            if let Some((si, var, sigs)) = link(nominal, &v.adds, &v.linked, q.name)? {
+            if let Some((si, var, sigs)) = link((nominal, memo), &v.adds, &v.linked, q.name)? {
                 v.adds.push((si, var));
                 v.linked.push((si, sigs));
             }
@@ -161,7 +168,7 @@ impl EffectVars {
 /// stage's forward sensitivities at the nominal optimum. Returns the mechanics stage, its
 /// variable and the derivative signals (appended after those already queued in `linked`).
 fn link(
-    nominal: &[FittedStage],
+    (nominal, memo): (&[FittedStage], &Memo),
     adds: &[(usize, Var)],
     linked: &[(usize, Vec<Signal>)],
     name: &str,
@@ -186,7 +193,16 @@ fn link(
     st.vars.push(gvar.clone());
     let mut u = gas.u.clone();
     u.push(0.0);
-    let d = unmeasured::difference_sensitivity(&st, &u, st.vars.len() - 1, gas.first)?;
+    // a function of the nominal gas stage and the variable alone (its start and unit)
+    let key = format!(
+        "{}:{:x}:{:x}",
+        gvar.name,
+        gvar.initial.to_bits(),
+        gvar.scale.to_bits()
+    );
+    let d = memo.link(&key, || {
+        unmeasured::difference_sensitivity(&st, &u, st.vars.len() - 1, gas.first)
+    })?;
     let cold = d.len() - 1;
     let queued: usize = linked
         .iter()

@@ -18,6 +18,8 @@ use stirling_dsl::Model;
 
 /// The variables an effect adds, and where they enter.
 mod effect_vars;
+/// What building a joint problem computes again and again, computed once.
+mod memo;
 /// Stage 1's pressure differences re-evaluated at the fitted gas stage.
 mod rebase;
 
@@ -77,6 +79,8 @@ pub struct EffectAt {
 pub struct Basis {
     pub effects: Vec<EffectAt>,
     pub x: Vec<f64>,
+    /// The runs every joint problem on this calibration shares ([`memo`]).
+    pub memo: memo::Memo,
 }
 
 impl Basis {
@@ -85,6 +89,7 @@ impl Basis {
         Basis {
             effects: Vec::new(),
             x: nominal.iter().flat_map(|s| s.u.iter().copied()).collect(),
+            memo: memo::Memo::default(),
         }
     }
 }
@@ -136,7 +141,13 @@ impl<'a> Joint<'a> {
         cands: &[EffectAt],
         free_shapes: bool,
     ) -> Result<Self, DiagnoseError> {
-        let vars = EffectVars::of(model, nominal, &basis.effects, cands, free_shapes)?;
+        let vars = EffectVars::of(
+            model,
+            (nominal, &basis.memo),
+            &basis.effects,
+            cands,
+            free_shapes,
+        )?;
         let all_shapes: Vec<(&str, f64)> = basis
             .effects
             .iter()
@@ -164,7 +175,8 @@ impl<'a> Joint<'a> {
             base_x: basis.x.clone(),
         };
         if !basis.effects.is_empty() {
-            joint.rebase(&joint.start())?;
+            let key = memo::basis_key(&basis.x, &basis.effects);
+            joint.rebase_memo(&joint.start(), Some((&basis.memo, &key)))?;
         }
         Ok(joint)
     }

@@ -25,7 +25,9 @@
 //! input without stage 1's rows seeing why; on the self-check's gain records that drove the
 //! gain away (closure 0.86 to -437), so the joint of a gain keeps the nominal differences.
 
+use super::memo::Memo;
 use super::{is_mechanics, Joint};
+use crate::fit::sensitivity::Signal;
 use crate::fit::vars::{Sensor, VarKind};
 use crate::fit::{unmeasured, FitError, FittedStage};
 
@@ -90,6 +92,17 @@ impl Joint<'_> {
     /// Stage 1's pressure differences, and the derivatives of its linked variables, taken
     /// from the gas stage at the joint variables `u` (the links then act from there).
     pub fn rebase(&mut self, u: &[f64]) -> Result<(), FitError> {
+        self.rebase_memo(u, None)
+    }
+
+    /// [`Joint::rebase`], the run's signals taken from `memo` under the basis key `key` when
+    /// it holds them (`u` must then be the basis's optimum with the candidate at its null:
+    /// [`Joint::start`]), and kept there when computed.
+    pub(super) fn rebase_memo(
+        &mut self,
+        u: &[f64],
+        memo: Option<(&Memo, &str)>,
+    ) -> Result<(), FitError> {
         let Some(link) = self.dp_link.clone() else {
             return Ok(());
         };
@@ -101,7 +114,30 @@ impl Joint<'_> {
             return Ok(());
         };
         let vars: Vec<usize> = link.linked.iter().map(|l| l.1).collect();
-        let (dp, sens) = unmeasured::differences_at(&gas.stage, &ug, &vars, gas.first, last)?;
+        let names: Vec<String> = link
+            .linked
+            .iter()
+            .map(|l| mech.vars[l.0].name.clone())
+            .collect();
+        let run = || unmeasured::differences_at(&gas.stage, &ug, &vars, gas.first, last);
+        let (dp, sens) = match memo {
+            None => run()?,
+            Some((memo, basis)) => {
+                // the run's columns (every variable of the gas stage) set its steps: a key
+                // of its own for each set, so a kept run is the one this joint would make
+                let cols: Vec<&str> = gas.stage.vars.iter().map(|v| v.name.as_str()).collect();
+                let key = &format!("{basis}|{}", cols.join(","));
+                let got = recall(memo, key, &names);
+                match got {
+                    Some(hit) => hit,
+                    None => {
+                        let (dp, sens) = run()?;
+                        keep(memo, key, &names, (&dp, &sens));
+                        (dp, sens)
+                    }
+                }
+            }
+        };
         let mech = &mut self.stages[link.mech].1.stage;
         for (&s, d) in link.base.iter().zip(dp) {
             mech.signals[s] = d;
@@ -141,5 +177,27 @@ impl Joint<'_> {
             .filter_map(|&j| free.iter().position(|&c| c == j).map(|k| (j, var[k])))
             .map(|(j, v)| (a[j] - b[j]).abs() / v.sqrt().max(1e-300))
             .fold(0.0, f64::max)
+    }
+}
+
+/// The memo's name of the differences (no parameter's name holds a `#`).
+const DIFFERENCES: &str = "#differences";
+
+/// The memo's differences and linked derivatives at the basis `key`, when it holds all of
+/// them.
+fn recall(memo: &Memo, key: &str, names: &[String]) -> Option<(Vec<Signal>, Vec<Vec<Signal>>)> {
+    let dp = memo.rebased(key, DIFFERENCES)?;
+    let sens = names
+        .iter()
+        .map(|n| memo.rebased(key, n))
+        .collect::<Option<Vec<_>>>()?;
+    Some((dp, sens))
+}
+
+/// Keep the differences and linked derivatives of a rebase at the basis `key`.
+fn keep(memo: &Memo, key: &str, names: &[String], (dp, sens): (&[Signal], &[Vec<Signal>])) {
+    memo.keep_rebased(key, DIFFERENCES, dp);
+    for (n, d) in names.iter().zip(sens) {
+        memo.keep_rebased(key, n, d);
     }
 }
