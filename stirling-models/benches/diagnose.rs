@@ -4,10 +4,13 @@
 //! `diagnose::diagnose` with every candidate effect, its progress lines as it goes, and the
 //! wall and CPU time of each run.
 //!
-//! `cargo bench -p stirling-models --bench diagnose -- [lag|coulomb] [RUNS]`
+//! `cargo bench -p stirling-models --bench diagnose -- [lag|coulomb|pair] [RUNS]`
 //! - `lag` (default): `--effect sensor_lag=0.002`, seed 5, settle 0.1 s, diagnosed from
 //!   `kd = 702.8, kp = 53.8, hh = 538` (the record of docs/diagnosis.md);
-//! - `coulomb`: `--effect coulomb=0.02`, seed 11, settle 0.1 s, from the defaults.
+//! - `coulomb`: `--effect coulomb=0.02`, seed 11, settle 0.1 s, from the defaults;
+//! - `pair` (issue 34, item 6: at most 30 s for two effects): `--effect regen_quadratic=1e8
+//!   --effect sensor_lag=0.003`, seed 21, the rig's default settle, from the defaults (the
+//!   record of `findings/several-effects.md`; both effects are named).
 //!
 //! A whole diagnosis takes tens of seconds, so this is a plain timing harness (the minimum
 //! and median over `RUNS`, default 1), not criterion's sampling.
@@ -29,20 +32,27 @@ fn cpu_seconds() -> Option<f64> {
 
 /// The rig record and the starting parameter overrides of a case.
 fn case(name: &str) -> (RigConfig, Vec<(&'static str, f64)>) {
-    let (effect, seed, set) = match name {
-        "coulomb" => ("coulomb=0.02", 11, vec![]),
+    let (effects, seed, settle, set) = match name {
+        "coulomb" => (vec!["coulomb=0.02"], 11, 0.1, vec![]),
+        "pair" => (
+            vec!["regen_quadratic=1e8", "sensor_lag=0.003"],
+            21,
+            RigConfig::default().settle,
+            vec![],
+        ),
         _ => (
-            "sensor_lag=0.002",
+            vec!["sensor_lag=0.002"],
             5,
+            0.1,
             vec![("kd", 702.8), ("kp", 53.8), ("hh", 538.0)],
         ),
     };
     let cfg = RigConfig {
         model: "nsection".into(),
         n: Some(2),
-        effects: vec![effect.into()],
+        effects: effects.into_iter().map(String::from).collect(),
         t_end: 3.0,
-        settle: 0.1,
+        settle,
         rate: 2000.0,
         seed,
         ..Default::default()
