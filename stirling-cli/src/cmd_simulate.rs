@@ -12,6 +12,9 @@ use stirling_models::sim::{self, SimOptions, SimSummary, Trajectory};
 
 use crate::common::{self, files, ranges, ModelArgs};
 
+/// The running figures and Schmidt's analysis of a kinematic engine's run.
+mod kinematic;
+
 /// The largest CSV `--out` writes (bytes).
 const MAX_CSV_BYTES: f64 = 1e9;
 
@@ -29,6 +32,11 @@ pub struct SimulateArgs {
     /// Start from equilibrium with the displacer displaced by X metres (default 5e-3)
     #[arg(long, allow_negative_numbers = true, value_parser = ranges::finite)]
     pub perturb: Option<f64>,
+    /// Starting value of a state by name, set after the rest state and the kick, e.g.
+    /// --start omega=6.3: a push start of a kinematic engine's flywheel (rad/s; repeatable).
+    /// A kinematic engine's run then reports its speed, indicated power and Schmidt's analysis
+    #[arg(long, value_name = "STATE=VALUE", allow_hyphen_values = true, value_parser = ranges::state_value)]
+    pub start: Vec<(String, f64)>,
     /// Number of output samples (2 to 1e6)
     #[arg(long, default_value_t = 2000, allow_negative_numbers = true, value_parser = ranges::samples)]
     pub samples: usize,
@@ -84,15 +92,20 @@ pub fn run(args: &SimulateArgs) -> anyhow::Result<()> {
     let (model, p) = args.model.load()?;
     let model = model.as_ref();
     check_outputs(args, model)?;
-    let x0 = initial_state(model, &p, args)?;
+    common::unique("--start", &args.start, |(c, _)| c.clone())?;
+    let mut x0 = initial_state(model, &p, args)?;
+    apply_start(model, &mut x0, &args.start)?;
     let bar = progress_bar();
     let t_end = args.t_end;
     let mut progress = |t: f64| {
         bar.set_position((1000.0 * t / t_end) as u64);
         bar.set_message(format!("{t:.4}"));
     };
-    let (traj, summary, lc) = simulate(model, &p, &x0, args, &mut progress)?;
+    let (traj, mut summary, lc) = simulate(model, &p, &x0, args, &mut progress)?;
     bar.finish_and_clear();
+    if lc.is_none() {
+        kinematic::add_running(model, &p, &traj, &mut summary);
+    }
     if let Some(out) = &args.out {
         write_csv(out, args.force, model, &traj)?;
     }
@@ -251,6 +264,22 @@ fn initial_state(model: &dyn Model, p: &[f64], args: &SimulateArgs) -> anyhow::R
     Ok(x)
 }
 
+/// `--start NAME=VALUE`: each named state set to its value.
+fn apply_start(model: &dyn Model, x: &mut [f64], start: &[(String, f64)]) -> anyhow::Result<()> {
+    let names = model.state_names();
+    for (name, v) in start {
+        let Some(i) = names.iter().position(|n| n == name) else {
+            bail!(
+                "--start {name}={v}: `{}` has no state `{name}`; its states: {}",
+                model.name(),
+                names.join(", ")
+            );
+        };
+        x[i] = *v;
+    }
+    Ok(())
+}
+
 fn write_csv(path: &Path, force: bool, model: &dyn Model, tr: &Trajectory) -> anyhow::Result<()> {
     let mut f = files::create(path, force, "--out")?;
     let mut rows = || -> std::io::Result<()> {
@@ -357,6 +386,7 @@ fn print_summary(o: &mut impl Write, s: &SimSummary) -> std::io::Result<()> {
     } else {
         let x: Vec<String> = s.final_state.iter().map(|v| format!("{v:.6e}")).collect();
         writeln!(o, "final state: {}", x.join(", "))?;
+        kinematic::print(o, s)?;
     }
     writeln!(
         o,

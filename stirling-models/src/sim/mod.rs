@@ -52,6 +52,10 @@ pub mod monodromy;
 pub mod physical;
 /// A sparse LU that keeps its pivots between factorizations (KLU's refactorization).
 pub mod refactor_lu;
+/// A kinematic engine as it runs: speed, indicated work, the gas's cycle means.
+pub mod running;
+/// Schmidt's isothermal analysis of a kinematic engine on its own volumes.
+pub mod schmidt;
 /// Forward sensitivities by the staggered corrector (diffsol's sensitivity BDF).
 pub mod sens;
 /// Limit cycles by single shooting.
@@ -329,6 +333,15 @@ pub struct SimSummary {
     /// How the limit cycle was refined: `dense`, `krylov` or `settled`.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub shooting: Option<ShootingRoute>,
+    /// A kinematic engine's speed and indicated power over its last whole revolutions.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub running: Option<running::Running>,
+    /// Schmidt's analysis at the run's cycle-mean gas temperatures and mass.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub schmidt: Option<schmidt::Schmidt>,
+    /// Why a kinematic engine's run has no running figures (it did not turn), or no Schmidt.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub running_note: Option<String>,
     pub steps: usize,
     pub rhs_calls: usize,
     pub jacobian_calls: usize,
