@@ -373,6 +373,19 @@ pub fn identify_stages<'a>(
 ) -> Result<(Identification, Vec<FittedStage<'a>>), FitError> {
     let clock = Instant::now();
     super::supported::check_sensors(model)?;
+    // a kinematic record that logs the volume instead of the angle: the angle read back
+    // through the model's volume
+    let from_volume = super::kinematic::volume::angle_from_volume(model, p0, data)?;
+    let with_angle;
+    let data = match &from_volume {
+        Some(va) => {
+            let mut d = data.clone();
+            d.others.push((va.angle.clone(), va.theta.clone()));
+            with_angle = d;
+            &with_angle
+        }
+        None => data,
+    };
     let angle = super::kinematic::measured_angle(model, data)?;
     // a flywheel's angle counter unwrapped (by `measured_angle`) before the record's
     // outliers are looked for
@@ -399,7 +412,11 @@ pub fn identify_stages<'a>(
     check_bounds(model, p0, &free, &opts.bounds)?;
     if let Some(angle) = &angle {
         let parts = (&layout, &rec);
-        return super::kinematic::identify(model, p0, parts, angle, &free, opts);
+        let mut id = super::kinematic::identify(model, p0, parts, angle, &free, opts)?;
+        if let Some(va) = &from_volume {
+            id.0.notes.push(va.note());
+        }
+        return Ok(id);
     }
     let (mech, gas_free) = classify(model, p0, &free)?;
     let run = Run {

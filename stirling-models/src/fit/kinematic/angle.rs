@@ -65,7 +65,7 @@ pub fn measured_angle(model: &dyn Model, data: &Measured) -> Result<Option<Angle
     }
     let Some(raw) = data.channel(&name) else {
         let what = format!(
-            "the flywheel's angle `{name}` (rad, or `{name} [deg]`) that drives its cranks"
+            "the flywheel's angle `{name}` (rad, or `{name} [deg]`) that drives its cranks, or the working gas's volume (`dV [cm^3]` from mid-stroke, or `V`) to read it from"
         );
         return Err(missing(&name, &what));
     };

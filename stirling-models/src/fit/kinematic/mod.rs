@@ -24,6 +24,8 @@ pub mod angle;
 pub mod stage;
 /// The gas's starting state, fitted before the parameters.
 pub mod start;
+/// The angle read from a record's volume (`dV [cm^3]`) through the model's volume.
+pub mod volume;
 
 pub use angle::{measured_angle, unwrap_angle, Angle};
 
