@@ -136,6 +136,7 @@ fn a_volume_in_the_wrong_unit_is_refused_by_name() {
     let e = angle_from_volume(m.as_ref(), &m.default_params(), &by_volume).unwrap_err();
     assert!(matches!(e, FitError::KinematicColumn { .. }), "{e:?}");
     let msg = e.to_string();
+    eprintln!("{msg}");
     assert!(
         msg.contains("`dV`") && msg.contains("cm^3 a revolution"),
         "{msg}"
