@@ -260,6 +260,16 @@ pub(crate) fn function(
     let mut stores: Vec<(u32, u32)> = (0..tape.outputs.len() as u32)
         .map(|k| (tape.outputs[k as usize], k))
         .collect();
+    let spread = spread(tape, rep);
+    if !spread.is_empty() {
+        let mut moved = std::collections::HashSet::new();
+        for &(_, o, step) in &spread {
+            for i in 0..rep.count as u32 {
+                moved.insert(o + i * step);
+            }
+        }
+        stores.retain(|&(_, k)| !moved.contains(&k));
+    }
     stores.sort_unstable();
     let mut e = Emit {
         b,
@@ -344,7 +354,46 @@ pub(crate) fn live_out(tape: &Tape, rep: &Repeat) -> Vec<u32> {
 /// two buffers of the carried values (this iteration's and the next one's, swapped per
 /// iteration), and the last iteration's values the code after the loop reads.
 pub(crate) fn scratch_len(tape: &Tape, rep: &Repeat) -> usize {
-    before(rep).len() + 2 * carried(rep).len() + live_out(tape, rep).len()
+    before(rep).len() + 2 * carried(rep).len() + live_out(tape, rep).len() + spread(tape, rep).len()
+}
+
+/// The outputs of a register computed before the loop that one per iteration stores:
+/// `(register, output, step)`, the register's value is output `output + i * step` for every
+/// iteration `i` (each run of `rep.count` outputs of one register evenly spaced, in the same
+/// buffer). Stored by the straight part before the loop (e.g. a Jacobian entry every section
+/// has, the same number in each), they were a pass over the output buffer of its own, and at
+/// n = 1000 the buffer (72 KB) no longer fits the level-1 cache between that pass and the
+/// loop's; stored in the loop, each goes to the cache line the iteration writes anyway.
+pub(crate) fn spread(tape: &Tape, rep: &Repeat) -> Vec<(u32, u32, u32)> {
+    let head = tape.head() as u32;
+    let mut by_reg: HashMap<u32, Vec<u32>> = HashMap::new();
+    for (k, &r) in tape.outputs.iter().enumerate() {
+        if (r as usize) < rep.start {
+            by_reg.entry(r).or_default().push(k as u32);
+        }
+    }
+    let n = rep.count;
+    let mut v = Vec::new();
+    for (r, mut outs) in by_reg {
+        if n < 2 || outs.len() < n {
+            continue;
+        }
+        outs.sort_unstable();
+        let mut i = 0;
+        while i + n <= outs.len() {
+            let w = &outs[i..i + n];
+            let step = w[1] - w[0];
+            let even = step > 0 && w.windows(2).all(|p| p[1] - p[0] == step);
+            if even && (w[n - 1] < head || w[0] >= head) {
+                v.push((r, w[0], step));
+                i += n;
+            } else {
+                i += 1;
+            }
+        }
+    }
+    v.sort_unstable();
+    v
 }
 
 /// Where the code after the loop finds a value of the last iteration.
@@ -406,6 +455,18 @@ fn body(e: &mut Emit, vals: &[Option<Value>]) -> Result<HashMap<usize, Exit>, Ji
         let v = vals[r as usize]
             .ok_or_else(|| JitError::Codegen(format!("loop reads register {r} unset")))?;
         e.b.ins().store(flags(), v, buf_a, offset(c as u32));
+    }
+    // the values before the loop that each iteration stores (`spread`): to the scratch
+    // array after the last iteration's values (a number: loaded from the table in the loop)
+    let spread = spread(e.tape, rep);
+    let spread_base = out_base + k;
+    for (j, &(r, ..)) in spread.iter().enumerate() {
+        if !leaf(&e.tape.ops[r as usize]) {
+            let v = vals[r as usize]
+                .ok_or_else(|| JitError::Codegen(format!("loop stores register {r} unset")))?;
+            e.b.ins()
+                .store(flags(), v, e.args.scratch, offset(spread_base + j as u32));
+        }
     }
     e.b.ins().jump(
         lp,
@@ -482,6 +543,18 @@ fn body(e: &mut Emit, vals: &[Option<Value>]) -> Result<HashMap<usize, Exit>, Ji
             e.store(val, out, Some((h, tl)));
             s += 1;
         }
+    }
+    for (j, &(r, out, step)) in spread.iter().enumerate() {
+        let op = e.tape.ops[r as usize];
+        let v = if leaf(&op) {
+            e.leaf(op)
+        } else {
+            e.load(e.args.scratch, spread_base + j as u32)
+        };
+        let (h, tl) = (e.args.ptrs[HEAD], e.args.ptrs[TAIL]);
+        let h = m.at(e, h, HEAD, step as i64);
+        let tl = m.at(e, tl, TAIL, step as i64);
+        e.store(v, out, Some((h, tl)));
     }
     let next = e.b.ins().iadd_imm_s(i, 1);
     let more =
