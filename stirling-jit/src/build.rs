@@ -24,6 +24,10 @@ use crate::{shims, JitError};
 pub(crate) struct Imports {
     pub funcs: Vec<(Func, FuncRef)>,
     pub powf: Option<FuncRef>,
+    /// Whether `tanh`'s unsaturated case calls the trampoline [`TANH_KEEP`] (the looped
+    /// code) rather than the shim itself (the unrolled code, where it measured faster at
+    /// n = 2: with every register kept the allocator's other spills there cost more).
+    pub tanh_keep: bool,
 }
 
 /// How a tape is cut into functions (Cranelift's compile time grows faster than linearly
@@ -128,6 +132,7 @@ pub(crate) fn function(
     let mut imports = Imports {
         funcs: Vec::new(),
         powf: None,
+        tanh_keep: false,
     };
     declare_imports(module, func, &tape.ops[range.clone()], &mut imports)?;
     let config = module.target_config();
@@ -310,7 +315,9 @@ pub(crate) fn declare_imports(
     for op in ops {
         match *op {
             Op::Func(f, _) if inline(f) => {}
-            Op::Func(Func::Tanh, _) if !imports.funcs.iter().any(|&(g, _)| g == Func::Tanh) => {
+            Op::Func(Func::Tanh, _)
+                if imports.tanh_keep && !imports.funcs.iter().any(|&(g, _)| g == Func::Tanh) =>
+            {
                 let id =
                     module.declare_function(TANH_KEEP, Linkage::Local, &keep_signature(module))?;
                 let r = module.declare_func_in_func(id, func);
@@ -395,7 +402,7 @@ fn func_value(
         Func::Abs => b.ins().fabs(a),
         Func::Sqrt => b.ins().sqrt(a),
         Func::Tanh => match imports.funcs.iter().find(|&&(g, _)| g == f) {
-            Some(&(_, r)) => tanh(b, r, a),
+            Some(&(_, r)) => tanh(b, r, a, imports.tanh_keep),
             None => return Err(missing()),
         },
         Func::Sign => {
@@ -420,7 +427,7 @@ fn func_value(
 /// else the shim is called in a cold block. A call makes the code spill every live `xmm`
 /// register around it (all caller-saved), so calling on every `tanh` cost the JIT a spill
 /// of everything at every link of every section.
-fn tanh(b: &mut FunctionBuilder, shim: FuncRef, a: Value) -> Value {
+fn tanh(b: &mut FunctionBuilder, shim: FuncRef, a: Value, keep: bool) -> Value {
     let abs = b.ins().fabs(a);
     let limit = b.ins().f64const(22.0);
     let saturated = b.ins().fcmp(FloatCC::GreaterThanOrEqual, abs, limit);
@@ -435,6 +442,13 @@ fn tanh(b: &mut FunctionBuilder, shim: FuncRef, a: Value) -> Value {
     b.ins().jump(join, &[BlockArg::Value(v)]);
     b.switch_to_block(slow);
     b.set_cold_block(slow);
+    if !keep {
+        let v = call(b, shim, &[a]);
+        b.ins().jump(join, &[BlockArg::Value(v)]);
+        b.seal_block(join);
+        b.switch_to_block(join);
+        return b.block_params(join)[0];
+    }
     // through the trampoline that keeps every register (`define_tanh_keep`), its result in
     // a stack slot: a call of the shim itself clobbers every `xmm` register, so every value
     // live across a `tanh` was spilled (on the hot path too) and reloaded after it

@@ -246,6 +246,7 @@ pub(crate) fn function(
     let mut imports = Imports {
         funcs: Vec::new(),
         powf: None,
+        tanh_keep: true,
     };
     declare_imports(module, func, &tape.ops, &mut imports)?;
     let config = module.target_config();

@@ -135,9 +135,6 @@ impl JitTape {
         let mut module = module()?;
         let ptr = module.target_config().pointer_type();
         let mut layout = build::Layout::new(tape, chunk);
-        if uses_tanh(tape) {
-            build::define_tanh_keep(&mut module)?;
-        }
         let mut ids = Vec::with_capacity(layout.chunks.len());
         let mut ctx = module.make_context();
         let mut bytes = 0;
