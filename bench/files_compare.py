@@ -14,7 +14,9 @@ fastest, so every ratio is measured in the same run on the same machine load.
 Prints one table; writes `files_results.json` next to this file.
 
 Usage: python files_compare.py --speed PATH [--ns 2,10,100,1000] [--casadi-max-n 100]
-       [--rounds 3]
+       [--rounds 3] [--before PATH]
+(`--before`: another build of files_speed, e.g. the branch point's, timed in the same rounds,
+so that a change is measured against its base in one run under one load.)
 """
 import argparse
 import json
@@ -57,7 +59,30 @@ def check(ours, cas, n):
     return err
 
 
-def casadi_row(path, n, rounds):
+def before_row(before, n, rounds):
+    """The same row of another build of `files_speed` (`--before`), its fastest of `rounds`."""
+    if not before:
+        return None
+    row = speed(before, n)[1]
+    for _ in range(rounds - 1):
+        keep_fastest(row, speed(before, n)[1])
+    return row
+
+
+def with_before(best, old):
+    """`best` with the other build's times and ratios (`before_*`)."""
+    if old is None:
+        return best
+    for k in ("macro_ns", "jit_ns", "jit_folded_ns"):
+        best["before_" + k] = old[k]
+    best["before_jit_over_macro"] = old["jit_ns"] / old["macro_ns"]
+    lit = best.get("casadi_literal_ns")
+    if lit:
+        best["before_literal_over_folded"] = lit / old["jit_folded_ns"]
+    return best
+
+
+def casadi_row(path, n, rounds, before=None):
     load, first = speed(path, n)
     topo = Topology(n, first["params"])
     literal = CasadiModel(topo, K=(16, 32))
@@ -69,9 +94,16 @@ def casadi_row(path, n, rounds):
     assert np.allclose(f_par, literal.rhs(np.array(x)), rtol=1e-12, atol=0), "p-input C differs"
     best = dict(first)
     lit, par = float("inf"), float("inf")
+    old = None
     for r in range(rounds):
         if r > 0:
             keep_fastest(best, speed(path, n)[1])
+        if before:
+            row = speed(before, n)[1]
+            if old is None:
+                old = row
+            else:
+                keep_fastest(old, row)
         lit = min(lit, literal._c_kernel_times(np.array(x))["rhs_jac"] * 1e9)
         par = min(par, time_c(lib, x, pv)["rhs_jac"] * 1e9)
     best.pop("folded_at_x", None)
@@ -79,7 +111,7 @@ def casadi_row(path, n, rounds):
                  "literal_over_folded": lit / best["jit_folded_ns"],
                  "params_over_folded": par / best["jit_folded_ns"],
                  "params_over_jit": par / best["jit_ns"]})
-    return load, best
+    return load, with_before(best, old)
 
 
 def main():
@@ -88,15 +120,28 @@ def main():
     ap.add_argument("--ns", default="2,10,100,1000")
     ap.add_argument("--casadi-max-n", type=int, default=100)
     ap.add_argument("--rounds", type=int, default=3)
+    ap.add_argument("--before", help="another build of files_speed (e.g. before a change), "
+                    "timed in the same rounds: its JIT / macro and literal / folded printed too")
     a = ap.parse_args()
     rows, loads = [], []
     for n in [int(s) for s in a.ns.split(",")]:
         print(f"--- files, n = {n}", file=sys.stderr, flush=True)
         if n <= a.casadi_max_n:
-            load, row = casadi_row(a.speed, n, a.rounds)
+            load, row = casadi_row(a.speed, n, a.rounds, a.before)
         else:
             load, row = speed(a.speed, n)
+            old = None
+            for r in range(a.rounds):
+                if r > 0:
+                    keep_fastest(row, speed(a.speed, n)[1])
+                if a.before:
+                    o = speed(a.before, n)[1]
+                    if old is None:
+                        old = o
+                    else:
+                        keep_fastest(old, o)
             row.pop("folded_at_x", None)
+            row = with_before(row, old)
         loads.append(load)
         rows.append(row)
     with open(os.path.join(HERE, "files_results.json"), "w") as fh:
@@ -121,6 +166,16 @@ def print_table(loads, rows):
                f"  {r['params_over_folded']:>10.2f}x") if lit else f"{'-':>11}  {'-':>11}"
         print(f"{r['n']:>6} {r['macro_ns']:>8.0f} {r['jit_ns']:>8.0f} {r['jit_over_macro']:>9.2f}x"
               f" {r['jit_compile_ms']:>9.1f} ms {r['jit_folded_ns']:>7.0f}  {cas}")
+    if any("before_jit_ns" in r for r in rows):
+        print("\nthe other build (--before), same rounds:")
+        print("     n    macro      JIT  JIT/macro  folded  lit/folded")
+        for r in rows:
+            if "before_jit_ns" not in r:
+                continue
+            lf = r.get("before_literal_over_folded")
+            lf = f"{lf:>9.2f}x" if lf else f"{'-':>10}"
+            print(f"{r['n']:>6} {r['before_macro_ns']:>8.0f} {r['before_jit_ns']:>8.0f}"
+                  f" {r['before_jit_over_macro']:>9.2f}x {r['before_jit_folded_ns']:>7.0f}  {lf}")
     print("\nbars: JIT/macro <= 1.3 at every n; CasADi literal / folded >= 1.5 at n <= 100")
 
 

@@ -7,7 +7,11 @@ use std::collections::HashMap;
 use std::ops::Range;
 
 use cranelift_codegen::ir::condcodes::FloatCC;
-use cranelift_codegen::ir::{types, AbiParam, BlockArg, FuncRef, InstBuilder, MemFlagsData, Value};
+use cranelift_codegen::ir::{
+    types, AbiParam, BlockArg, FuncRef, InstBuilder, MemFlagsData, Signature, StackSlotData,
+    StackSlotKind, Value,
+};
+use cranelift_codegen::isa::CallConv;
 use cranelift_frontend::{FunctionBuilder, FunctionBuilderContext};
 use cranelift_jit::JITModule;
 use cranelift_module::{Linkage, Module};
@@ -20,6 +24,10 @@ use crate::{shims, JitError};
 pub(crate) struct Imports {
     pub funcs: Vec<(Func, FuncRef)>,
     pub powf: Option<FuncRef>,
+    /// Whether `tanh`'s unsaturated case calls the trampoline [`TANH_KEEP`] (the looped
+    /// code) rather than the shim itself (the unrolled code, where it measured faster at
+    /// n = 2: with every register kept the allocator's other spills there cost more).
+    pub tanh_keep: bool,
 }
 
 /// How a tape is cut into functions (Cranelift's compile time grows faster than linearly
@@ -124,6 +132,7 @@ pub(crate) fn function(
     let mut imports = Imports {
         funcs: Vec::new(),
         powf: None,
+        tanh_keep: false,
     };
     declare_imports(module, func, &tape.ops[range.clone()], &mut imports)?;
     let config = module.target_config();
@@ -187,7 +196,13 @@ pub(crate) fn function(
             _ => {
                 let (args, count) = operands(&op);
                 let a = r(args[0]);
-                let c = if count == 2 { r(args[1]) } else { a };
+                let (a, c) = if count == 2 {
+                    let c = r(args[1]);
+                    let mem = |q: u32| leaf(&tape.ops[q as usize]);
+                    crate::looped::commuted(op, a, c, [mem(args[0]), mem(args[1])])
+                } else {
+                    (a, a)
+                };
                 arith(&mut b, &imports, &mut minus_zero, op, a, c)?
             }
         };
@@ -300,6 +315,14 @@ pub(crate) fn declare_imports(
     for op in ops {
         match *op {
             Op::Func(f, _) if inline(f) => {}
+            Op::Func(Func::Tanh, _)
+                if imports.tanh_keep && !imports.funcs.iter().any(|&(g, _)| g == Func::Tanh) =>
+            {
+                let id =
+                    module.declare_function(TANH_KEEP, Linkage::Local, &keep_signature(module))?;
+                let r = module.declare_func_in_func(id, func);
+                imports.funcs.push((Func::Tanh, r));
+            }
             Op::Func(f, _) if !imports.funcs.iter().any(|&(g, _)| g == f) => {
                 let id = module.declare_function(shims::name(f), Linkage::Import, &unary)?;
                 let r = module.declare_func_in_func(id, func);
@@ -312,6 +335,49 @@ pub(crate) fn declare_imports(
             _ => {}
         }
     }
+    Ok(())
+}
+
+/// The symbol of the trampoline to `tanh`'s shim that keeps every register
+/// ([`define_tanh_keep`]).
+pub(crate) const TANH_KEEP: &str = "stirling_tanh_keep";
+
+/// The signature of [`TANH_KEEP`]: `(a, out)`, `tanh(a)` stored to `*out`, every register
+/// kept (Cranelift's `preserve_all` convention, which has no return values).
+fn keep_signature(module: &JITModule) -> Signature {
+    let ptr = module.target_config().pointer_type();
+    let mut s = Signature::new(CallConv::PreserveAll);
+    s.params.push(AbiParam::new(types::F64));
+    s.params.push(AbiParam::new(ptr));
+    s
+}
+
+/// Define [`TANH_KEEP`] in `module`: it calls `tanh`'s shim (the C convention) and, being
+/// `preserve_all`, saves and restores every register that call may clobber, so that the
+/// code calling it (in a cold block) keeps its values in registers across the call.
+pub(crate) fn define_tanh_keep(module: &mut JITModule) -> Result<(), JitError> {
+    let sig = keep_signature(module);
+    let id = module.declare_function(TANH_KEEP, Linkage::Local, &sig)?;
+    let mut ctx = module.make_context();
+    ctx.func.signature = sig;
+    let mut unary = module.make_signature();
+    unary.params.push(AbiParam::new(types::F64));
+    unary.returns.push(AbiParam::new(types::F64));
+    let shim = module.declare_function(shims::name(Func::Tanh), Linkage::Import, &unary)?;
+    let shim = module.declare_func_in_func(shim, &mut ctx.func);
+    let mut fctx = FunctionBuilderContext::new();
+    let mut b = FunctionBuilder::new(&mut ctx.func, &mut fctx);
+    let block = b.create_block();
+    b.append_block_params_for_function_params(block);
+    b.switch_to_block(block);
+    b.seal_block(block);
+    let (a, out) = (b.block_params(block)[0], b.block_params(block)[1]);
+    let v = call(&mut b, shim, &[a]);
+    b.ins().store(MemFlagsData::trusted(), v, out, 0);
+    b.ins().return_(&[]);
+    b.finalize(module.target_config());
+    module.define_function(id, &mut ctx)?;
+    module.clear_context(&mut ctx);
     Ok(())
 }
 
@@ -336,7 +402,7 @@ fn func_value(
         Func::Abs => b.ins().fabs(a),
         Func::Sqrt => b.ins().sqrt(a),
         Func::Tanh => match imports.funcs.iter().find(|&&(g, _)| g == f) {
-            Some(&(_, r)) => tanh(b, r, a),
+            Some(&(_, r)) => tanh(b, r, a, imports.tanh_keep),
             None => return Err(missing()),
         },
         Func::Sign => {
@@ -361,7 +427,7 @@ fn func_value(
 /// else the shim is called in a cold block. A call makes the code spill every live `xmm`
 /// register around it (all caller-saved), so calling on every `tanh` cost the JIT a spill
 /// of everything at every link of every section.
-fn tanh(b: &mut FunctionBuilder, shim: FuncRef, a: Value) -> Value {
+fn tanh(b: &mut FunctionBuilder, shim: FuncRef, a: Value, keep: bool) -> Value {
     let abs = b.ins().fabs(a);
     let limit = b.ins().f64const(22.0);
     let saturated = b.ins().fcmp(FloatCC::GreaterThanOrEqual, abs, limit);
@@ -376,7 +442,22 @@ fn tanh(b: &mut FunctionBuilder, shim: FuncRef, a: Value) -> Value {
     b.ins().jump(join, &[BlockArg::Value(v)]);
     b.switch_to_block(slow);
     b.set_cold_block(slow);
-    let v = call(b, shim, &[a]);
+    if !keep {
+        let v = call(b, shim, &[a]);
+        b.ins().jump(join, &[BlockArg::Value(v)]);
+        b.seal_block(join);
+        b.switch_to_block(join);
+        return b.block_params(join)[0];
+    }
+    // through the trampoline that keeps every register (`define_tanh_keep`), its result in
+    // a stack slot: a call of the shim itself clobbers every `xmm` register, so every value
+    // live across a `tanh` was spilled (on the hot path too) and reloaded after it
+    let slot = b.create_sized_stack_slot(StackSlotData::new(StackSlotKind::ExplicitSlot, 8, 3));
+    // the functions' first parameter is a pointer (`x`)
+    let ptr = b.func.signature.params[0].value_type;
+    let at = b.ins().stack_addr(ptr, slot, 0);
+    b.ins().call(shim, &[a, at]);
+    let v = b.ins().stack_load(ptr, types::F64, slot, 0);
     b.ins().jump(join, &[BlockArg::Value(v)]);
     b.seal_block(join);
     b.switch_to_block(join);

@@ -134,7 +134,7 @@ impl Emit<'_, '_> {
         &mut self,
         range: std::ops::Range<usize>,
         vals: &mut [Option<Value>],
-        exit: &HashMap<usize, Value>,
+        exit: &HashMap<usize, Exit>,
     ) -> Result<(), JitError> {
         let mut s = self
             .stores
@@ -150,10 +150,13 @@ impl Emit<'_, '_> {
             } else {
                 let (a, count) = operands(&op);
                 let x = self.reg(a[0] as usize, vals, exit)?;
-                let y = if count == 2 {
-                    self.reg(a[1] as usize, vals, exit)?
+                let (x, y) = if count == 2 {
+                    let y = self.reg(a[1] as usize, vals, exit)?;
+                    let mem =
+                        |q: u32| leaf(&self.tape.ops[q as usize]) || vals[q as usize].is_none();
+                    commuted(op, x, y, [mem(a[0]), mem(a[1])])
                 } else {
-                    x
+                    (x, x)
                 };
                 arith(&mut self.b, &self.imports, &mut self.minus_zero, op, x, y)?
             };
@@ -174,15 +177,23 @@ impl Emit<'_, '_> {
         &mut self,
         q: usize,
         vals: &[Option<Value>],
-        exit: &HashMap<usize, Value>,
+        exit: &HashMap<usize, Exit>,
     ) -> Result<Value, JitError> {
         let op = self.tape.ops[q];
         if leaf(&op) {
             return Ok(self.leaf(op));
         }
-        vals[q]
-            .or_else(|| exit.get(&q).copied())
-            .ok_or_else(|| JitError::Codegen(format!("register {q} read before it is computed")))
+        if let Some(v) = vals[q] {
+            return Ok(v);
+        }
+        // the last iteration's values: loaded at each use, as the leaves are
+        match exit.get(&q) {
+            Some(&Exit::Slot(k)) => Ok(self.load(self.args.scratch, k)),
+            Some(&Exit::Carried(buf, c)) => Ok(self.load(buf, c)),
+            None => Err(JitError::Codegen(format!(
+                "register {q} read before it is computed"
+            ))),
+        }
     }
 }
 
@@ -235,6 +246,7 @@ pub(crate) fn function(
     let mut imports = Imports {
         funcs: Vec::new(),
         powf: None,
+        tanh_keep: true,
     };
     declare_imports(module, func, &tape.ops, &mut imports)?;
     let config = module.target_config();
@@ -249,6 +261,16 @@ pub(crate) fn function(
     let mut stores: Vec<(u32, u32)> = (0..tape.outputs.len() as u32)
         .map(|k| (tape.outputs[k as usize], k))
         .collect();
+    let spread = spread(tape, rep);
+    if !spread.is_empty() {
+        let mut moved = std::collections::HashSet::new();
+        for &(_, o, step) in &spread {
+            for i in 0..rep.count as u32 {
+                moved.insert(o + i * step);
+            }
+        }
+        stores.retain(|&(_, k)| !moved.contains(&k));
+    }
     stores.sort_unstable();
     let mut e = Emit {
         b,
@@ -312,7 +334,7 @@ pub(crate) fn before(rep: &Repeat) -> Vec<u32> {
 }
 
 /// The body instructions of the last iteration the code after the loop reads.
-fn live_out(tape: &Tape, rep: &Repeat) -> Vec<u32> {
+pub(crate) fn live_out(tape: &Tape, rep: &Repeat) -> Vec<u32> {
     let last = rep.end() - rep.len;
     let mut v: Vec<u32> = Vec::new();
     for op in &tape.ops[rep.end()..] {
@@ -329,18 +351,77 @@ fn live_out(tape: &Tape, rep: &Repeat) -> Vec<u32> {
     v
 }
 
-/// The loop; the registers of its last iteration that the code after it reads, by register.
-fn body(e: &mut Emit, vals: &[Option<Value>]) -> Result<HashMap<usize, Value>, JitError> {
+/// The length of the scratch array of the looped code: the values from before the loop,
+/// two buffers of the carried values (this iteration's and the next one's, swapped per
+/// iteration), and the last iteration's values the code after the loop reads.
+pub(crate) fn scratch_len(tape: &Tape, rep: &Repeat) -> usize {
+    before(rep).len() + 2 * carried(rep).len() + live_out(tape, rep).len() + spread(tape, rep).len()
+}
+
+/// The outputs of a register computed before the loop that one per iteration stores:
+/// `(register, output, step)`, the register's value is output `output + i * step` for every
+/// iteration `i` (each run of `rep.count` outputs of one register evenly spaced, in the same
+/// buffer). Stored by the straight part before the loop (e.g. a Jacobian entry every section
+/// has, the same number in each), they were a pass over the output buffer of its own, and at
+/// n = 1000 the buffer (72 KB) no longer fits the level-1 cache between that pass and the
+/// loop's; stored in the loop, each goes to the cache line the iteration writes anyway.
+pub(crate) fn spread(tape: &Tape, rep: &Repeat) -> Vec<(u32, u32, u32)> {
+    let head = tape.head() as u32;
+    let mut by_reg: HashMap<u32, Vec<u32>> = HashMap::new();
+    for (k, &r) in tape.outputs.iter().enumerate() {
+        if (r as usize) < rep.start {
+            by_reg.entry(r).or_default().push(k as u32);
+        }
+    }
+    let n = rep.count;
+    let mut v = Vec::new();
+    for (r, mut outs) in by_reg {
+        if n < 2 || outs.len() < n {
+            continue;
+        }
+        outs.sort_unstable();
+        let mut i = 0;
+        while i + n <= outs.len() {
+            let w = &outs[i..i + n];
+            let step = w[1] - w[0];
+            let even = step > 0 && w.windows(2).all(|p| p[1] - p[0] == step);
+            if even && (w[n - 1] < head || w[0] >= head) {
+                v.push((r, w[0], step));
+                i += n;
+            } else {
+                i += 1;
+            }
+        }
+    }
+    v.sort_unstable();
+    v
+}
+
+/// Where the code after the loop finds a value of the last iteration.
+#[derive(Clone, Copy)]
+pub(crate) enum Exit {
+    /// Slot `k` of the scratch array.
+    Slot(u32),
+    /// Slot `k` of the carried buffer the last iteration wrote (its address `Value`).
+    Carried(Value, u32),
+}
+
+/// The loop; where the code after it finds the registers of its last iteration that it
+/// reads, by register.
+fn body(e: &mut Emit, vals: &[Option<Value>]) -> Result<HashMap<usize, Exit>, JitError> {
     let rep = e.rep;
     let carried = carried(rep);
     let outs = live_out(e.tape, rep);
+    let ptr = e.b.func.dfg.value_type(e.args.scratch);
     let lp = e.b.create_block();
     let i = e.b.append_block_param(lp, types::I64);
+    // the carried values: read from `cur`, written to `nxt` as soon as they are computed
+    // (kept in a register to the end of the body for a later read of the previous one,
+    // they were spilled, stored and reloaded), the two swapped per iteration
+    let cur = e.b.append_block_param(lp, ptr);
+    let nxt = e.b.append_block_param(lp, ptr);
     let exit = e.b.create_block();
-    let exits: Vec<Value> = outs
-        .iter()
-        .map(|_| e.b.append_block_param(exit, types::F64))
-        .collect();
+    let last_buf = e.b.append_block_param(exit, ptr);
     // the values computed before the loop go to the scratch array, read where they are used
     // (a memory operand of their user): kept in registers across the loop they were
     // spilled, and reloaded before each use, an instruction more per use
@@ -352,27 +433,50 @@ fn body(e: &mut Emit, vals: &[Option<Value>]) -> Result<HashMap<usize, Value>, J
             .store(flags(), v, e.args.scratch, offset(k as u32));
     }
     let zero = e.b.ins().iconst(types::I64, 0);
-    // the values the next iteration reads go through the scratch array too, after the
-    // values from before the loop: stored as soon as no read of the previous one follows
-    // in the body, else at its end
-    let slot = |c: usize| (before.len() + c) as u32;
-    let mut last_read = vec![0usize; carried.len()];
-    for (t, st) in rep.body.iter().enumerate() {
-        if let Step::Op { args, .. } = st {
-            for a in args {
-                if let Arg::Prev { t: u, .. } = *a {
-                    let c = carried.iter().position(|&(w, _)| w == u).unwrap_or(0);
-                    last_read[c] = last_read[c].max(t);
-                }
-            }
+    let nc = carried.len() as u32;
+    let buf_a =
+        e.b.ins()
+            .iadd_imm_s(e.args.scratch, before.len() as i64 * 8);
+    let buf_b = e.b.ins().iadd_imm_s(buf_a, nc as i64 * 8);
+    // the last iteration's values the code after the loop reads (other than carried ones):
+    // stored as computed, read where used (as exit block parameters they were live, and
+    // spilled, to the end of the body)
+    let out_base = before.len() as u32 + 2 * nc;
+    let mut out_slot: HashMap<u32, Exit> = HashMap::new();
+    let mut k = 0;
+    for &t in &outs {
+        if let Some(c) = carried.iter().position(|&(w, _)| w == t) {
+            out_slot.insert(t, Exit::Carried(last_buf, c as u32));
+        } else {
+            out_slot.insert(t, Exit::Slot(out_base + k));
+            k += 1;
         }
     }
     for (c, &(_, r)) in carried.iter().enumerate() {
         let v = vals[r as usize]
             .ok_or_else(|| JitError::Codegen(format!("loop reads register {r} unset")))?;
-        e.b.ins().store(flags(), v, e.args.scratch, offset(slot(c)));
+        e.b.ins().store(flags(), v, buf_a, offset(c as u32));
     }
-    e.b.ins().jump(lp, &[BlockArg::Value(zero)]);
+    // the values before the loop that each iteration stores (`spread`): to the scratch
+    // array after the last iteration's values (a number: loaded from the table in the loop)
+    let spread = spread(e.tape, rep);
+    let spread_base = out_base + k;
+    for (j, &(r, ..)) in spread.iter().enumerate() {
+        if !leaf(&e.tape.ops[r as usize]) {
+            let v = vals[r as usize]
+                .ok_or_else(|| JitError::Codegen(format!("loop stores register {r} unset")))?;
+            e.b.ins()
+                .store(flags(), v, e.args.scratch, offset(spread_base + j as u32));
+        }
+    }
+    e.b.ins().jump(
+        lp,
+        &[
+            BlockArg::Value(zero),
+            BlockArg::Value(buf_a),
+            BlockArg::Value(buf_b),
+        ],
+    );
     e.b.switch_to_block(lp);
     let mut m = Moved {
         i,
@@ -382,9 +486,10 @@ fn body(e: &mut Emit, vals: &[Option<Value>]) -> Result<HashMap<usize, Value>, J
     let mut s = 0;
     for (t, step) in rep.body.iter().enumerate() {
         let stored = rep.stores.get(s).is_some_and(|&(u, ..)| u as usize == t);
+        let live = out_slot.contains_key(&(t as u32));
         let val = match *step {
             Step::Leaf(l) => {
-                if !stored {
+                if !stored && !live {
                     continue;
                 }
                 loop_leaf(e, &mut m, l)
@@ -392,10 +497,15 @@ fn body(e: &mut Emit, vals: &[Option<Value>]) -> Result<HashMap<usize, Value>, J
             Step::Op { op, args } => {
                 let (_, count) = operands(&op);
                 let mut v = [e.consts; 2];
+                let mut mem = [false; 2];
                 for k in 0..count {
                     v[k] = match args[k] {
-                        Arg::Leaf(l) => loop_leaf(e, &mut m, l),
+                        Arg::Leaf(l) => {
+                            mem[k] = true;
+                            loop_leaf(e, &mut m, l)
+                        }
                         Arg::Before(r) => {
+                            mem[k] = true;
                             let slot = before.binary_search(&r).unwrap_or(0);
                             e.load(e.args.scratch, slot as u32)
                         }
@@ -403,21 +513,26 @@ fn body(e: &mut Emit, vals: &[Option<Value>]) -> Result<HashMap<usize, Value>, J
                             JitError::Codegen(format!("body reads instruction {u} unset"))
                         })?,
                         Arg::Prev { t: u, .. } => {
+                            mem[k] = true;
                             let c = carried.iter().position(|&(w, _)| w == u).unwrap_or(0);
-                            e.load(e.args.scratch, slot(c))
+                            e.load(cur, c as u32)
                         }
                     };
                 }
-                let y = if count == 2 { v[1] } else { v[0] };
-                arith(&mut e.b, &e.imports, &mut e.minus_zero, op, v[0], y)?
+                let (x, y) = if count == 2 {
+                    commuted(op, v[0], v[1], mem)
+                } else {
+                    (v[0], v[0])
+                };
+                arith(&mut e.b, &e.imports, &mut e.minus_zero, op, x, y)?
             }
         };
         own[t] = Some(val);
         if let Some(c) = carried.iter().position(|&(w, _)| w as usize == t) {
-            if last_read[c] < t {
-                e.b.ins()
-                    .store(flags(), val, e.args.scratch, offset(slot(c)));
-            }
+            e.b.ins().store(flags(), val, nxt, offset(c as u32));
+        }
+        if let Some(&Exit::Slot(k)) = out_slot.get(&(t as u32)) {
+            e.b.ins().store(flags(), val, e.args.scratch, offset(k));
         }
         while let Some(&(u, out, step)) = rep.stores.get(s) {
             if u as usize != t {
@@ -430,33 +545,46 @@ fn body(e: &mut Emit, vals: &[Option<Value>]) -> Result<HashMap<usize, Value>, J
             s += 1;
         }
     }
-    let body_val = |t: u32| -> Result<Value, JitError> {
-        own[t as usize]
-            .ok_or_else(|| JitError::Codegen(format!("loop carries instruction {t} unset")))
-    };
+    for (j, &(r, out, step)) in spread.iter().enumerate() {
+        let op = e.tape.ops[r as usize];
+        let v = if leaf(&op) {
+            e.leaf(op)
+        } else {
+            e.load(e.args.scratch, spread_base + j as u32)
+        };
+        let (h, tl) = (e.args.ptrs[HEAD], e.args.ptrs[TAIL]);
+        let h = m.at(e, h, HEAD, step as i64);
+        let tl = m.at(e, tl, TAIL, step as i64);
+        e.store(v, out, Some((h, tl)));
+    }
     let next = e.b.ins().iadd_imm_s(i, 1);
     let more =
         e.b.ins()
             .icmp_imm_s(IntCC::UnsignedLessThan, next, rep.count as i64);
-    for (c, &(t, _)) in carried.iter().enumerate() {
-        if last_read[c] >= t as usize {
-            let v = body_val(t)?;
-            e.b.ins().store(flags(), v, e.args.scratch, offset(slot(c)));
-        }
-    }
-    let again = [BlockArg::Value(next)];
-    let leave = outs
-        .iter()
-        .map(|&t| body_val(t).map(BlockArg::Value))
-        .collect::<Result<Vec<_>, _>>()?;
-    e.b.ins().brif(more, lp, &again, exit, &leave);
+    let again = [
+        BlockArg::Value(next),
+        BlockArg::Value(nxt),
+        BlockArg::Value(cur),
+    ];
+    e.b.ins()
+        .brif(more, lp, &again, exit, &[BlockArg::Value(nxt)]);
     e.b.seal_block(lp);
     e.b.seal_block(exit);
     e.b.switch_to_block(exit);
     let last = rep.end() - rep.len;
-    Ok(outs
-        .iter()
-        .zip(exits)
-        .map(|(&t, v)| (last + t as usize, v))
+    Ok(out_slot
+        .into_iter()
+        .map(|(t, x)| (last + t as usize, x))
         .collect())
+}
+
+/// The operands of the binary `op` in the order to emit them: a commutative operation
+/// (`+`, `*`: the same bits either way) with its first operand read from memory and its
+/// second not takes them swapped, so that the load becomes the instruction's memory operand
+/// (x86 folds a load into the second operand only) rather than a load into a register.
+pub(crate) fn commuted(op: Op, a: Value, b: Value, mem: [bool; 2]) -> (Value, Value) {
+    match op {
+        Op::Add(..) | Op::Mul(..) if mem[0] && !mem[1] => (b, a),
+        _ => (a, b),
+    }
 }

@@ -101,13 +101,20 @@ impl JitTape {
         let mut module = module()?;
         let ptr = module.target_config().pointer_type();
         let numbers = looped::Numbers::new(tape, rep);
+        if uses_tanh(tape) {
+            build::define_tanh_keep(&mut module)?;
+        }
         let mut ctx = module.make_context();
         for _ in 0..6 {
             ctx.func.signature.params.push(AbiParam::new(ptr));
         }
         looped::function(&mut module, &mut ctx.func, tape, rep, &numbers)?;
         let id = module.declare_function("tape_loop", Linkage::Export, &ctx.func.signature)?;
+        ctx.set_disasm(disasm());
         module.define_function(id, &mut ctx)?;
+        if let Some(d) = ctx.compiled_code().and_then(|c| c.vcode.clone()) {
+            eprintln!("{d}");
+        }
         let bytes = code_bytes(&ctx);
         module.clear_context(&mut ctx);
         module.finalize_definitions()?;
@@ -116,7 +123,7 @@ impl JitTape {
             _module: module,
             code,
             needs: needs(tape),
-            scratch: looped::before(rep).len() + looped::carried(rep).len(),
+            scratch: looped::scratch_len(tape, rep),
             _consts: numbers.values,
             looped: true,
             bytes,
@@ -138,7 +145,11 @@ impl JitTape {
             build::function(&mut module, &mut ctx.func, tape, &layout, c)?;
             let name = format!("tape{c}");
             let id = module.declare_function(&name, Linkage::Export, &ctx.func.signature)?;
+            ctx.set_disasm(disasm());
             module.define_function(id, &mut ctx)?;
+            if let Some(d) = ctx.compiled_code().and_then(|c| c.vcode.clone()) {
+                eprintln!("{d}");
+            }
             bytes += code_bytes(&ctx);
             module.clear_context(&mut ctx);
             ids.push(id);
@@ -263,6 +274,19 @@ fn worth_looping(tape: &Tape, rep: &Repeat) -> bool {
         && rep.start <= LOOP_PART_OPS
         && rep.len <= LOOP_PART_OPS
         && tape.ops.len() - rep.end() <= LOOP_PART_OPS
+}
+
+/// Whether `tape` calls `tanh` (its code then calls the trampoline `build::TANH_KEEP`).
+fn uses_tanh(tape: &Tape) -> bool {
+    tape.ops
+        .iter()
+        .any(|op| matches!(op, Op::Func(stirling_dsl::expr::Func::Tanh, _)))
+}
+
+/// Whether to print the machine code of every compiled function to stderr (the environment
+/// variable `STIRLING_JIT_DISASM` set: a profiling aid, e.g. to count a loop body's spills).
+fn disasm() -> bool {
+    std::env::var_os("STIRLING_JIT_DISASM").is_some()
 }
 
 /// The JIT module for this machine, the shims known by name.

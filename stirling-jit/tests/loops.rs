@@ -9,7 +9,8 @@ use stirling_jit::{JitTape, LOOP_MIN};
 /// A chain of `n` sections, as a function of the rows lays them out: a scalar part (the
 /// parameters' terms), then per section `j` its state's terms, a value carried from the
 /// previous section (a link), the section's index as a number, a `tanh` and an output per
-/// row in each of the two buffers (a right-hand side and a Jacobian's values). The first
+/// row in each of the two buffers (a right-hand side and a Jacobian's values), and two outputs
+/// per section of values computed before the sections. The first
 /// and last sections differ (a number folded in, as the variants of a row do).
 fn chain(n: usize) -> Tape {
     let mut ops = vec![Op::P(0), Op::P(1), Op::K(0.5)];
@@ -43,6 +44,10 @@ fn chain(n: usize) -> Tape {
         outputs.push(q);
         tail.push(a);
         tail.push(f);
+        // a value from before the sections and a number, an output of every section (as a
+        // Jacobian entry the same in each): the loop stores them (`looped::spread`)
+        tail.push(3);
+        tail.push(2);
         carried = f;
     }
     sections.push(ops.len() as u32);

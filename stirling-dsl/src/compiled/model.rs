@@ -108,6 +108,20 @@ fn run(f: &Function, p: &[f64], x: &[f64], v: &[f64], mut each: impl FnMut((usiz
     });
 }
 
+/// Whether `a` and `b` hold the same numbers bit for bit (the folded functions were computed
+/// from exactly these bits). Without a branch per element, so that the check on every call of
+/// a folded model costs a few instructions rather than one compare and branch per parameter
+/// (element-wise `==` on the 28 parameters of `nsection` was about 5 ns of its 55 ns RHS +
+/// Jacobian at n = 2).
+#[inline]
+fn same_bits(a: &[f64], b: &[f64]) -> bool {
+    a.len() == b.len()
+        && a.iter()
+            .zip(b)
+            .fold(0u64, |d, (x, y)| d | (x.to_bits() ^ y.to_bits()))
+            == 0
+}
+
 /// Run `f`'s native code straight into the caller's slices: its outputs before the tape's
 /// split (rows `0..s`, [`Function::split_rows`]) to `head`, the others in order to `tail`.
 /// `false` (nothing written) without native code, without a split or where a slice is too
@@ -250,9 +264,10 @@ impl CompiledModel {
 
     /// This model with the parameters `p` folded in: every parameter expression of every
     /// function computed once, at `p` (what a simulation or a sweep point can use; a fit
-    /// keeps the parameters as inputs). Called with `p` it gives bit for bit what this
-    /// model gives; called with any other vector it computes with the parameters as inputs,
-    /// so a changed parameter is never silently ignored.
+    /// keeps the parameters as inputs). Called with `p` (the same bits) it gives bit for bit
+    /// what this model gives; called with any other vector (even `-0.0` for `0.0`) it
+    /// computes with the parameters as inputs, so a changed parameter is never silently
+    /// ignored.
     pub fn folded(&self, p: &[f64]) -> CompiledModel {
         let jit = self.jit;
         let folded = self
@@ -316,7 +331,7 @@ impl CompiledModel {
     #[inline]
     fn fns(&self, p: &[f64]) -> &Functions {
         match &self.folded {
-            Some((q, f)) if q.as_slice() == p => f,
+            Some((q, f)) if same_bits(q, p) => f,
             _ => &self.f,
         }
     }
