@@ -1,18 +1,18 @@
 //! The diagnosis of a kinematic engine (a flywheel driving cranks, docs/physics.md section
 //! 12; method and measurements: docs/diagnosis.md, "Kinematic engines"). The record gives the
 //! pressure `p` and the flywheel's angle; the calibration is the kinematic fit
-//! ([`crate::fit::kinematic`]: the gas driven by the measured angle, the free gas parameters,
-//! the pressure offset and the gas's initial masses fitted), and every later step is the
-//! free-piston diagnosis's on that one driven stage: the score of each effect the engine
-//! names at its null, the joint fit of the significant ones with the nominal gas parameters
-//! (still driven by the measured angle), the held-out BIC and closure, the verdict, the
-//! explanation step by step.
+//! ([`crate::fit::kinematic`]: the gas driven by the measured angle, the film coefficients,
+//! the pressure offset and the gas's initial masses fitted). The free-piston diagnosis runs
+//! on that one driven stage for the gap before, where, and the sensor effects (score, joint
+//! fit); each model effect the engine names is fitted by the kinematic fit itself with its
+//! strength freed (`kinematic_refit.rs`), and all are judged on the held-out block by the
+//! free-piston verdict's rule.
 //!
 //! What does not carry over: the second pass with stage 1 restarted (the end stops of a
-//! free body; a flywheel has no stops, and no stage 1 runs), and the simulated gap (the free
-//! run's cycles are counted on the displacer's position `x`, which a kinematic record does
-//! not carry; its note says so). The flywheel's friction and load act on no driven row, so
-//! no effect on the flywheel can be tested (see [`check_candidates`]).
+//! free body; no stage 1 runs), the simulated gap (its cycles are counted on the displacer's
+//! position `x`, which a kinematic record does not carry; its note says so), steps after the
+//! first. The flywheel's friction and load act on no driven row, so no effect on the flywheel
+//! can be tested.
 
 use std::collections::HashMap;
 use std::sync::{Mutex, OnceLock};
@@ -117,7 +117,7 @@ pub(super) fn diagnose(
     d.verdict = verdict(&ranking, named.as_deref(), level, gap, held);
     if let (Some(name), Some(h)) = (&named, held) {
         let row = ranking.iter().find(|r| &r.effect == name).expect("named");
-        d.steps = vec![step(row, h, data, &ranking, &nominal)];
+        d.steps = vec![step(row, h, data, &ranking)];
         d.remainder = Vec::new();
     } else if named.is_none() {
         d.steps.clear();
@@ -254,20 +254,13 @@ fn verdict(
 }
 
 /// The one step of a named model effect.
-fn step(
-    row: &RankEntry,
-    held: &HeldOut,
-    data: &Measured,
-    ranking: &[RankEntry],
-    nominal: &HeldOut,
-) -> Step {
+fn step(row: &RankEntry, held: &HeldOut, data: &Measured, ranking: &[RankEntry]) -> Step {
     let noise = data.p.as_deref().map_or(f64::NAN, noise_sigma);
     let closure = Interval {
         value: row.closure_fraction.unwrap_or(f64::NAN),
         ci_low: row.ci_low.unwrap_or(f64::NAN),
         ci_high: row.ci_high.unwrap_or(f64::NAN),
     };
-    let _ = nominal;
     Step {
         step: 1,
         effects: vec![row.effect.clone()],

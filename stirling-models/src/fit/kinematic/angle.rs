@@ -164,7 +164,10 @@ pub fn check_rate_of(angle: &Angle, data: &Measured) -> Result<(), FitError> {
         return Ok(());
     }
     let per_rev = 1.0 / (turns * dt);
-    if per_rev >= MIN_SAMPLES_PER_CYCLE {
+    // under two samples a revolution (steps over pi) the angle cannot be a sampled rotation:
+    // its unit is wrong (degrees read as rad turn 57 times too fast), which the speed check
+    // against the pressure's cycle names
+    if per_rev >= MIN_SAMPLES_PER_CYCLE || per_rev < 2.0 {
         return Ok(());
     }
     Err(FitError::KinematicRate {
