@@ -102,7 +102,7 @@ pub(super) fn diagnose(
     }
     d.fits += 1 + refits.len();
     let mut ranking: Vec<RankEntry> = refits.iter().map(|r| r.entry.clone()).collect();
-    ranking.extend(d.ranking.drain(..));
+    ranking.append(&mut d.ranking);
     let level = opts.alpha / cands.len().max(1) as f64;
     rank(&mut ranking, level);
     let named = ranking
@@ -360,7 +360,7 @@ fn kinematic_pool(model: &dyn Model, pool: &[&'static EffectInfo]) -> Vec<&'stat
                     });
                     EffectParam {
                         typical: own.map_or(q.typical, |i| i.default),
-                        ..q.clone()
+                        ..*q
                     }
                 })
                 .collect();
@@ -373,7 +373,7 @@ fn kinematic_pool(model: &dyn Model, pool: &[&'static EffectInfo]) -> Vec<&'stat
             }
             let info = EffectInfo {
                 params: Box::leak(params.into_boxed_slice()),
-                ..e.clone()
+                ..*e
             };
             &*Box::leak(Box::new(info))
         })

@@ -167,7 +167,7 @@ pub fn check_rate_of(angle: &Angle, data: &Measured) -> Result<(), FitError> {
     // under two samples a revolution (steps over pi) the angle cannot be a sampled rotation:
     // its unit is wrong (degrees read as rad turn 57 times too fast), which the speed check
     // against the pressure's cycle names
-    if per_rev >= MIN_SAMPLES_PER_CYCLE || per_rev < 2.0 {
+    if !(2.0..MIN_SAMPLES_PER_CYCLE).contains(&per_rev) {
         return Ok(());
     }
     Err(FitError::KinematicRate {
