@@ -34,6 +34,10 @@ pub struct DiagnoseArgs {
     /// model declares; the calibration stays inside them
     #[arg(long, value_name = "FILE")]
     pub bounds: Option<PathBuf>,
+    /// Nominal parameters the calibration frees, comma-separated (default: those the model
+    /// declares `free`; on a kinematic engine, its film coefficients and flow resistances)
+    #[arg(long, value_delimiter = ',')]
+    pub free: Option<Vec<String>>,
     /// Training block a:b in seconds (default: first 60 %)
     #[arg(long, allow_hyphen_values = true)]
     pub train: Option<String>,
@@ -161,6 +165,10 @@ pub fn run(a: &DiagnoseArgs) -> anyhow::Result<()> {
     let opts = DiagnoseOptions {
         fit: stirling_models::fit::FitOptions {
             bounds,
+            free: a
+                .free
+                .as_ref()
+                .map(|v| v.iter().map(|s| s.trim().to_string()).collect()),
             ..Default::default()
         },
         effects: effects_arg(&a.effects),

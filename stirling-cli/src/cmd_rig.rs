@@ -64,10 +64,11 @@ pub struct RigArgs {
     /// Noise seed
     #[arg(long, default_value_t = 1, allow_negative_numbers = true, value_parser = ranges::seed)]
     pub seed: u64,
-    /// Channels to write besides t: the seed's sensors p (cold side), x, y by default; add
+    /// Channels to write besides t: the seed's sensors p (cold side), x, y by default (on a
+    /// kinematic engine, its state channels: p and the flywheel's angle, e.g. p,theta); add
     /// p_hot (hot-side pressure, multi-CV models) for a richer rig than the seed's engine had
-    #[arg(long, value_delimiter = ',', default_value = "p,x,y")]
-    pub channels: Vec<String>,
+    #[arg(long, value_delimiter = ',')]
+    pub channels: Option<Vec<String>>,
     /// Output CSV (the truth goes to FILE.truth.json)
     #[arg(long)]
     pub out: PathBuf,
@@ -81,7 +82,19 @@ pub struct RigArgs {
 
 pub fn run(a: &RigArgs) -> anyhow::Result<()> {
     let name = |s: &String| s.split('=').next().unwrap_or("").trim().to_string();
-    common::unique("--channels", &a.channels, |c| c.trim().to_string())?;
+    let mut noise = a.noise.clone();
+    let channels = match &a.channels {
+        Some(c) => c.clone(),
+        None => {
+            let (channels, angle) = default_channels(&a.model, a.with.n);
+            // the angle's noise in rad, when not given: an encoder's 0.1 degree
+            if let Some(angle) = angle.filter(|n| !noise.iter().any(|(c, _)| c == n)) {
+                noise.push((angle, ANGLE_NOISE));
+            }
+            channels
+        }
+    };
+    common::unique("--channels", &channels, |c| c.trim().to_string())?;
     common::unique("--effect", &a.effect, name)?;
     common::unique("--noise", &a.noise, |(c, _)| c.clone())?;
     common::unique("--start", &a.start, |(c, _)| c.clone())?;
@@ -96,14 +109,14 @@ pub fn run(a: &RigArgs) -> anyhow::Result<()> {
         rate: a.rate,
         noise_p: a.noise_p,
         noise_x: a.noise_x,
-        noise: a.noise.clone(),
+        noise,
         offset_p: a.offset_p,
         offset_x: a.offset_x,
         offset_y: a.offset_y,
         x0: a.x0,
         start: a.start.clone(),
         seed: a.seed,
-        channels: a.channels.clone(),
+        channels,
         truth: a.truth.clone(),
     };
     // refuse before the (long) simulation
@@ -151,4 +164,28 @@ pub fn run(a: &RigArgs) -> anyhow::Result<()> {
         )?;
     }
     Ok(())
+}
+
+/// The noise of a kinematic engine's angle channel when `--channels` and `--noise` leave it
+/// to the rig (rad): an encoder's resolution, 0.1 degree.
+const ANGLE_NOISE: f64 = 0.002;
+
+/// The channels a rig record of `model` carries when `--channels` is not given: the seed's
+/// `p, x, y`, or on a kinematic engine (a flywheel drives its cranks, so it has no free body
+/// `x`, `y`) the pressure and the flywheel's angle, what its fit and diagnosis read (the
+/// angle's name returned too).
+fn default_channels(model: &str, n: Option<usize>) -> (Vec<String>, Option<String>) {
+    let seed = || (["p", "x", "y"].map(String::from).to_vec(), None);
+    // a model that does not build is refused by the rig itself, with its own message
+    let Ok(m) = stirling_models::effects::augmented(model, n, stirling_dsl::Closure::Full) else {
+        return seed();
+    };
+    let wheels = stirling_models::layout::StateLayout::flywheels(m.as_ref());
+    match wheels.first() {
+        Some(&(angle, _)) => {
+            let name = m.state_names()[angle].clone();
+            (vec!["p".into(), name.clone()], Some(name))
+        }
+        None => seed(),
+    }
 }

@@ -14,7 +14,7 @@ pub(super) fn candidates(
     // a model outside the library (a user's augmented engine) carries the effects it names
     // with `effect` items, or else those whose every parameter it declares; the sensor effects
     // act on the records of any model
-    let pool = effects::carried(&base, Some(model));
+    let pool = super::kinematic::candidate_pool(model, effects::carried(&base, Some(model)));
     let Some(names) = names else {
         return Ok(pool);
     };

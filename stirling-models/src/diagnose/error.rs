@@ -59,8 +59,11 @@ pub enum DiagnoseError {
     // the cause in the message, not as a source: a chain printed by the caller showed it twice
     #[error("the nominal calibration failed: {0}")]
     Nominal(FitError),
-    #[error("model `{model}` is a kinematic engine (a flywheel drives its cranks): the diagnosis does not run on it yet; it calibrates the mechanics from the measured pressure, which a kinematic record's fit does not identify (the flywheel's friction and load act as one torque). Fit the record with `stirling fit` (docs/custom-topologies.md, section 13)")]
-    Kinematic { model: String },
+    #[error("model `{model}` is a kinematic engine: its diagnosis calibrates the gas parameters driven by the measured angle, and it has no film coefficient (W/(m^2 K)) to free by default: name the gas parameters to calibrate with --free")]
+    KinematicFree { model: String },
+    // the fit's refusal of a kinematic record (its rate), as the fit words it
+    #[error("{0}")]
+    Record(FitError),
     #[error("model `{model}` has no parameter `{name}`")]
     UnknownParameter { name: String, model: String },
     #[error("`{param}` enters neither driven subsystem of `{model}`")]

@@ -37,6 +37,10 @@ mod gap;
 pub mod joint;
 /// The joint fit of one candidate from one start.
 mod joint_fit;
+/// The diagnosis of a kinematic engine: the driven stage of the measured angle.
+pub mod kinematic;
+/// The model effects of a kinematic engine, fitted by the kinematic fit.
+mod kinematic_refit;
 /// Where: residuals by channel, harmonic, phase of the cycle and subsystem.
 pub mod localize;
 /// Pairs of significant candidates tried together.

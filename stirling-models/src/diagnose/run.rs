@@ -27,9 +27,7 @@ pub fn diagnose(
 ) -> Result<Diagnosis, DiagnoseError> {
     let clock = Instant::now();
     if !crate::layout::StateLayout::flywheels(model).is_empty() {
-        return Err(DiagnoseError::Kinematic {
-            model: model.name().into(),
-        });
+        return super::kinematic::diagnose(model, p0, data, opts);
     }
     let first = diagnose_once(model, p0, data, opts)?;
     let mut d = super::restarted::second_pass(model, p0, data, opts, &first)

@@ -146,6 +146,15 @@ pub enum FitError {
         turns: f64,
         cycles: f64,
     },
+    #[error("{file}: the record samples at {rate:.4} Hz, {per_rev:.1} samples per revolution of the flywheel (its angle `{angle}` turns at {turns:.4} rev/s): too coarse for a kinematic engine's fit, which needs at least {} samples a revolution, {need:.1} Hz or more here: below that the pressure's cycle is not followed from sample to sample, its third differences (the noise estimate) are the signal's own, and the pressure looks like noise; record at {need:.1} Hz or more", super::excitation::MIN_SAMPLES_PER_CYCLE)]
+    KinematicRate {
+        file: String,
+        angle: String,
+        rate: f64,
+        turns: f64,
+        per_rev: f64,
+        need: f64,
+    },
     #[error("{stage} expects two bodies (displacer x, piston y); `{model}` has {found}")]
     Bodies {
         stage: &'static str,

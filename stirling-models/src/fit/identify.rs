@@ -401,6 +401,9 @@ pub fn identify_stages<'a>(
         }
         None => data,
     };
+    if let Some(a) = &angle {
+        super::kinematic::angle::check_rate_of(a, data)?;
+    }
     let layout = StateLayout::working_gas(model);
     let rec = Record::new(model, &layout, p0, data, opts)?;
     let free = opts.free.clone().unwrap_or_else(|| default_free(model, p0));

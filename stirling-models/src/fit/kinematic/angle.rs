@@ -7,7 +7,7 @@
 use stirling_dsl::Model;
 
 use crate::data::Measured;
-use crate::fit::excitation::record_frequency;
+use crate::fit::excitation::{record_frequency, MIN_SAMPLES_PER_CYCLE};
 use crate::fit::FitError;
 use crate::layout::StateLayout;
 
@@ -137,6 +137,47 @@ pub fn check_speed(
         });
     }
     Ok(())
+}
+
+/// Refuse a kinematic record sampled too slowly for its flywheel's speed: fewer than
+/// [`MIN_SAMPLES_PER_CYCLE`] samples a revolution over the whole record (the angle's
+/// turning rate; a record without the angle, or of an engine of free bodies, passes here).
+/// At 20 Hz the gamma LTD (2.8 rev/s) gives 7 samples a revolution, and its pressure was
+/// refused as a channel that "does not move enough" (its third differences, the noise
+/// estimate, are the undersampled cycle's own).
+pub fn check_rate(model: &dyn Model, data: &Measured) -> Result<(), FitError> {
+    let Some(angle) = measured_angle(model, data)? else {
+        return Ok(());
+    };
+    check_rate_of(&angle, data)
+}
+
+/// [`check_rate`] on a measured angle.
+pub fn check_rate_of(angle: &Angle, data: &Measured) -> Result<(), FitError> {
+    let a = &angle.data;
+    let (n, dt) = (a.len(), data.dt());
+    if n < 2 || !(dt > 0.0) {
+        return Ok(());
+    }
+    let turns = (a[n - 1] - a[0]).abs() / std::f64::consts::TAU / ((n - 1) as f64 * dt);
+    if !(turns > 0.0) || !turns.is_finite() {
+        return Ok(());
+    }
+    let per_rev = 1.0 / (turns * dt);
+    // under two samples a revolution (steps over pi) the angle cannot be a sampled rotation:
+    // its unit is wrong (degrees read as rad turn 57 times too fast), which the speed check
+    // against the pressure's cycle names
+    if !(2.0..MIN_SAMPLES_PER_CYCLE).contains(&per_rev) {
+        return Ok(());
+    }
+    Err(FitError::KinematicRate {
+        file: data.source.clone(),
+        angle: angle.name.clone(),
+        rate: 1.0 / dt,
+        turns,
+        per_rev,
+        need: MIN_SAMPLES_PER_CYCLE * turns,
+    })
 }
 
 #[cfg(test)]

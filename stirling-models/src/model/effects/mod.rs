@@ -315,7 +315,16 @@ pub fn check_range(name: &str, v: f64) -> Result<(), EffectError> {
 /// Parameters of the augmented model with every effect at its null (the nominal model).
 pub fn nominal_params(model: &dyn Model) -> Vec<f64> {
     let mut p = model.default_params();
-    for e in EFFECTS.iter().chain(sites::from_sites(model)) {
+    // an engine outside the library that names its effects is nulled at those alone: a
+    // parameter of its own under a library effect's name is its own (the gamma LTD's
+    // piston leak `Gleak`, 4e-10, is the library `leak`'s strength by name)
+    let named = sites::from_sites(model);
+    let library: &[EffectInfo] = if named.is_empty() || canonical(model.name()).is_some() {
+        EFFECTS
+    } else {
+        &[]
+    };
+    for e in library.iter().chain(named) {
         for q in e.params {
             if let (Some(null), Some(i)) = (q.null, model.param_index(q.name)) {
                 p[i] = null;

@@ -1,0 +1,381 @@
+//! The diagnosis of a kinematic engine (a flywheel driving cranks, docs/physics.md section
+//! 12; method and measurements: docs/diagnosis.md, "Kinematic engines"). The record gives the
+//! pressure `p` and the flywheel's angle; the calibration is the kinematic fit
+//! ([`crate::fit::kinematic`]: the gas driven by the measured angle, the film coefficients,
+//! the pressure offset and the gas's initial masses fitted). The free-piston diagnosis runs
+//! on that one driven stage for the gap before, where, and the sensor effects (score, joint
+//! fit); each model effect the engine names is fitted by the kinematic fit itself with its
+//! strength freed (`kinematic_refit.rs`), and all are judged on the held-out block by the
+//! free-piston verdict's rule.
+//!
+//! What does not carry over: the second pass with stage 1 restarted (the end stops of a
+//! free body; no stage 1 runs), the simulated gap (its cycles are counted on the displacer's
+//! position `x`, which a kinematic record does not carry; its note says so), steps after the
+//! first. The flywheel's friction and load act on no driven row, so no effect on the flywheel
+//! can be tested.
+
+use std::collections::HashMap;
+use std::sync::{Mutex, OnceLock};
+use std::time::Instant;
+
+use stirling_dsl::Model;
+
+use super::kinematic_refit::{held_out, is_model_effect, refit, HeldOut, Refit};
+use super::types::{ChannelError, Diagnosis, Interval, RankEntry, Step, Verdict};
+use super::{DiagnoseError, DiagnoseOptions};
+use crate::data::Measured;
+use crate::effects::{EffectInfo, EffectParam, EffectTarget};
+use crate::fit::classify::classify;
+use crate::fit::FitOptions;
+use crate::layout::StateLayout;
+use crate::signal::noise_sigma;
+
+/// The units of the parameters a kinematic diagnosis calibrates when no `--free` is given:
+/// the film coefficients, the estimates a kit engine's geometry does not give (its dimensions,
+/// temperatures and gas constants are read or measured; its leak is what the `leak` effect
+/// tests). Not the regenerator's flow resistance: its pressure drop is a few Pa against a
+/// 10 Pa transducer, so a free `Rf` is not identified and its fit settles on its floor when
+/// the gas misses something (a gamma LTD record with 5x the nominal leak: `Rf` at 300
+/// against 1e4, the leak fitted at half its truth, its interval missing it; with `Rf` held,
+/// the leak came out at 1.98e-9 for 2e-9).
+pub const CALIBRATED_UNITS: [&str; 1] = ["W/(m^2 K)"];
+
+/// Diagnose the kinematic engine `model` from `p0` (its effects at their nulls) on a record
+/// with the pressure `p` and the flywheel's angle.
+pub(super) fn diagnose(
+    model: &dyn Model,
+    p0: &[f64],
+    data: &Measured,
+    opts: &DiagnoseOptions,
+) -> Result<Diagnosis, DiagnoseError> {
+    let clock = Instant::now();
+    // a record too coarse for the cycle is refused by its rate, before the blocks' motion
+    // check takes its aliased pressure for a still engine
+    crate::fit::kinematic::angle::check_rate(model, data).map_err(DiagnoseError::Record)?;
+    let free = match &opts.fit.free {
+        Some(f) => f.clone(),
+        None => default_free(model, p0)?,
+    };
+    let cands = super::candidates::candidates(model, &opts.effects)?;
+    let (model_effects, sensor): (Vec<&EffectInfo>, Vec<&EffectInfo>) =
+        cands.iter().copied().partition(|e| is_model_effect(e));
+    // the shared diagnosis: the calibration, the gap before, where, and the sensor effects
+    // (scored and fitted on the driven stage as on a free-piston engine)
+    let mut o = opts.clone();
+    o.fit.free = Some(free.clone());
+    o.effects = Some(sensor.iter().map(|e| e.name.to_string()).collect());
+    let mut d = super::run::diagnose_once(model, p0, data, &o)?;
+    // the model effects, each by the kinematic fit with its strength freed
+    let fit_opts = FitOptions {
+        train: Some(d.train),
+        holdout: Some(d.holdout),
+        prior: opts.prior,
+        free: Some(free.clone()),
+        free_run: None,
+        multiple_shooting: None,
+        input_noise_draws: 0,
+        ..opts.fit.clone()
+    };
+    let (id0, _) = crate::fit::identify_stages(model, p0, data, &fit_opts)?;
+    let nominal = held_out(&id0, data, d.holdout)?;
+    let mut refits: Vec<Refit> = Vec::new();
+    for e in &model_effects {
+        let r = refit(
+            model,
+            p0,
+            data,
+            (&free, &fit_opts),
+            e,
+            (&nominal, d.holdout),
+            (opts.bootstrap, opts.seed),
+        );
+        if let Some(progress) = opts.progress {
+            progress(&format!(
+                "{}: fitted with the gas parameters ({:.1} s): p = {:.2e}, held-out BIC {:+.1}",
+                e.name,
+                r.entry.seconds,
+                r.entry.p_value,
+                r.entry.delta_bic.unwrap_or(f64::NAN)
+            ));
+        }
+        refits.push(r);
+    }
+    d.fits += 1 + refits.len();
+    let mut ranking: Vec<RankEntry> = refits.iter().map(|r| r.entry.clone()).collect();
+    ranking.append(&mut d.ranking);
+    let level = opts.alpha / cands.len().max(1) as f64;
+    rank(&mut ranking, level);
+    let named = ranking
+        .iter()
+        .find(|r| passes(r, level))
+        .map(|r| r.effect.clone());
+    let gap = nominal.mean();
+    let held = named
+        .as_ref()
+        .and_then(|n| refits.iter().find(|r| &r.entry.effect == n))
+        .and_then(|r| r.held.as_ref());
+    d.verdict = verdict(&ranking, named.as_deref(), level, gap, held);
+    if let (Some(name), Some(h)) = (&named, held) {
+        let row = ranking.iter().find(|r| &r.effect == name).expect("named");
+        d.steps = vec![step(row, h, data, &ranking)];
+        d.remainder = Vec::new();
+    } else if named.is_none() {
+        d.steps.clear();
+    }
+    d.ranking = ranking;
+    d.simulation_gap = None;
+    d.simulation_gap_note = Some(
+        "not computed on a kinematic engine: the free run's cycles are counted on the \
+         displacer's position `x`, which its record does not carry (the driven fit is \
+         judged on the held-out block instead)"
+            .into(),
+    );
+    for s in &mut d.steps {
+        s.simulation_gap = None;
+        s.simulation_gap_note.clone_from(&d.simulation_gap_note);
+    }
+    d.seconds = clock.elapsed().as_secs_f64();
+    Ok(d)
+}
+
+/// Whether a candidate is named: its strength significant at `level`, the held-out BIC
+/// lowered by more than 10, its closure interval above 0.5 (the free-piston verdict's rule).
+fn passes(r: &RankEntry, level: f64) -> bool {
+    r.fitted
+        && r.p_value < level
+        && r.delta_bic.is_some_and(|b| b < -10.0)
+        && r.ci_low.is_some_and(|c| c > 0.5)
+}
+
+/// The significant candidates first, then by held-out BIC change, then by p-value.
+fn rank(ranking: &mut [RankEntry], level: f64) {
+    ranking.sort_by(|a, b| {
+        let sig = |r: &RankEntry| !(r.p_value < level);
+        sig(a)
+            .cmp(&sig(b))
+            .then(
+                a.delta_bic
+                    .unwrap_or(f64::INFINITY)
+                    .total_cmp(&b.delta_bic.unwrap_or(f64::INFINITY)),
+            )
+            .then(a.p_value.total_cmp(&b.p_value))
+    });
+}
+
+/// The verdict: the named effect, or `no_significant_gap` when no candidate is significant,
+/// or `unexplained`. A remainder is flagged when the held-out error after the named effect
+/// exceeds the noise floor by more than three standard deviations of a mean of squared
+/// normal noise over the held-out samples (`3 sqrt(2 / N)`).
+fn verdict(
+    ranking: &[RankEntry],
+    named: Option<&str>,
+    level: f64,
+    gap: f64,
+    held: Option<&HeldOut>,
+) -> Verdict {
+    let significant: Vec<&RankEntry> = ranking.iter().filter(|r| r.p_value < level).collect();
+    let top = named
+        .and_then(|n| ranking.iter().find(|r| r.effect == n))
+        .or(significant.first().copied());
+    let (closure_fraction, ci_low, ci_high) = top.map_or((None, None, None), |r| {
+        (r.closure_fraction, r.ci_low, r.ci_high)
+    });
+    let params = |r: &RankEntry| {
+        r.params
+            .iter()
+            .map(|q| {
+                format!(
+                    "{} = {:.3e} [{:.3e}, {:.3e}]",
+                    q.name, q.value, q.ci_low, q.ci_high
+                )
+            })
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
+    match (named, top) {
+        (Some(name), Some(r)) => {
+            let after = held.map_or(f64::NAN, HeldOut::mean);
+            let n = held.map_or(1.0, |h| h.err.len() as f64);
+            let remainder = after > 1.0 + 3.0 * (2.0 / n).sqrt();
+            Verdict {
+                verdict: "effect".into(),
+                effect: Some(name.into()),
+                effects: vec![name.into()],
+                unexplained_remainder: remainder,
+                closure_fraction,
+                ci_low,
+                ci_high,
+                gap,
+                reason: format!(
+                    "`{name}` fitted with the gas parameters: {} (p = {:.1e}, significant at {level:.1e}), held-out BIC {:+.1}, closes {:.3} [{:.3}, {:.3}] of the held-out gap ({gap:.3} -> {after:.3} noise variances){}",
+                    params(r),
+                    r.p_value,
+                    r.delta_bic.unwrap_or(f64::NAN),
+                    r.closure_fraction.unwrap_or(f64::NAN),
+                    r.ci_low.unwrap_or(f64::NAN),
+                    r.ci_high.unwrap_or(f64::NAN),
+                    if remainder { "; a significant remainder stays above the noise" } else { "" }
+                ),
+            }
+        }
+        (_, None) => Verdict {
+            verdict: "no_significant_gap".into(),
+            effect: None,
+            effects: Vec::new(),
+            unexplained_remainder: false,
+            closure_fraction: None,
+            ci_low: None,
+            ci_high: None,
+            gap,
+            reason: format!(
+                "no candidate is significant at {level:.1e} (held-out error {gap:.3} noise variances)"
+            ),
+        },
+        (None, Some(r)) => Verdict {
+            verdict: "unexplained".into(),
+            effect: Some(r.effect.clone()),
+            effects: Vec::new(),
+            unexplained_remainder: true,
+            closure_fraction,
+            ci_low,
+            ci_high,
+            gap,
+            reason: format!(
+                "{} candidate(s) significant at {level:.1e}, but none lowers the held-out BIC by more than 10 and closes more than 0.5 of the gap with confidence (best: `{}`, held-out BIC {:+.1}, closure {:.3} [{:.3}, {:.3}])",
+                significant.len(),
+                r.effect,
+                r.delta_bic.unwrap_or(f64::NAN),
+                r.closure_fraction.unwrap_or(f64::NAN),
+                r.ci_low.unwrap_or(f64::NAN),
+                r.ci_high.unwrap_or(f64::NAN),
+            ),
+        },
+    }
+}
+
+/// The one step of a named model effect.
+fn step(row: &RankEntry, held: &HeldOut, data: &Measured, ranking: &[RankEntry]) -> Step {
+    let noise = data.p.as_deref().map_or(f64::NAN, noise_sigma);
+    let closure = Interval {
+        value: row.closure_fraction.unwrap_or(f64::NAN),
+        ci_low: row.ci_low.unwrap_or(f64::NAN),
+        ci_high: row.ci_high.unwrap_or(f64::NAN),
+    };
+    Step {
+        step: 1,
+        effects: vec![row.effect.clone()],
+        p_value: row.p_value,
+        delta_bic: row.delta_bic.unwrap_or(f64::NAN),
+        params: row.params.clone(),
+        closure,
+        cumulative: closure,
+        holdout_error: held.mean(),
+        channels: vec![ChannelError {
+            channel: "p".into(),
+            rms: held.rms,
+            noise,
+            ratio: held.rms / noise,
+        }],
+        simulation_gap: None,
+        simulation_gap_note: None,
+        ranking: ranking.to_vec(),
+        seconds: row.seconds,
+        after_stops: false,
+        from_reset: false,
+        eval: None,
+    }
+}
+
+/// The parameters the calibration frees by default: the gas parameters whose unit is one of
+/// [`CALIBRATED_UNITS`] and whose value is not an effect's null (0).
+pub fn default_free(model: &dyn Model, p0: &[f64]) -> Result<Vec<String>, DiagnoseError> {
+    let free: Vec<String> = model
+        .params()
+        .iter()
+        .zip(p0)
+        .filter(|(i, &v)| CALIBRATED_UNITS.contains(&i.unit) && v > 0.0)
+        .map(|(i, _)| i.name.to_string())
+        .filter(|n| {
+            matches!(classify(model, p0, std::slice::from_ref(n)), Ok((m, g)) if m.is_empty() && !g.is_empty())
+        })
+        .collect();
+    if free.is_empty() {
+        return Err(DiagnoseError::KinematicFree {
+            model: model.name().into(),
+        });
+    }
+    Ok(free)
+}
+
+/// The candidates of a kinematic engine among `pool` (what the engine names, and the sensor
+/// effects): the position gains dropped (a kinematic record measures no position), the
+/// library's `sensor_lag` dropped when the engine names a lag with its parameter, and each
+/// model effect's typical strength (the joint fit's step and its second start) taken from the
+/// engine's own parameter of that unit when it has one (the gamma LTD's leak `Gleak`, 4e-10
+/// kg/(s Pa), against the library's 2e-8 for a free-piston engine's seals: from 2e-8 the joint
+/// fit of a leak ended near 1e-9 on every record, clean or not). An engine of free bodies
+/// gets `pool` as it is.
+pub(super) fn candidate_pool(
+    model: &dyn Model,
+    pool: Vec<&'static EffectInfo>,
+) -> Vec<&'static EffectInfo> {
+    if StateLayout::flywheels(model).is_empty() {
+        return pool;
+    }
+    static CACHE: OnceLock<Mutex<HashMap<String, Vec<&'static EffectInfo>>>> = OnceLock::new();
+    let names: Vec<&str> = pool.iter().map(|e| e.name).collect();
+    let key = format!(
+        "{}#{}#{}",
+        model.name(),
+        model.params().len(),
+        names.join(",")
+    );
+    let cache = CACHE.get_or_init(Default::default);
+    let mut cache = cache.lock().unwrap_or_else(|e| e.into_inner());
+    cache
+        .entry(key)
+        .or_insert_with(|| kinematic_pool(model, &pool))
+        .clone()
+}
+
+fn kinematic_pool(model: &dyn Model, pool: &[&'static EffectInfo]) -> Vec<&'static EffectInfo> {
+    let declared_lag = |e: &EffectInfo| {
+        e.name != "sensor_lag"
+            && e.target == EffectTarget::Sensor
+            && e.params.iter().any(|q| q.name == "tau_p")
+    };
+    let has_lag = pool.iter().any(|e| declared_lag(e));
+    pool.iter()
+        .filter(|e| e.name != "sensor_gain" && !(has_lag && e.name == "sensor_lag"))
+        .map(|&e| {
+            if e.target != EffectTarget::Model {
+                return e;
+            }
+            let params: Vec<EffectParam> = e
+                .params
+                .iter()
+                .map(|q| {
+                    let own = model.params().iter().find(|i| {
+                        q.null.is_some() && i.name != q.name && i.unit == q.unit && i.default > 0.0
+                    });
+                    EffectParam {
+                        typical: own.map_or(q.typical, |i| i.default),
+                        ..*q
+                    }
+                })
+                .collect();
+            if params
+                .iter()
+                .zip(e.params)
+                .all(|(a, b)| a.typical == b.typical)
+            {
+                return e;
+            }
+            let info = EffectInfo {
+                params: Box::leak(params.into_boxed_slice()),
+                ..*e
+            };
+            &*Box::leak(Box::new(info))
+        })
+        .collect()
+}
