@@ -111,5 +111,12 @@ stirling_model! {
         space room { pressure: Pb, volume: 1.0e-3, temperature: Tk, faces { piston: Ap } }
         link cold -> room { conductance: Gleak }
         sensor p: P_cold "Pa";
+        // what the diagnosis may find that the model leaves out (`stirling diagnose`, each at its
+        // null here: docs/diagnosis.md, "Kinematic engines"): a second seal leak from the cold
+        // space to the room (the displacer rod's bushing in the top plate), the foam's and the
+        // gap's quadratic flow friction, and the pressure transducer's lag
+        effect leak cold -> room;
+        effect quadratic on link hot -> cold;
+        effect lag on sensor p;
     }
 }
