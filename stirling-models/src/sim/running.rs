@@ -1,6 +1,6 @@
 //! A kinematic engine as it runs: its speed, the indicated work of its last whole revolutions,
 //! and the cycle-mean state of its gas (what Schmidt's analysis is then made at,
-//! [`super::schmidt`]).
+//! [`crate::sim::schmidt`]).
 //!
 //! A flywheel's angle grows by `2 pi` a revolution, so no state returns and there is no
 //! periodic orbit to shoot (`--limit-cycle` refuses such a model); the engine is pushed

@@ -79,7 +79,7 @@ pub struct EffectAt {
 pub struct Basis {
     pub effects: Vec<EffectAt>,
     pub x: Vec<f64>,
-    /// The runs every joint problem on this calibration shares ([`memo`]).
+    /// The runs every joint problem on this calibration shares (`joint/memo.rs`).
     pub memo: memo::Memo,
 }
 

@@ -1,7 +1,7 @@
 //! A kinematic engine's record that logs the working gas's volume instead of the crank angle
 //! (lab setups often log `dV [cm^3]`, the volume's change, zero at mid-stroke, from a linear
 //! transducer on the power piston): the angle that drives the gas is read back through the
-//! model's own volume `V(theta)` (its cranks and spaces, [`volume_at_angles`]).
+//! model's own volume `V(theta)` (its cranks and spaces, [`crate::sim::indicated::volume_at_angles`]).
 //!
 //! `V(theta)` rises on one half of a revolution and falls on the other, so a volume is met at
 //! two angles; the engine turns forward (the angle grows), so the branch is the one whose
