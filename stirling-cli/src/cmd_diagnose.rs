@@ -416,10 +416,21 @@ fn print_gap_before(o: &mut impl Write, d: &Diagnosis) -> io::Result<()> {
 
 /// Where: subsystems, harmonics and phase bins per channel.
 fn print_localization(o: &mut impl Write, l: &Localization) -> io::Result<()> {
+    // a subsystem the record does not drive (a kinematic engine's mechanics: its angle is
+    // prescribed) has no error: said so, not printed as NaN
+    let err = |e: f64| {
+        if e.is_finite() {
+            format!("{e:.3}")
+        } else {
+            "not fitted".into()
+        }
+    };
     writeln!(
         o,
-        "  subsystems: mechanics {:.3}, gas {:.3} noise variances; dominant {}",
-        l.mechanics_error, l.gas_error, l.dominant_subsystem
+        "  subsystems: mechanics {}, gas {} noise variances; dominant {}",
+        err(l.mechanics_error),
+        err(l.gas_error),
+        l.dominant_subsystem
     )?;
     let list = |v: &[f64], f: fn(&f64) -> String| v.iter().map(f).collect::<Vec<_>>();
     for c in &l.channels {

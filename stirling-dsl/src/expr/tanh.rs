@@ -18,7 +18,9 @@
 //! `[1e-10, 20]` (checked against 50-digit decimals; glibc's `tanh` is also off by up to 2
 //! there), hence within 3 of libm's (test `tanh_matches_libm`).
 
+#[allow(clippy::excessive_precision)] // the digits of fdlibm's split of ln 2, as published
 const LN2_HI: f64 = 6.931_471_803_691_238_164_90e-1; // ln 2 with 32 trailing zero bits
+#[allow(clippy::excessive_precision)]
 const LN2_LO: f64 = 1.908_214_929_270_587_700_02e-10; // ln 2 - LN2_HI
 const INV_LN2: f64 = std::f64::consts::LOG2_E;
 /// `1.5 * 2^52`: adding and subtracting it rounds a double of magnitude below `2^51` to an
