@@ -75,12 +75,15 @@ pub fn running(
         model.pv(p, s, &mut pr, &mut vol);
         (pr, vol)
     };
+    // every vessel's pressure and `dV/dtheta` at each sample, one evaluation each
+    let pressure: Vec<Vec<f64>> = win.iter().map(|s| pv(s).0).collect();
+    let slope: Vec<Vec<f64>> = win.iter().map(|s| volume_slopes(&pv, s, ia)).collect();
     let mut work_per_space = Vec::new();
     let mut turned = revs;
     for (name, k) in &spaces {
-        let pressure: Vec<f64> = win.iter().map(|s| pv(s).0[*k]).collect();
-        let slope: Vec<f64> = win.iter().map(|s| space_slope(&pv, s, ia, *k)).collect();
-        let (w, n) = work_per_revolution(th, &slope, &pressure)?;
+        let pk: Vec<f64> = pressure.iter().map(|v| v[*k]).collect();
+        let sk: Vec<f64> = slope.iter().map(|v| v[*k]).collect();
+        let (w, n) = work_per_revolution(th, &sk, &pk)?;
         work_per_space.push((name.clone(), w));
         turned = n;
     }
@@ -106,17 +109,16 @@ pub fn running(
     })
 }
 
-/// `dV_k/dtheta` of vessel `k` at the state `s` (the cranks follow the angle `ia`).
-fn space_slope(
-    pv: &impl Fn(&[f64]) -> (Vec<f64>, Vec<f64>),
-    s: &[f64],
-    ia: usize,
-    k: usize,
-) -> f64 {
+/// `dV/dtheta` of every vessel at the state `s` (the cranks follow the angle `ia`).
+fn volume_slopes(pv: &impl Fn(&[f64]) -> (Vec<f64>, Vec<f64>), s: &[f64], ia: usize) -> Vec<f64> {
     let (mut up, mut dn) = (s.to_vec(), s.to_vec());
     up[ia] += H;
     dn[ia] -= H;
-    (pv(&up).1[k] - pv(&dn).1[k]) / (2.0 * H)
+    let (vu, vd) = (pv(&up).1, pv(&dn).1);
+    vu.iter()
+        .zip(&vd)
+        .map(|(a, b)| (a - b) / (2.0 * H))
+        .collect()
 }
 
 /// The mean gas temperature of each space over the samples `win`, and the mean mass of the
