@@ -261,3 +261,20 @@ fn end_stops_and_a_pressure_lag_are_both_named() {
         tau.value
     );
 }
+
+#[test]
+fn a_gain_whose_fitted_engine_dies_in_a_free_run_is_flagged() {
+    // position gains of +5 % on both sensors: the gain's fit closes most of the driven gap,
+    // but the mechanics stage pulls `gain_x` negative (docs/diagnosis.md, Known
+    // limitations) and the fitted engine, run on its own over the held-out block, dies out;
+    // the verdict keeps the gain and says its strengths do not describe the running engine
+    let d = diagnosed_at(2000.0, &["sensor_gain"], 1.0, 1005, &["sensor_gain"]);
+    assert_eq!(d.verdict.effects, ["sensor_gain"], "{}", d.verdict.reason);
+    let sim = d.simulation_gap.as_ref().and_then(|g| g.closure.as_ref());
+    let sim = sim.expect("the free run of the fitted model is compared");
+    assert!(sim.ci_high < 0.0, "simulated closure {sim:?}");
+    assert!(d.verdict.free_run_worse, "{}", d.verdict.reason);
+    assert!(d.verdict.reason.contains("read them with care"));
+    let json = serde_json::to_value(&d).unwrap();
+    assert_eq!(json["verdict"]["free_run_worse"], true);
+}

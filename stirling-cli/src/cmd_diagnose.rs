@@ -321,10 +321,15 @@ fn print_text(o: &mut impl Write, path: &Path, d: &Diagnosis) -> io::Result<()> 
         "\nverdict: {}{}{} ({})",
         d.verdict.verdict,
         named.iter().map(|e| format!(" `{e}`")).collect::<String>(),
-        if d.verdict.unexplained_remainder && d.verdict.verdict == "effect" {
-            " + an unexplained remainder"
-        } else {
-            ""
+        match (
+            d.verdict.unexplained_remainder && d.verdict.verdict == "effect",
+            d.verdict.free_run_worse,
+        ) {
+            (true, true) =>
+                " + an unexplained remainder, and a free run worse than the calibrated model's",
+            (true, false) => " + an unexplained remainder",
+            (false, true) => ", but a free run worse than the calibrated model's",
+            (false, false) => "",
         },
         d.verdict.reason
     )?;

@@ -32,6 +32,8 @@ pub mod covariance;
 mod cycle_features;
 /// Why a diagnosis failed.
 pub mod error;
+/// The free run of the named effects, checked against the calibrated model's.
+pub mod free_run_check;
 mod gap;
 /// The joint problem of one candidate: the calibrated stages extended by its variables.
 pub mod joint;

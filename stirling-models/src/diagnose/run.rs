@@ -9,7 +9,9 @@ use super::candidates::candidates;
 use super::context::{predict, Context, Prediction};
 use super::gap::gap_before;
 use super::types::{Diagnosis, EffectEstimate};
-use super::{joint, localize, score, sim_gap, steps, verdict, DiagnoseError, DiagnoseOptions};
+use super::{
+    free_run_check, joint, localize, score, sim_gap, steps, verdict, DiagnoseError, DiagnoseOptions,
+};
 use crate::data::Measured;
 use crate::fit::free_run::SensorOffsets;
 use crate::fit::{self, FitOptions, FittedStage, Identification};
@@ -109,6 +111,7 @@ pub(super) fn diagnose_once(
         p_nom: &p_nom,
     };
     attach_simulated_gaps(&mut diagnosis, model, data, &nominal_run, opts);
+    free_run_check::flag(&mut diagnosis);
     diagnosis.seconds = clock.elapsed().as_secs_f64();
     Ok(diagnosis)
 }

@@ -173,6 +173,11 @@ pub struct Verdict {
     /// Whether a significant gap remains that the named effects do not explain (always for
     /// `unexplained`, never for `no_significant_gap`).
     pub unexplained_remainder: bool,
+    /// Whether the model with the named effects, run on its own over the held-out block, is
+    /// further from the record than the calibrated model (its simulated closure's interval
+    /// lies below zero, [`crate::diagnose::free_run_check`]): the effects close the gap of the
+    /// driven subsystems, not the running engine's.
+    pub free_run_worse: bool,
     pub closure_fraction: Option<f64>,
     pub ci_low: Option<f64>,
     pub ci_high: Option<f64>,

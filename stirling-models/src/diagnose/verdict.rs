@@ -149,6 +149,7 @@ pub fn decide(
             .map(|r| vec![r.effect.clone()])
             .unwrap_or_default(),
         unexplained_remainder: v == "unexplained",
+        free_run_worse: false,
         closure_fraction: r.and_then(|r| r.closure_fraction),
         ci_low: r.and_then(|r| r.ci_low),
         ci_high: r.and_then(|r| r.ci_high),
@@ -221,6 +222,7 @@ pub fn decide_steps(
         effect: named.first().cloned(),
         effects: Vec::new(),
         unexplained_remainder: true,
+        free_run_worse: false,
         closure_fraction: Some(cum.value),
         ci_low: Some(cum.ci_low),
         ci_high: Some(cum.ci_high),
@@ -249,6 +251,7 @@ pub fn decide_steps(
         verdict: "effect".into(),
         effects: named,
         unexplained_remainder: remainder,
+        free_run_worse: false,
         reason: format!("{chain}: {total}{tail}"),
         ..base
     }
