@@ -1,6 +1,6 @@
 //! The truth models outside the effect library (`stirling::models::outside`): at their null
 //! they are the nominal `nsection`, their analytic Jacobians match central differences, and
-//! the rig runs them (`--truth`), refusing library effects on top.
+//! the rig runs them (`--truth`), with library effects on top when asked.
 
 mod common;
 
@@ -108,13 +108,26 @@ fn the_rig_runs_an_outside_truth_and_it_acts() {
             .fold(0.0, f64::max);
         assert!(diff > 1e-5, "{} changes x by {diff} m only", o.name);
     }
-    let err = rig::run(&RigConfig {
+    // a library effect beside the outside cause (the self-check's mixed records): both act
+    let alone = rig::run(&cfg(Some("h_speed"), vec!["chv=1".into()])).unwrap();
+    let both = rig::run(&RigConfig {
         effects: vec!["Fcd=0.1".into()],
-        ..cfg(Some("h_speed"), vec![])
+        ..cfg(Some("h_speed"), vec!["chv=1".into()])
     })
-    .unwrap_err()
-    .to_string();
-    assert!(err.contains("takes no --effect"), "{err}");
+    .unwrap();
+    assert_eq!(both.truth.outside.as_deref(), Some("h_speed"));
+    assert_eq!(both.truth.active_effects, ["coulomb"]);
+    assert_eq!(both.truth.parameters["chv"], 1.0);
+    let (a, b) = (
+        alone.data.x.as_ref().unwrap(),
+        both.data.x.as_ref().unwrap(),
+    );
+    let diff = a
+        .iter()
+        .zip(b)
+        .map(|(u, v)| (u - v).abs())
+        .fold(0.0, f64::max);
+    assert!(diff > 1e-5, "the friction changes x by {diff} m only");
     let err = rig::run(&cfg(Some("bounce"), vec![]))
         .unwrap_err()
         .to_string();

@@ -104,6 +104,11 @@ pub struct DiagnoseArgs {
     /// pairs)
     #[arg(long, default_value_t = 1.0, value_parser = ranges::non_negative)]
     pub pair_strength: f64,
+    /// Self-check: every library effect beside every outside cause, each at this multiple of
+    /// its unit (0: none); right when the verdict is `unexplained` or names the library
+    /// effect alone with an unexplained remainder
+    #[arg(long, default_value_t = 1.0, value_parser = ranges::non_negative)]
+    pub mixed_strength: f64,
     /// Self-check: cases run at once (each diagnosis also uses both cores)
     #[arg(long, default_value_t = 2, value_parser = ranges::at_least_one)]
     pub jobs: usize,
@@ -249,6 +254,7 @@ fn run_self_check(a: &DiagnoseArgs) -> anyhow::Result<()> {
         outside,
         outside_strengths: a.outside_strengths.clone(),
         pair_strength: (a.pair_strength > 0.0).then_some(a.pair_strength),
+        mixed_strength: (a.mixed_strength > 0.0).then_some(a.mixed_strength),
         seeds: a.seeds,
         clean: a.clean,
         t_end: a.t_end,

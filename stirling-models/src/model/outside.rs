@@ -2,8 +2,10 @@
 //! only. The diagnosis never sees them (they are not in [`crate::effects::EFFECTS`]); on
 //! their records its right answer is `unexplained`.
 //!
-//! Both extend the `nsection` engine (docs/custom-topologies.md, "Composition") with one
-//! strength parameter whose null (0) gives the nominal `nsection` exactly:
+//! Both extend the augmented `nsection` engine (`nsection_fx`: every library effect at its null;
+//! docs/custom-topologies.md, "Composition") with one strength parameter whose null (0) gives
+//! the nominal `nsection` exactly; so the rig can put a library effect beside an outside cause
+//! (the self-check's mixed records):
 //!
 //! - `h_speed`: heat-transfer coefficients that grow with the gas speed the pistons drive,
 //!   `h_hot = hh (1 + chv |v|)`, `h_cold = hk (1 + chv |v - w|)`, with the smooth
@@ -12,11 +14,14 @@
 //!   `-k3 (kp/kd) y^3` on the piston (both flexures harden alike relative to their rate).
 
 use stirling_dsl::{Closure, Model};
+// `nsection_fx_engine` is crate-local: extending it calls back through the `stirling_model` in scope.
+use super::effects::nsection_fx_engine;
+use stirling_macros::stirling_model;
 
 stirling_macros::stirling_model! {
     /// `nsection` with heat-transfer coefficients growing with the piston speeds (outside the
     /// effect library; `chv = 0` is the nominal model).
-    pub model NSectionHSpeed extends nsection_engine {
+    pub model NSectionHSpeed extends nsection_fx_engine {
         name "nsection_h_speed";
         params {
             /// growth of the heat-transfer coefficients with the gas speed (0: constant h)
@@ -36,7 +41,7 @@ stirling_macros::stirling_model! {
 stirling_macros::stirling_model! {
     /// `nsection` with hardening (cubic) flexure springs (outside the effect library; `k3 = 0`
     /// is the nominal model).
-    pub model NSectionSpringCubic extends nsection_engine {
+    pub model NSectionSpringCubic extends nsection_fx_engine {
         name "nsection_spring_cubic";
         params {
             /// cubic stiffness of the displacer flexure; the piston's is `k3 kp / kd` (0: linear)

@@ -43,12 +43,6 @@ pub enum RigError {
     NonFinite { channel: String, t: f64 },
     #[error(transparent)]
     Outside(#[from] crate::outside::OutsideError),
-    #[error("--truth {truth} takes no --effect (got {effects}): its strength is a parameter, e.g. --set {param}=VALUE")]
-    TruthWithEffects {
-        truth: String,
-        effects: String,
-        param: String,
-    },
     #[error("--truth {truth} extends nsection; the model must be nsection (got `{model}`)")]
     TruthBase { truth: String, model: String },
     #[error("`{0}` exists: pass --force to overwrite")]

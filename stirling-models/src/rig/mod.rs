@@ -222,9 +222,10 @@ fn engine(cfg: &RigConfig) -> Result<(Box<dyn Model>, EffectSettings, Vec<f64>),
     Ok((model, fx, p))
 }
 
-/// The outside truth model `truth` (on `nsection` only, without library effects).
+/// The outside truth model `truth` (on `nsection` only; library effects apply to it too, since it
+/// extends the augmented engine).
 fn outside_engine(cfg: &RigConfig, truth: &str) -> Result<Box<dyn Model>, RigError> {
-    let info = crate::outside::outside(truth).ok_or_else(|| {
+    crate::outside::outside(truth).ok_or_else(|| {
         RigError::Outside(crate::outside::OutsideError::Unknown {
             name: truth.into(),
             known: crate::outside::OUTSIDE
@@ -234,13 +235,6 @@ fn outside_engine(cfg: &RigConfig, truth: &str) -> Result<Box<dyn Model>, RigErr
                 .join(", "),
         })
     })?;
-    if !cfg.effects.is_empty() {
-        return Err(RigError::TruthWithEffects {
-            truth: truth.into(),
-            effects: cfg.effects.join(" "),
-            param: info.param.into(),
-        });
-    }
     let n = match cfg.model.as_str() {
         "nsection" => cfg.n,
         "order7" => Some(1),

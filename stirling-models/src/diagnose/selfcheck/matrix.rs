@@ -4,6 +4,8 @@
 
 use serde::Serialize;
 
+use super::plan::is_right;
+
 /// Verdict counts by truth.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct Confusion {
@@ -27,6 +29,8 @@ pub struct Confusion {
 pub fn class_of(label: &str) -> &'static str {
     if label == "clean" {
         "clean"
+    } else if label.contains("+outside:") {
+        "mixed"
     } else if label.starts_with("outside:") {
         "outside"
     } else if label.contains('+') {
@@ -59,11 +63,11 @@ impl Confusion {
             counts[r][c] += 1;
         }
         let clean: Vec<_> = cases.iter().filter(|(t, _, _)| t == "clean").collect();
-        let classes = ["single", "pair", "outside", "clean"]
+        let classes = ["single", "pair", "outside", "mixed", "clean"]
             .iter()
             .map(|k| {
                 let of: Vec<_> = cases.iter().filter(|(t, _, _)| class_of(t) == *k).collect();
-                let right = of.iter().filter(|(_, e, v)| e == v).count();
+                let right = of.iter().filter(|(_, e, v)| is_right(e, v)).count();
                 (k.to_string(), right, of.len())
             })
             .filter(|(_, _, n)| *n > 0)
@@ -73,7 +77,7 @@ impl Confusion {
             rows,
             columns,
             counts,
-            right: cases.iter().filter(|(_, e, v)| e == v).count(),
+            right: cases.iter().filter(|(_, e, v)| is_right(e, v)).count(),
             total: cases.len(),
             clean: clean.len(),
             false_alarms: clean

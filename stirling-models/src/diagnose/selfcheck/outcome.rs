@@ -7,7 +7,7 @@ use std::time::Instant;
 use serde::Serialize;
 use stirling_dsl::Model;
 
-use super::plan::{set_label, Planned, Split, Truth, VerdictOptions};
+use super::plan::{set_label, Planned, Split, Truth, VerdictOptions, REMAINDER};
 use super::record::{record, seeded_start, signature, Signature};
 use crate::diagnose::run::diagnose;
 use crate::diagnose::steps::StepRule;
@@ -30,8 +30,11 @@ pub struct Outcome {
     pub verdict: String,
     /// The verdict under the thresholds tuned on the tuning set (filled in by the summary).
     pub tuned_verdict: String,
-    /// The right verdict.
+    /// The right verdict (alternatives joined by ` | `: [`super::plan::is_right`]).
     pub expected: String,
+    /// The diagnosis said a gap remains that the named effects do not explain (its verdict
+    /// label then ends in [`REMAINDER`]).
+    pub remainder: bool,
     /// Candidates the diagnosis considered (the Bonferroni count).
     pub candidates: usize,
     /// The top-ranked candidate and its closure [95 % CI] (the truth's when it is an effect
@@ -71,11 +74,17 @@ pub struct StepBrief {
     pub from_reset: bool,
 }
 
-/// The verdict label of a diagnosis: the set of named effects (`a+b`), `unexplained` or
+/// The verdict label of a diagnosis: the set of named effects (`a+b`, ending in
+/// [`REMAINDER`] when the diagnosis says a gap remains), `unexplained` or
 /// `no_significant_gap`.
 pub fn verdict_label(d: &Diagnosis) -> String {
     if d.verdict.verdict == "effect" && !d.verdict.effects.is_empty() {
-        set_label(&d.verdict.effects)
+        let tail = if d.verdict.unexplained_remainder {
+            REMAINDER
+        } else {
+            ""
+        };
+        format!("{}{tail}", set_label(&d.verdict.effects))
     } else {
         d.verdict.verdict.clone()
     }
@@ -115,7 +124,8 @@ impl Outcome {
             cumulative = s.cumulative_low;
         }
         if !named.is_empty() && cumulative > th.min_closure {
-            set_label(&named)
+            let tail = if self.remainder { REMAINDER } else { "" };
+            format!("{}{tail}", set_label(&named))
         } else if self.ranking.iter().any(|r| r.p_value < level) || self.gap > GROSS_GAP {
             "unexplained".into()
         } else {
@@ -134,6 +144,7 @@ impl Outcome {
             verdict: "error".into(),
             tuned_verdict: "error".into(),
             expected: c.truth.expected(),
+            remainder: false,
             candidates: 0,
             top: None,
             closure_of: None,
@@ -159,6 +170,7 @@ impl Outcome {
         self.truth_rank = name
             .as_ref()
             .and_then(|n| d.ranking.iter().position(|r| &r.effect == n).map(|i| i + 1));
+        self.remainder = d.verdict.verdict == "effect" && d.verdict.unexplained_remainder;
         self.verdict = verdict_label(&d);
         self.gap = d.verdict.gap;
         self.steps = d

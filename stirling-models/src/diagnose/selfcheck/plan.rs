@@ -28,6 +28,25 @@ pub enum Truth {
     Outside { name: String, strength: f64 },
     /// Two library effects at once, each at `strength` times its self-check unit.
     Pair { names: Vec<String>, strength: f64 },
+    /// A library effect beside a cause outside the library, each at `strength` times its
+    /// unit.
+    Mixed {
+        effect: String,
+        outside: String,
+        strength: f64,
+    },
+}
+
+/// What a verdict label gets when the verdict names effects and says a gap remains that the
+/// library does not explain.
+pub const REMAINDER: &str = "+remainder";
+
+/// Whether `verdict` is right for `expected`: one of its alternatives (` | `); a named set
+/// with a remainder counts as the set unless the alternative asks for the remainder itself.
+pub fn is_right(expected: &str, verdict: &str) -> bool {
+    expected.split(" | ").any(|e| {
+        e == verdict || (!e.ends_with(REMAINDER) && verdict.strip_suffix(REMAINDER) == Some(e))
+    })
 }
 
 /// The label of a set of named effects: the names in alphabetical order, joined by `+`.
@@ -45,26 +64,33 @@ impl Truth {
             Truth::Effect { name, .. } => name.clone(),
             Truth::Outside { name, .. } => format!("outside:{name}"),
             Truth::Pair { names, .. } => set_label(names),
+            Truth::Mixed {
+                effect, outside, ..
+            } => format!("{effect}+outside:{outside}"),
         }
     }
 
-    /// The class of the record: `clean`, `single`, `pair`, `outside`.
+    /// The class of the record: `clean`, `single`, `pair`, `outside`, `mixed`.
     pub fn class(&self) -> &'static str {
         match self {
             Truth::Clean => "clean",
             Truth::Effect { .. } => "single",
             Truth::Pair { .. } => "pair",
             Truth::Outside { .. } => "outside",
+            Truth::Mixed { .. } => "mixed",
         }
     }
 
-    /// The right verdict: `no_significant_gap`, the effect's name, `unexplained`.
+    /// The right verdict: `no_significant_gap`, the effect's name, `unexplained`; beside an
+    /// outside cause either `unexplained` or the library effect with the remainder left
+    /// unexplained (alternatives joined by ` | `, read by [`is_right`]).
     pub fn expected(&self) -> String {
         match self {
             Truth::Clean => "no_significant_gap".into(),
             Truth::Effect { name, .. } => name.clone(),
             Truth::Outside { .. } => "unexplained".into(),
             Truth::Pair { names, .. } => set_label(names),
+            Truth::Mixed { effect, .. } => format!("unexplained | {effect}{REMAINDER}"),
         }
     }
 
@@ -73,7 +99,8 @@ impl Truth {
             Truth::Clean => 0.0,
             Truth::Effect { strength, .. }
             | Truth::Outside { strength, .. }
-            | Truth::Pair { strength, .. } => *strength,
+            | Truth::Pair { strength, .. }
+            | Truth::Mixed { strength, .. } => *strength,
         }
     }
 }
@@ -105,6 +132,10 @@ pub struct VerdictOptions {
     pub outside_strengths: Vec<f64>,
     /// Every pair of the library effects at this multiple of their units (`None`: no pairs).
     pub pair_strength: Option<f64>,
+    /// Every library effect beside every outside cause, each at this multiple of its unit
+    /// (`None`: none). These cases come last in the plan, so that adding them leaves every
+    /// other case's index (and its seeded start) as it was.
+    pub mixed_strength: Option<f64>,
     /// Noise seeds per effect / outside case in the tuning and the evaluation set.
     pub seeds: (usize, usize),
     /// Clean records in the tuning and the evaluation set (each its own seed and start).
@@ -132,6 +163,7 @@ impl Default for VerdictOptions {
             outside: None,
             outside_strengths: vec![1.0],
             pair_strength: Some(1.0),
+            mixed_strength: None,
             seeds: (1, 1),
             clean: (10, 20),
             t_end: 2.0,
@@ -242,17 +274,50 @@ fn split_cases(
     out
 }
 
-/// The whole plan, tuning set first; every case's start is perturbed by its own seed.
+/// The mixed cases of one seed set: every library effect beside every outside cause.
+fn mixed_cases(
+    opts: &VerdictOptions,
+    split: Split,
+    effects: &[String],
+    outside: &[String],
+) -> Vec<(Truth, Split, u64)> {
+    let Some(m) = opts.mixed_strength else {
+        return Vec::new();
+    };
+    let (seeds, base) = match split {
+        Split::Tune => (opts.seeds.0, opts.seed),
+        Split::Eval => (opts.seeds.1, opts.seed + 1000),
+    };
+    let mut out = Vec::new();
+    for s in 0..seeds as u64 {
+        for o in outside {
+            for e in effects {
+                let truth = Truth::Mixed {
+                    effect: e.clone(),
+                    outside: o.clone(),
+                    strength: m,
+                };
+                out.push((truth, split, base + s));
+            }
+        }
+    }
+    out
+}
+
+/// The whole plan, tuning set first, then the mixed cases (tuning, evaluation); every case's
+/// start is perturbed by its own seed.
 pub fn plan(opts: &VerdictOptions) -> Result<Vec<Planned>, DiagnoseError> {
     let effects = effect_names(opts)?;
     let outside = outside_names(opts)?;
     let mut cases = split_cases(opts, Split::Tune, &effects, &outside);
     let eval = split_cases(opts, Split::Eval, &effects, &outside);
-    if eval.is_empty() {
+    let mixed = [Split::Tune, Split::Eval].map(|s| mixed_cases(opts, s, &effects, &outside));
+    if eval.is_empty() && mixed[1].is_empty() {
         // refused before the tuning set runs, not after it
         return Err(DiagnoseError::EmptyEvaluation);
     }
     cases.extend(eval);
+    cases.extend(mixed.into_iter().flatten());
     Ok(cases
         .into_iter()
         .enumerate()
@@ -302,6 +367,32 @@ mod tests {
             .iter()
             .filter(|c| c.split == Split::Eval)
             .all(|c| !tune.contains(&c.seed)));
+    }
+
+    #[test]
+    fn mixed_cases_come_last_and_leave_the_others_as_they_were() {
+        let base = plan(&VerdictOptions::default()).unwrap();
+        let with = plan(&VerdictOptions {
+            mixed_strength: Some(1.0),
+            ..Default::default()
+        })
+        .unwrap();
+        assert_eq!(&with[..base.len()], &base[..]);
+        let mixed = &with[base.len()..];
+        // every library effect beside every outside cause, on both seed sets
+        assert_eq!(mixed.len(), 2 * 6 * OUTSIDE.len());
+        assert!(mixed.iter().all(|c| c.truth.class() == "mixed"));
+        let c = &mixed[mixed.len() - 1];
+        assert_eq!(c.split, Split::Eval);
+        assert_eq!(c.truth.label(), "sensor_gain+outside:spring_cubic");
+        let e = c.truth.expected();
+        assert!(is_right(&e, "unexplained"));
+        assert!(is_right(&e, "sensor_gain+remainder"));
+        assert!(!is_right(&e, "sensor_gain"), "explained away");
+        assert!(!is_right(&e, "coulomb+sensor_gain+remainder"));
+        // a named set with a remainder is the set for the other classes
+        assert!(is_right("leak", "leak+remainder"));
+        assert!(!is_right("leak", "coulomb+leak"));
     }
 
     #[test]

@@ -54,16 +54,27 @@ pub fn rig_config(opts: &VerdictOptions, c: &Planned) -> RigConfig {
                 .collect(),
             ..base
         },
-        Truth::Outside { name, strength } => {
-            let set = outside(name)
-                .map(|o| vec![format!("{}={}", o.param, strength * o.typical)])
-                .unwrap_or_default();
-            RigConfig {
-                truth: Some(name.clone()),
-                set,
-                ..base
-            }
-        }
+        Truth::Mixed {
+            effect,
+            outside: name,
+            strength,
+        } => RigConfig {
+            effects: verdict_settings(effect, *strength),
+            ..outside_config(base, name, *strength)
+        },
+        Truth::Outside { name, strength } => outside_config(base, name, *strength),
+    }
+}
+
+/// The rig of outside cause `name` at `strength` times its unit.
+fn outside_config(base: RigConfig, name: &str, strength: f64) -> RigConfig {
+    let set = outside(name)
+        .map(|o| vec![format!("{}={}", o.param, strength * o.typical)])
+        .unwrap_or_default();
+    RigConfig {
+        truth: Some(name.to_string()),
+        set,
+        ..base
     }
 }
 
@@ -76,15 +87,19 @@ pub fn record(opts: &VerdictOptions, c: &Planned, dir: &Path) -> Result<Measured
             source,
         })
     };
-    if let Truth::Pair { names, .. } = &c.truth {
-        if names.iter().any(|n| n == "end_stops") {
-            let partner = RigConfig {
-                effects: without_stops(&cfg.effects),
-                ..cfg.clone()
-            };
-            let sig = signature(&run(&partner)?.data);
-            cfg.effects = stops_inside(&cfg.effects, &sig);
-        }
+    // the stops inside the stroke the partner (a library effect or an outside cause) leaves
+    let stops_beside = match &c.truth {
+        Truth::Pair { names, .. } => names.iter().any(|n| n == "end_stops"),
+        Truth::Mixed { effect, .. } => effect == "end_stops",
+        _ => false,
+    };
+    if stops_beside {
+        let partner = RigConfig {
+            effects: without_stops(&cfg.effects),
+            ..cfg.clone()
+        };
+        let sig = signature(&run(&partner)?.data);
+        cfg.effects = stops_inside(&cfg.effects, &sig);
     }
     through_csv(run(&cfg)?, dir, c.index)
 }

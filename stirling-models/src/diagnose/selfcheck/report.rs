@@ -3,6 +3,7 @@
 use std::path::{Path, PathBuf};
 
 use super::outcome::Outcome;
+use super::plan::is_right;
 use super::verdicts::VerdictCheck;
 use crate::diagnose::DiagnoseError;
 
@@ -20,7 +21,7 @@ fn pct(v: f64) -> String {
 
 /// One case as a table row (and a progress line).
 pub fn case_row(c: &Outcome) -> String {
-    let right = if c.tuned_verdict == c.expected {
+    let right = if is_right(&c.expected, &c.tuned_verdict) {
         "right"
     } else {
         "WRONG"

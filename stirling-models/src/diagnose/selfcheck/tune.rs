@@ -8,6 +8,7 @@
 use serde::Serialize;
 
 use super::outcome::Outcome;
+use super::plan::is_right;
 use crate::diagnose::verdict::{Thresholds, MIN_CLOSURE, STRONG_BIC};
 
 /// The tuning result.
@@ -45,7 +46,7 @@ fn score(cases: &[&Outcome], th: &Thresholds) -> (usize, usize, usize) {
     let mut out = (0, 0, 0);
     for c in cases {
         let v = c.relabel(th);
-        out.0 += usize::from(v == c.expected);
+        out.0 += usize::from(is_right(&c.expected, &v));
         if c.label == "clean" {
             out.2 += 1;
             out.1 += usize::from(v != "no_significant_gap");

@@ -17,6 +17,7 @@
 mod models;
 mod sites;
 
+pub(crate) use models::nsection_fx_engine;
 pub use models::{
     Cv1Fx, Cv1FxParams, NSectionExtFx, NSectionExtFxParams, NSectionFx, NSectionFxParams,
 };

@@ -86,6 +86,8 @@ stirling_macros::stirling_model! {
         effect leak cold -> bounce as Gleak;
     }
 }
+// the base by path, for the outside causes' truth models (`model/outside.rs`)
+pub(crate) use nsection_fx_engine;
 
 stirling_macros::stirling_model! {
     /// `nsection` with all DSL-expressible effects (leak, Coulomb friction, end stops,
