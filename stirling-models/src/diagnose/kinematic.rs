@@ -325,23 +325,6 @@ pub(super) fn candidate_pool(
     if StateLayout::flywheels(model).is_empty() {
         return pool;
     }
-    static CACHE: OnceLock<Mutex<HashMap<String, Vec<&'static EffectInfo>>>> = OnceLock::new();
-    let names: Vec<&str> = pool.iter().map(|e| e.name).collect();
-    let key = format!(
-        "{}#{}#{}",
-        model.name(),
-        model.params().len(),
-        names.join(",")
-    );
-    let cache = CACHE.get_or_init(Default::default);
-    let mut cache = cache.lock().unwrap_or_else(|e| e.into_inner());
-    cache
-        .entry(key)
-        .or_insert_with(|| kinematic_pool(model, &pool))
-        .clone()
-}
-
-fn kinematic_pool(model: &dyn Model, pool: &[&'static EffectInfo]) -> Vec<&'static EffectInfo> {
     let declared_lag = |e: &EffectInfo| {
         e.name != "sensor_lag"
             && e.target == EffectTarget::Sensor
@@ -354,19 +337,7 @@ fn kinematic_pool(model: &dyn Model, pool: &[&'static EffectInfo]) -> Vec<&'stat
             if e.target != EffectTarget::Model {
                 return e;
             }
-            let params: Vec<EffectParam> = e
-                .params
-                .iter()
-                .map(|q| {
-                    let own = model.params().iter().find(|i| {
-                        q.null.is_some() && i.name != q.name && i.unit == q.unit && i.default > 0.0
-                    });
-                    EffectParam {
-                        typical: own.map_or(q.typical, |i| i.default),
-                        ..*q
-                    }
-                })
-                .collect();
+            let params = own_typicals(model, e);
             if params
                 .iter()
                 .zip(e.params)
@@ -374,11 +345,46 @@ fn kinematic_pool(model: &dyn Model, pool: &[&'static EffectInfo]) -> Vec<&'stat
             {
                 return e;
             }
-            let info = EffectInfo {
-                params: Box::leak(params.into_boxed_slice()),
-                ..*e
-            };
-            &*Box::leak(Box::new(info))
+            rescaled(e, params)
         })
         .collect()
+}
+
+/// The effect's parameters with each strength's typical value taken from the model's own
+/// parameter of the same unit (the first with a positive default).
+fn own_typicals(model: &dyn Model, e: &EffectInfo) -> Vec<EffectParam> {
+    e.params
+        .iter()
+        .map(|q| {
+            let own = model.params().iter().find(|i| {
+                q.null.is_some() && i.name != q.name && i.unit == q.unit && i.default > 0.0
+            });
+            EffectParam {
+                typical: own.map_or(q.typical, |i| i.default),
+                ..*q
+            }
+        })
+        .collect()
+}
+
+/// `e` with `params`, made `'static` once per distinct content (the library's effects are
+/// `'static`; a process that diagnoses many engines keeps one copy of each rescaling, keyed
+/// by the effect and its typical values bit for bit, so two engines of one name but other
+/// defaults never share a stale one).
+fn rescaled(e: &'static EffectInfo, params: Vec<EffectParam>) -> &'static EffectInfo {
+    static CACHE: OnceLock<Mutex<HashMap<String, &'static EffectInfo>>> = OnceLock::new();
+    let bits: Vec<String> = params
+        .iter()
+        .map(|q| format!("{:x}", q.typical.to_bits()))
+        .collect();
+    let key = format!("{}#{}", e.name, bits.join(","));
+    let cache = CACHE.get_or_init(Default::default);
+    let mut cache = cache.lock().unwrap_or_else(|e| e.into_inner());
+    cache.entry(key).or_insert_with(|| {
+        let info = EffectInfo {
+            params: Box::leak(params.into_boxed_slice()),
+            ..*e
+        };
+        &*Box::leak(Box::new(info))
+    })
 }
