@@ -143,15 +143,19 @@ fn forms(n: usize, t: Triplets) -> (Option<Vec<Vec<f64>>>, Option<Triplets>) {
 fn system(a: Triplets, b: &DVector<f64>, c: &DVector<f64>, poles: &[Pole]) -> StateSpace {
     let n = a.rows;
     let (a, a_sparse) = forms(n, a);
-    let (b, b_sparse) = forms(n, Triplets::column(b));
-    let (c, c_sparse) = forms(n, Triplets::row(c));
+    // dense `b`, `c` straight from the vectors (their signed zeros kept, as before triplets)
+    let dense = n <= DENSE_UP_TO;
+    let b_dense = dense.then(|| b.iter().map(|v| vec![*v]).collect());
+    let c_dense = dense.then(|| vec![c.iter().copied().collect()]);
+    let b_sparse = (n >= SPARSE_FROM).then(|| Triplets::column(b));
+    let c_sparse = (n >= SPARSE_FROM).then(|| Triplets::row(c));
     let (d, d_sparse) = forms(n, Triplets::new(1, 1));
     StateSpace {
         a,
         a_sparse,
-        b,
+        b: b_dense,
         b_sparse,
-        c,
+        c: c_dense,
         c_sparse,
         d,
         d_sparse,
@@ -176,7 +180,9 @@ fn jacobian_and_open_loop(lin: &Linearization, n: usize) -> (Entries, Entries) {
     let ol = &lin.open_loop.full;
     let j: Entries = match &lin.dynamics.sparse {
         Some(sp) => sp.entries.clone(),
-        None => Triplets::of_dense(&lin.dynamics.jacobian).entries().collect(),
+        None => Triplets::of_dense(&lin.dynamics.jacobian)
+            .entries()
+            .collect(),
     };
     if ol.a.nrows() == n {
         return (j, Triplets::of_dense(&ol.a).entries().collect());

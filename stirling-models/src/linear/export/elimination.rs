@@ -31,7 +31,10 @@ impl Elimination {
         let mut is = vec![false; n];
         mass.iter().for_each(|&i| is[i] = true);
         let (keep, last): (Vec<usize>, _) = match mass.last() {
-            Some(&l) => ((0..n).filter(|&i| i != l).collect(), Some((l, mass.to_vec()))),
+            Some(&l) => (
+                (0..n).filter(|&i| i != l).collect(),
+                Some((l, mass.to_vec())),
+            ),
             None => ((0..n).collect(), None),
         };
         let mass = if last.is_some() {
@@ -140,7 +143,10 @@ mod tests {
         // the mass states' rows of T sum to zero: x - x* = T z never changes the charge
         let charge = t.row(1) + t.row(3);
         assert!(charge.iter().all(|v| *v == 0.0), "{charge}");
-        assert_eq!(t.row(3).iter().copied().collect::<Vec<_>>(), vec![0.0, -1.0, 0.0]);
+        assert_eq!(
+            t.row(3).iter().copied().collect::<Vec<_>>(),
+            vec![0.0, -1.0, 0.0]
+        );
     }
 
     #[test]

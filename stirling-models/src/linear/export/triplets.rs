@@ -100,10 +100,19 @@ mod tests {
     fn vectors_keep_their_nonzeros_and_shape() {
         let v = DVector::from_vec(vec![0.0, 2.0, 0.0, -1.5]);
         let (c, r) = (Triplets::column(&v), Triplets::row(&v));
-        assert_eq!((c.rows, c.cols, c.i.clone(), c.j.clone()), (4, 1, vec![1, 3], vec![0, 0]));
-        assert_eq!((r.rows, r.cols, r.i.clone(), r.j.clone()), (1, 4, vec![0, 0], vec![1, 3]));
+        assert_eq!(
+            (c.rows, c.cols, c.i.clone(), c.j.clone()),
+            (4, 1, vec![1, 3], vec![0, 0])
+        );
+        assert_eq!(
+            (r.rows, r.cols, r.i.clone(), r.j.clone()),
+            (1, 4, vec![0, 0], vec![1, 3])
+        );
         assert_eq!(c.v, vec![2.0, -1.5]);
-        assert_eq!(c.dense_rows(), vec![vec![0.0], vec![2.0], vec![0.0], vec![-1.5]]);
+        assert_eq!(
+            c.dense_rows(),
+            vec![vec![0.0], vec![2.0], vec![0.0], vec![-1.5]]
+        );
         assert_eq!(r.dense_rows(), vec![v.iter().copied().collect::<Vec<_>>()]);
         assert_eq!(c.format, FORMAT);
     }
@@ -112,7 +121,10 @@ mod tests {
     fn dense_round_trip_is_exact() {
         let m = DMatrix::from_row_slice(2, 3, &[0.0, 1.25, 0.0, -3.0, 0.0, 7.0]);
         let t = Triplets::of_dense(&m);
-        assert_eq!(t.entries().collect::<Vec<_>>(), vec![(0, 1, 1.25), (1, 0, -3.0), (1, 2, 7.0)]);
+        assert_eq!(
+            t.entries().collect::<Vec<_>>(),
+            vec![(0, 1, 1.25), (1, 0, -3.0), (1, 2, 7.0)]
+        );
         assert_eq!(t.dense(), m);
         let empty = Triplets::new(1, 1);
         assert_eq!(empty.dense_rows(), vec![vec![0.0]]);
