@@ -17,8 +17,10 @@
 //! [`DENSE_UP_TO`](crate::linear::export::DENSE_UP_TO) only so (the dense fields are `null`).
 //! Nothing is built dense then: `A` comes from the Jacobian's nonzeros (the sparse route's
 //! triplets), the broken loop's `A0 = J - B C` adds the rank-one product of the nonzeros of `B`
-//! and `C`, and the elimination (a private module) works on nonzeros too; below 200 states the
-//! file is as before (no sparse field).
+//! and `C`, and the elimination (a private module) works on nonzeros too. (On the dense route,
+//! below 401 states or with `--all-poles`, the linearization holds `J` dense already and its
+//! nonzeros are read from it.) Below 200 states the file is as before: `a_sparse` is `null` and
+//! no other sparse field is written.
 
 mod elimination;
 mod triplets;
