@@ -185,3 +185,89 @@ fn large_models_add_a_sparse_form() {
     assert!(nnz > n && nnz < n * n / 10, "{nnz} nonzeros of {n}^2");
     assert_eq!(matrix(&bl["a"]).len(), n);
 }
+
+/// The keys of an object.
+fn keys(v: &Value) -> Vec<&str> {
+    v.as_object().unwrap().keys().map(|k| k.as_str()).collect()
+}
+
+#[test]
+fn below_200_states_no_sparse_field_is_written() {
+    let out = stirling(&["linearize", "nsection", "--n", "95", "--json"]);
+    assert!(out.status.success());
+    let r: Value = serde_json::from_slice(&out.stdout).unwrap();
+    let e = &r["state_space"];
+    assert_eq!(r["n_states"], 198);
+    assert!(!keys(e).contains(&"basis_sparse"));
+    let bl = &e["broken_loop"];
+    assert!(bl["a_sparse"].is_null());
+    for k in ["b_sparse", "c_sparse", "d_sparse"] {
+        assert!(!keys(bl).contains(&k), "{k}");
+    }
+    assert_eq!(matrix(&bl["b"]).len(), 197);
+}
+
+/// Triplets as a dense matrix.
+fn from_triplets(t: &Value) -> Vec<Vec<f64>> {
+    let n = |k: &str| t[k].as_u64().unwrap() as usize;
+    let mut m = vec![vec![0.0; n("cols")]; n("rows")];
+    let (i, j, v) = (
+        t["i"].as_array().unwrap(),
+        t["j"].as_array().unwrap(),
+        t["v"].as_array().unwrap(),
+    );
+    assert!(i.len() == j.len() && j.len() == v.len());
+    for k in 0..v.len() {
+        let (r, c) = (
+            i[k].as_u64().unwrap() as usize,
+            j[k].as_u64().unwrap() as usize,
+        );
+        assert_eq!(m[r][c], 0.0, "({r}, {c}) repeated");
+        m[r][c] = v[k].as_f64().unwrap();
+    }
+    m
+}
+
+#[test]
+fn above_500_states_only_triplets_and_closed_is_broken_minus_bc() {
+    let out = stirling(&["linearize", "nsection", "--n", "250", "--json"]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let r: Value = serde_json::from_slice(&out.stdout).unwrap();
+    let e = &r["state_space"];
+    assert_eq!(r["n_states"], 508);
+    assert!(e["basis"].is_null());
+    let t = from_triplets(&e["basis_sparse"]);
+    assert_eq!((t.len(), t[0].len()), (508, 507));
+    let (bl, cl) = (&e["broken_loop"], &e["closed_loop"]);
+    for k in ["a", "b", "c", "d"] {
+        assert!(
+            bl[k].is_null() && cl[k].is_null(),
+            "{k} dense above 500 states"
+        );
+        let f = bl[format!("{k}_sparse")]["format"].as_str().unwrap();
+        assert!(
+            f.starts_with("triplets, 0-based: entry k is row i[k], column j[k]"),
+            "{f}"
+        );
+    }
+    let (a0, b, c) = (
+        from_triplets(&bl["a_sparse"]),
+        from_triplets(&bl["b_sparse"]),
+        from_triplets(&bl["c_sparse"]),
+    );
+    assert_eq!((b.len(), b[0].len(), c.len(), c[0].len()), (507, 1, 1, 507));
+    assert_eq!(from_triplets(&bl["d_sparse"]), vec![vec![0.0]]);
+    assert_eq!(from_triplets(&cl["b_sparse"]), b);
+    let a = from_triplets(&cl["a_sparse"]);
+    let scale = a.iter().flatten().fold(0.0f64, |m, v| m.max(v.abs()));
+    for i in 0..507 {
+        for j in 0..507 {
+            let want = a0[i][j] - b[i][0] * c[0][j];
+            assert!((a[i][j] - want).abs() <= 1e-12 * scale, "{i},{j}");
+        }
+    }
+}

@@ -8,14 +8,29 @@
 //! last mass state (`m_last - m_last* = -` the sum of the other mass deviations at constant
 //! charge): the coordinates keep the model's state names and `A` keeps its sparsity, and it is
 //! similar to the orthogonal reduction of [`crate::linear::reduce`]. `basis` gives `T` with `x - x*
-//! = T z`. From [`SPARSE_FROM`](crate::linear::export::SPARSE_FROM) states on `A` is also written
-//! as triplets, above [`DENSE_UP_TO`](crate::linear::export::DENSE_UP_TO) only so.
+//! = T z`.
+//!
+//! Size: from [`SPARSE_FROM`](crate::linear::export::SPARSE_FROM) states on `A`, `B`, `C`, `D`
+//! and `T` are also written as triplets (`a_sparse`, `b_sparse`, `c_sparse`, `d_sparse`,
+//! `basis_sparse`; 0-based, row-major, each stating
+//! [`FORMAT`](crate::linear::export::FORMAT)), above
+//! [`DENSE_UP_TO`](crate::linear::export::DENSE_UP_TO) only so (the dense fields are `null`).
+//! Nothing is built dense then: `A` comes from the Jacobian's nonzeros (the sparse route's
+//! triplets), the broken loop's `A0 = J - B C` adds the rank-one product of the nonzeros of `B`
+//! and `C`, and the elimination (a private module) works on nonzeros too. (On the dense route,
+//! below 401 states or with `--all-poles`, the linearization holds `J` dense already and its
+//! nonzeros are read from it.) Below 200 states the file is as before: `a_sparse` is `null` and
+//! no other sparse field is written.
 
-use nalgebra::{DMatrix, DVector};
+mod elimination;
+mod triplets;
+
+use nalgebra::DVector;
 use serde::{Deserialize, Serialize};
 use stirling_dsl::Model;
 
-use super::equilibrium::mass_states;
+use self::elimination::Elimination;
+pub use self::triplets::{Triplets, FORMAT};
 use super::{Linearization, Pole};
 
 /// The largest state count written as dense matrices.
@@ -25,16 +40,6 @@ pub const SPARSE_FROM: usize = 200;
 
 /// The sign convention, in words.
 pub const CONVENTION: &str = "x' = A x + B u, y = C x + D u; the loop closes with negative unity feedback u = -y, so closed_loop.a = broken_loop.a - B C; margins of broken_loop as MATLAB's margin and python-control's control.margin";
-
-/// A sparse matrix: 0-based row and column indices and the nonzero values.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct Triplets {
-    pub rows: usize,
-    pub cols: usize,
-    pub i: Vec<usize>,
-    pub j: Vec<usize>,
-    pub v: Vec<f64>,
-}
 
 /// One row of the pole table (MATLAB's `damp`).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -49,19 +54,30 @@ pub struct Damp {
     pub time_constant_s: Option<f64>,
 }
 
-/// A single-input single-output state-space system.
+/// A single-input single-output state-space system. Up to [`DENSE_UP_TO`] states `a, b, c, d`
+/// are dense; from [`SPARSE_FROM`] states on the same matrices are also written as triplets
+/// (`a_sparse`, `b_sparse`, ...); above [`DENSE_UP_TO`] only so (the dense fields are `null`).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct StateSpace {
-    /// `A` by rows (absent above [`DENSE_UP_TO`] states).
+    /// `A` by rows.
     pub a: Option<Vec<Vec<f64>>>,
-    /// `A` as triplets (from [`SPARSE_FROM`] states on).
+    /// `A` as triplets.
     pub a_sparse: Option<Triplets>,
     /// `B`, one column.
-    pub b: Vec<Vec<f64>>,
+    pub b: Option<Vec<Vec<f64>>>,
+    /// `B` as triplets (`n x 1`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub b_sparse: Option<Triplets>,
     /// `C`, one row.
-    pub c: Vec<Vec<f64>>,
+    pub c: Option<Vec<Vec<f64>>>,
+    /// `C` as triplets (`1 x n`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub c_sparse: Option<Triplets>,
     /// `D` (1 x 1).
-    pub d: Vec<Vec<f64>>,
+    pub d: Option<Vec<Vec<f64>>>,
+    /// `D` as triplets (`1 x 1`, no entry: zero).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub d_sparse: Option<Triplets>,
     pub input: String,
     pub output: String,
     /// Poles with natural frequency and damping ratio, least stable first.
@@ -97,36 +113,12 @@ pub struct StateSpaceExport {
     /// `T` by rows (full x reduced) with `x - x* = T z`; absent without reduction or above
     /// [`DENSE_UP_TO`] states.
     pub basis: Option<Vec<Vec<f64>>>,
+    /// `T` as triplets (from [`SPARSE_FROM`] states on, with reduction).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub basis_sparse: Option<Triplets>,
     pub broken_loop: StateSpace,
     pub closed_loop: StateSpace,
     pub bode: BodeData,
-}
-
-fn rows(m: &DMatrix<f64>) -> Vec<Vec<f64>> {
-    (0..m.nrows())
-        .map(|i| m.row(i).iter().copied().collect())
-        .collect()
-}
-
-fn triplets(m: &DMatrix<f64>) -> Triplets {
-    let mut t = Triplets {
-        rows: m.nrows(),
-        cols: m.ncols(),
-        i: Vec::new(),
-        j: Vec::new(),
-        v: Vec::new(),
-    };
-    for i in 0..m.nrows() {
-        for j in 0..m.ncols() {
-            let v = m[(i, j)];
-            if v != 0.0 {
-                t.i.push(i);
-                t.j.push(j);
-                t.v.push(v);
-            }
-        }
-    }
-    t
 }
 
 fn damp(p: &[Pole]) -> Vec<Damp> {
@@ -141,129 +133,37 @@ fn damp(p: &[Pole]) -> Vec<Damp> {
         .collect()
 }
 
-/// A matrix's nonzeros, row-major (the dense route's matrices).
-fn entries(m: &DMatrix<f64>) -> Vec<(usize, usize, f64)> {
-    let t = triplets(m);
-    (0..t.v.len()).map(|k| (t.i[k], t.j[k], t.v[k])).collect()
-}
-
-/// The dense form of triplets (small systems only).
-fn dense(t: &Triplets) -> DMatrix<f64> {
-    let mut m = DMatrix::zeros(t.rows, t.cols);
-    for k in 0..t.v.len() {
-        m[(t.i[k], t.j[k])] += t.v[k];
-    }
-    m
+/// A matrix of `n` states (rows of `A`, `B`; columns of `C`; `T`) as the export writes it: dense
+/// up to [`DENSE_UP_TO`], triplets from [`SPARSE_FROM`].
+fn forms(n: usize, t: Triplets) -> (Option<Vec<Vec<f64>>>, Option<Triplets>) {
+    (
+        (n <= DENSE_UP_TO).then(|| t.dense_rows()),
+        (n >= SPARSE_FROM).then_some(t),
+    )
 }
 
 fn system(a: Triplets, b: &DVector<f64>, c: &DVector<f64>, poles: &[Pole]) -> StateSpace {
     let n = a.rows;
+    let (a, a_sparse) = forms(n, a);
+    // dense `b`, `c` straight from the vectors (their signed zeros kept, as before triplets)
+    let dense = n <= DENSE_UP_TO;
+    let b_dense = dense.then(|| b.iter().map(|v| vec![*v]).collect());
+    let c_dense = dense.then(|| vec![c.iter().copied().collect()]);
+    let b_sparse = (n >= SPARSE_FROM).then(|| Triplets::column(b));
+    let c_sparse = (n >= SPARSE_FROM).then(|| Triplets::row(c));
+    let (d, d_sparse) = forms(n, Triplets::new(1, 1));
     StateSpace {
-        a: (n <= DENSE_UP_TO).then(|| rows(&dense(&a))),
-        a_sparse: (n >= SPARSE_FROM).then_some(a),
-        b: b.iter().map(|v| vec![*v]).collect(),
-        c: vec![c.iter().copied().collect()],
-        d: vec![vec![0.0]],
+        a,
+        a_sparse,
+        b: b_dense,
+        b_sparse,
+        c: c_dense,
+        c_sparse,
+        d,
+        d_sparse,
         input: String::new(),
         output: String::new(),
         poles: damp(poles),
-    }
-}
-
-/// Elimination of the last mass state: kept states, and the eliminated one with the others.
-struct Elimination {
-    keep: Vec<usize>,
-    /// Eliminated state and the mass states (it included).
-    last: Option<(usize, Vec<usize>)>,
-    /// Per kept coordinate: whether it is a mass state.
-    mass: Vec<bool>,
-}
-
-impl Elimination {
-    fn new(model: &dyn Model) -> Self {
-        let n = model.n_states();
-        let mass = mass_states(model);
-        let mut is = vec![false; n];
-        mass.iter().for_each(|&i| is[i] = true);
-        let (keep, last): (Vec<usize>, _) = match mass.last() {
-            Some(&l) => ((0..n).filter(|&i| i != l).collect(), Some((l, mass))),
-            None => ((0..n).collect(), None),
-        };
-        let mass = if last.is_some() {
-            keep.iter().map(|&i| is[i]).collect()
-        } else {
-            vec![false; keep.len()]
-        };
-        Self { keep, last, mass }
-    }
-
-    /// `-1` where the kept coordinate `j` is a mass state (the eliminated state's row of `T`).
-    fn is_mass(&self, j: usize) -> bool {
-        self.mass[j]
-    }
-
-    /// `P A T` from the nonzeros of `A` (`n x n`), as row-major triplets: no dense matrix, so
-    /// the export of n = 10,000 sections (20,004 states) stays linear in the nonzeros.
-    fn a(&self, n: usize, a: &[(usize, usize, f64)]) -> Triplets {
-        let m = self.keep.len();
-        let mut pos = vec![None; n];
-        for (k, &i) in self.keep.iter().enumerate() {
-            pos[i] = Some(k);
-        }
-        let mass_cols: Vec<usize> = (0..m).filter(|&j| self.is_mass(j)).collect();
-        let last = self.last.as_ref().map(|(l, _)| *l);
-        let mut acc: std::collections::BTreeMap<(usize, usize), f64> = Default::default();
-        for &(r, c, v) in a {
-            let Some(i) = pos[r] else { continue };
-            if let Some(j) = pos[c] {
-                *acc.entry((i, j)).or_default() += v;
-            }
-            if Some(c) == last {
-                for &j in &mass_cols {
-                    *acc.entry((i, j)).or_default() -= v;
-                }
-            }
-        }
-        let mut t = Triplets {
-            rows: m,
-            cols: m,
-            i: Vec::new(),
-            j: Vec::new(),
-            v: Vec::new(),
-        };
-        for ((i, j), v) in acc.into_iter().filter(|(_, v)| *v != 0.0) {
-            t.i.push(i);
-            t.j.push(j);
-            t.v.push(v);
-        }
-        t
-    }
-
-    /// `P b`.
-    fn b(&self, b: &DVector<f64>) -> DVector<f64> {
-        DVector::from_iterator(self.keep.len(), self.keep.iter().map(|&i| b[i]))
-    }
-
-    /// `(c' T)'`.
-    fn c(&self, c: &DVector<f64>) -> DVector<f64> {
-        DVector::from_fn(self.keep.len(), |j, _| match &self.last {
-            Some((l, _)) if self.is_mass(j) => c[self.keep[j]] - c[*l],
-            _ => c[self.keep[j]],
-        })
-    }
-
-    /// `T` (full x kept).
-    fn basis(&self, n: usize) -> DMatrix<f64> {
-        let m = self.keep.len();
-        DMatrix::from_fn(n, m, |i, j| {
-            if i == self.keep[j] {
-                1.0
-            } else if self.last.as_ref().is_some_and(|(l, _)| *l == i) && self.is_mass(j) {
-                -1.0
-            } else {
-                0.0
-            }
-        })
     }
 }
 
@@ -276,37 +176,50 @@ fn nonzeros(v: &DVector<f64>) -> Vec<(usize, f64)> {
         .collect()
 }
 
+/// The nonzeros of the full `J` and `A0 = J - B C`: the sparse route never forms them dense, and
+/// `B C` is a rank-one update of the nonzeros of `B` times those of `C`.
+fn jacobian_and_open_loop(lin: &Linearization, n: usize) -> (Entries, Entries) {
+    let ol = &lin.open_loop.full;
+    let j: Entries = match &lin.dynamics.sparse {
+        Some(sp) => sp.entries.clone(),
+        None => Triplets::of_dense(&lin.dynamics.jacobian)
+            .entries()
+            .collect(),
+    };
+    if ol.a.nrows() == n {
+        return (j, Triplets::of_dense(&ol.a).entries().collect());
+    }
+    let (bi, ci) = (nonzeros(&ol.b), nonzeros(&ol.c));
+    let mut a0 = j.clone();
+    for &(r, bv) in &bi {
+        a0.extend(ci.iter().map(|&(c, cv)| (r, c, -bv * cv)));
+    }
+    (j, a0)
+}
+
+/// Matrix nonzeros `(i, j, v)`, 0-based.
+type Entries = Vec<(usize, usize, f64)>;
+
 /// The export of a linearization.
 pub fn export(model: &dyn Model, lin: &Linearization) -> StateSpaceExport {
     let ol = &lin.open_loop;
     let names = model.state_names();
+    let n = names.len();
     let el = Elimination::new(model);
     let (b, k) = (el.b(&ol.full.b), el.c(&ol.full.k()));
     let input = format!("{} ({})", ol.full.name, ol.full.unit);
     let output = format!("K x, fed back as u = -K x ({})", ol.full.unit);
-    // `J` and `A0 = J - b c'` by their nonzeros: the sparse route never forms them dense
-    let n = names.len();
-    let j: Vec<(usize, usize, f64)> = match &lin.dynamics.sparse {
-        Some(sp) => sp.entries.clone(),
-        None => entries(&lin.dynamics.jacobian),
-    };
-    let a0: Vec<(usize, usize, f64)> = if ol.full.a.nrows() == n {
-        entries(&ol.full.a)
-    } else {
-        let (bi, ci) = (nonzeros(&ol.full.b), nonzeros(&ol.full.c));
-        let mut a0 = j.clone();
-        for &(r, bv) in &bi {
-            a0.extend(ci.iter().map(|&(c, cv)| (r, c, -bv * cv)));
-        }
-        a0
-    };
+    let (j, a0) = jacobian_and_open_loop(lin, n);
     let mut broken = system(el.a(n, &a0), &b, &k, &ol.poles);
     broken.input = format!("u: {input}");
     broken.output = output.clone();
     let mut closed = system(el.a(n, &j), &b, &k, &lin.dynamics.poles);
     closed.input = format!("disturbance added to {input}");
     closed.output = output;
-    let bode = lin.bode();
+    let (basis, basis_sparse) = match el.last {
+        Some(_) => forms(n, el.basis(n)),
+        None => (None, None),
+    };
     StateSpaceExport {
         model: model.name().to_string(),
         n: model.n(),
@@ -321,17 +234,22 @@ pub fn export(model: &dyn Model, lin: &Linearization) -> StateSpaceExport {
             None => "none: no conserved inventory among the states".into(),
         },
         states: el.keep.iter().map(|&i| names[i].clone()).collect(),
-        basis: (el.last.is_some() && names.len() <= DENSE_UP_TO)
-            .then(|| rows(&el.basis(names.len()))),
+        basis,
+        basis_sparse,
         full_states: names,
         equilibrium: lin.dynamics.equilibrium.x.clone(),
         broken_loop: broken,
         closed_loop: closed,
-        bode: BodeData {
-            magnitude: bode.mag_db.iter().map(|db| 10f64.powf(db / 20.0)).collect(),
-            w_rad_s: bode.w,
-            magnitude_db: bode.mag_db,
-            phase_deg: bode.phase_deg,
-        },
+        bode: bode_data(lin),
+    }
+}
+
+fn bode_data(lin: &Linearization) -> BodeData {
+    let bode = lin.bode();
+    BodeData {
+        magnitude: bode.mag_db.iter().map(|db| 10f64.powf(db / 20.0)).collect(),
+        w_rad_s: bode.w,
+        magnitude_db: bode.mag_db,
+        phase_deg: bode.phase_deg,
     }
 }

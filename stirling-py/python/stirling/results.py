@@ -279,31 +279,36 @@ class StateSpace(Fields):
 
     __slots__ = ("_states",)
 
-    @property
-    def A(self) -> np.ndarray:  # noqa: N802 (the control engineer's name)
-        """The state matrix (1/s), dense (also above 500 states, from its triplets)."""
-        a = self._raw.get("a")
-        if a is not None:
-            return np.asarray(a, dtype=float).reshape(len(self._raw["b"]), -1)
-        t = self._raw["a_sparse"]
+    def _matrix(self, key: str, shape: Tuple[int, int]) -> np.ndarray:
+        """The dense field ``key``, or above 500 states its triplets (``key_sparse``) made dense."""
+        m = self._raw.get(key)
+        if m is not None:
+            return np.asarray(m, dtype=float).reshape(shape)
+        t = self._raw[key + "_sparse"]
         out = np.zeros((t["rows"], t["cols"]))
-        np.add.at(out, (np.asarray(t["i"]), np.asarray(t["j"])), np.asarray(t["v"], dtype=float))
+        np.add.at(out, (np.asarray(t["i"], dtype=int), np.asarray(t["j"], dtype=int)), np.asarray(t["v"], dtype=float))
         return out
 
     @property
+    def A(self) -> np.ndarray:  # noqa: N802 (the control engineer's name)
+        """The state matrix (1/s), dense (also above 500 states, from its triplets)."""
+        n = len(self._states)
+        return self._matrix("a", (n, n))
+
+    @property
     def B(self) -> np.ndarray:  # noqa: N802
-        """The input column (n x 1)."""
-        return np.asarray(self._raw["b"], dtype=float).reshape(-1, 1)
+        """The input column (n x 1), dense (also above 500 states, from its triplets)."""
+        return self._matrix("b", (len(self._states), 1))
 
     @property
     def C(self) -> np.ndarray:  # noqa: N802
-        """The output row (1 x n)."""
-        return np.asarray(self._raw["c"], dtype=float).reshape(1, -1)
+        """The output row (1 x n), dense (also above 500 states, from its triplets)."""
+        return self._matrix("c", (1, len(self._states)))
 
     @property
     def D(self) -> np.ndarray:  # noqa: N802
         """The feedthrough (1 x 1)."""
-        return np.asarray(self._raw["d"], dtype=float).reshape(1, 1)
+        return self._matrix("d", (1, 1))
 
     @property
     def states(self) -> List[str]:
