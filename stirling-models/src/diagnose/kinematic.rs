@@ -114,7 +114,13 @@ pub(super) fn diagnose(
         .as_ref()
         .and_then(|n| refits.iter().find(|r| &r.entry.effect == n))
         .and_then(|r| r.held.as_ref());
-    d.verdict = verdict(&ranking, named.as_deref(), level, gap, held);
+    d.verdict = verdict(
+        &ranking,
+        named.as_deref(),
+        level,
+        (gap, nominal.err.len()),
+        held,
+    );
     if let (Some(name), Some(h)) = (&named, held) {
         let row = ranking.iter().find(|r| &r.effect == name).expect("named");
         d.steps = vec![step(row, h, data, &ranking)];
@@ -170,7 +176,7 @@ fn verdict(
     ranking: &[RankEntry],
     named: Option<&str>,
     level: f64,
-    gap: f64,
+    (gap, n_held): (f64, usize),
     held: Option<&HeldOut>,
 ) -> Verdict {
     let significant: Vec<&RankEntry> = ranking.iter().filter(|r| r.p_value < level).collect();
@@ -194,8 +200,13 @@ fn verdict(
     };
     match (named, top) {
         (Some(name), Some(r)) => {
-            let after = held.map_or(f64::NAN, HeldOut::mean);
-            let n = held.map_or(1.0, |h| h.err.len() as f64);
+            // a sensor effect is fitted on the driven stage itself (no refit): its entry's
+            // held-out error, on the same samples
+            let after = held
+                .map(HeldOut::mean)
+                .or(r.holdout_error)
+                .unwrap_or(f64::NAN);
+            let n = held.map_or(n_held, |h| h.err.len()).max(1) as f64;
             let remainder = after > 1.0 + 3.0 * (2.0 / n).sqrt();
             Verdict {
                 verdict: "effect".into(),

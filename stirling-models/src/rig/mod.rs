@@ -304,10 +304,17 @@ pub fn run(cfg: &RigConfig) -> Result<RigOutput, RigError> {
 /// Measure any model with its declared sensors (`sensor name: STATE "unit";`): the channels
 /// `cfg.channels` name (the seed's `p`, `p_hot`, `x`, `y` where the model has them, read as
 /// the family's rig reads them, then any other declared sensor), from a run of `model` at
-/// `p` (no effects: the truth is the model itself). A pressure sensor (unit `Pa`) gets
+/// `p` with `cfg.effects` (model settings and sensor distortions by name, as the command's
+/// `--effect`; an effect the model does not carry is refused). A pressure sensor (unit `Pa`) gets
 /// `offset_p` and `noise_p`, a position (`m`) no offset and `noise_x`.
 pub fn measure(model: &dyn Model, p: &[f64], cfg: &RigConfig) -> Result<Measured, RigError> {
-    measure_with(model, p, &EffectSettings::default(), cfg)
+    // the config's effects act (they were ignored: a lag asked for and a clean record
+    // returned): model settings on a copy of `p`, sensor effects on the readings
+    let base = model.name().trim_end_matches("_fx");
+    let fx = EffectSettings::parse_for(base, Some(model), &cfg.effects)?;
+    let mut p = p.to_vec();
+    fx.apply(model, &mut p)?;
+    measure_with(model, &p, &fx, cfg)
 }
 
 /// [`measure`] with the sensor effects of `fx` on the readings (a lag or gain named on a
