@@ -4,7 +4,7 @@
 //! truth with `Rf` x2 and `Gleak` x3 off the defaults, fitted from the defaults, the 95 %
 //! intervals of `hp`, `hs`, `Rf`, `Gleak` cover the truth; the stage's Jacobian matches finite
 //! differences; a record without the angle, with too few samples, with the angle in degrees
-//! read as rad, or a free flywheel parameter is refused by name.
+//! read as rad, of a standing engine, or a free flywheel parameter is refused by name.
 
 use std::path::Path;
 
@@ -196,6 +196,12 @@ fn a_record_without_the_angle_or_too_short_is_refused() {
     let ratio = turns / cycles;
     assert!((45.0..70.0).contains(&ratio), "{turns} rev/s, {cycles} Hz");
     assert!(e.to_string().contains("`theta [deg]`"), "{e}");
+    // a standing engine (the angle does not move): refused as such, not as a wrong unit
+    let mut standing = rec.clone();
+    standing.others[0].1.iter_mut().for_each(|v| *v = 0.3);
+    let e = refused(&standing, &opts);
+    assert!(matches!(e, FitError::KinematicStands { .. }), "{e:?}");
+    assert!(e.to_string().contains("the engine stands"), "{e}");
     // the flywheel's friction (the declared free parameters) is not fitted
     let e = refused(&rec, &FitOptions::default());
     let msg = e.to_string();

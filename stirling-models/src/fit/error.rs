@@ -139,6 +139,13 @@ pub enum FitError {
         names: String,
         gas: String,
     },
+    #[error("{file}: fit: the flywheel's angle `{angle}` turns {revolutions:.3} revolutions in the {seconds:.3} s of the training block: the engine stands (or stopped), and a kinematic engine's fit drives the gas with the measured motion; record it running, over at least a few revolutions (or the angle column is not the flywheel's)")]
+    KinematicStands {
+        file: String,
+        angle: String,
+        revolutions: f64,
+        seconds: f64,
+    },
     #[error("{file}: fit: the angle `{angle}` turns at {turns:.4} rev/s on the training block but the pressure `p` cycles at {cycles:.4} Hz: the angle must be in rad (or carry its unit, `{angle} [deg]`) and be of the same record")]
     KinematicSpeed {
         file: String,

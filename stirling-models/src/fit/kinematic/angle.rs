@@ -113,7 +113,13 @@ pub fn unwrap(a: &[f64]) -> Vec<f64> {
     out
 }
 
-/// Refuse an angle that turns at another rate than the pressure `p` cycles on the training
+/// Fewer revolutions than this on the training block: the engine stands (a stopped engine's
+/// pressure still "cycles" at its noise's or its decay's rate, which the speed check would
+/// blame on the angle's unit).
+const MIN_REVOLUTIONS: f64 = 1.0;
+
+/// Refuse an angle that turns less than [`MIN_REVOLUTIONS`] on the training block, or at
+/// another rate than the pressure `p` cycles on the training
 /// block `tr` (inclusive sample indices, interval `dt`).
 pub fn check_speed(
     angle: &Angle,
@@ -124,6 +130,14 @@ pub fn check_speed(
     let a = &angle.data;
     let seconds = (tr.1 - tr.0) as f64 * dt;
     let turns = (a[tr.1] - a[tr.0]).abs() / std::f64::consts::TAU / seconds;
+    if turns * seconds < MIN_REVOLUTIONS {
+        return Err(FitError::KinematicStands {
+            file: data.source.clone(),
+            angle: angle.name.clone(),
+            revolutions: turns * seconds,
+            seconds,
+        });
+    }
     let Some(cycles) = record_frequency(data, tr, dt) else {
         return Ok(()); // the excitation check names a record without a cycle
     };
