@@ -168,10 +168,10 @@ fn rank(ranking: &mut [RankEntry], level: f64) {
     });
 }
 
-/// The verdict: the named effect, or `no_significant_gap` when no candidate is significant,
-/// or `unexplained`. A remainder is flagged when the held-out error after the named effect
-/// exceeds the noise floor by more than three standard deviations of a mean of squared
-/// normal noise over the held-out samples (`3 sqrt(2 / N)`).
+/// The verdict: the named effect, or `no_significant_gap` when no candidate is significant
+/// and the calibrated model meets the held-out block within the noise ([`noise_bar`]), or
+/// `unexplained`. A remainder is flagged when the held-out error after the named effect
+/// exceeds [`noise_bar`].
 fn verdict(
     ranking: &[RankEntry],
     named: Option<&str>,
@@ -206,8 +206,7 @@ fn verdict(
                 .map(HeldOut::mean)
                 .or(r.holdout_error)
                 .unwrap_or(f64::NAN);
-            let n = held.map_or(n_held, |h| h.err.len()).max(1) as f64;
-            let remainder = after > 1.0 + 3.0 * (2.0 / n).sqrt();
+            let remainder = after > noise_bar(held.map_or(n_held, |h| h.err.len()));
             Verdict {
                 verdict: "effect".into(),
                 effect: Some(name.into()),
@@ -230,6 +229,24 @@ fn verdict(
                 ),
             }
         }
+        (_, None) if gap > noise_bar(n_held) => Verdict {
+            verdict: "unexplained".into(),
+            effect: None,
+            effects: Vec::new(),
+            unexplained_remainder: true,
+            free_run_worse: false,
+            closure_fraction: None,
+            ci_low: None,
+            ci_high: None,
+            gap,
+            reason: format!(
+                "the calibrated model misses the held-out pressure by {gap:.3} noise variances, \
+                 more than noise alone leaves ({:.3}: 1 + 3 sqrt(4/N), N = {n_held}), yet no \
+                 candidate is significant at {level:.1e}: a cause the candidates do not see, or \
+                 one the calibration took into its parameters",
+                noise_bar(n_held)
+            ),
+        },
         (_, None) => Verdict {
             verdict: "no_significant_gap".into(),
             effect: None,
@@ -265,6 +282,16 @@ fn verdict(
             ),
         },
     }
+}
+
+/// The held-out error (mean of squared noise-normalized residuals over `n` samples) that
+/// noise alone exceeds with a chance of about 1e-3: three standard deviations above 1, the
+/// variance that of the mean of `n` squared standard normals (`2/n`) plus as much again for
+/// the noise level, which is itself estimated from the record (third differences). On eight
+/// clean records of the gamma LTD (seeds 1 to 8, 10 s at 100 Hz) the calibrated model left
+/// 0.83 to 1.12 (spread 0.10, against 0.07 from the mean alone); the bar at N = 401 is 1.30.
+fn noise_bar(n: usize) -> f64 {
+    1.0 + 3.0 * (4.0 / n.max(1) as f64).sqrt()
 }
 
 /// The one step of a named model effect.
