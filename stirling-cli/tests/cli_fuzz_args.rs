@@ -166,7 +166,7 @@ fn args(rng: &mut Lcg, out: &str, data: &str) -> Vec<String> {
     }
     match cmd {
         "rig" | "sweep" => a.extend(["--out".into(), out.into(), "--force".into()]),
-        "simulate" if rng.next() % 2 == 0 => a.extend(["--t-end".into(), "0.05".into()]),
+        "simulate" if rng.next().is_multiple_of(2) => a.extend(["--t-end".into(), "0.05".into()]),
         _ => {}
     }
     a
