@@ -118,7 +118,7 @@ pub fn unwrap(a: &[f64]) -> Vec<f64> {
 /// blame on the angle's unit).
 const MIN_REVOLUTIONS: f64 = 1.0;
 
-/// Refuse an angle that turns less than [`MIN_REVOLUTIONS`] on the training block, or at
+/// Refuse an angle that turns less than one revolution on the training block, or at
 /// another rate than the pressure `p` cycles on the training
 /// block `tr` (inclusive sample indices, interval `dt`).
 pub fn check_speed(
