@@ -72,6 +72,10 @@ pub struct StepBrief {
     pub after_stops: bool,
     /// Named from the reset start ([`StepRule::passes`]).
     pub from_reset: bool,
+    /// Held-out error after the step (noise variances) and each channel's rms against its
+    /// noise: what a test of the remainder reads.
+    pub holdout_error: f64,
+    pub channels: Vec<(String, f64)>,
 }
 
 /// The verdict label of a diagnosis: the set of named effects (`a+b`, ending in
@@ -184,6 +188,12 @@ impl Outcome {
                 cumulative_low: s.cumulative.ci_low,
                 after_stops: s.after_stops,
                 from_reset: s.from_reset,
+                holdout_error: s.holdout_error,
+                channels: s
+                    .channels
+                    .iter()
+                    .map(|c| (c.channel.clone(), c.ratio))
+                    .collect(),
             })
             .collect();
         self.tuned_verdict = self.verdict.clone();
