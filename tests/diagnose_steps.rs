@@ -64,6 +64,24 @@ fn diagnosed_with(rate: f64, effects: Vec<String>, seed: u64, candidates: &[&str
     d
 }
 
+/// The self-check's evaluation case `label` of the plan of `opts`, recorded and diagnosed as
+/// the self-check does it (its seeded start, its options); `tag` keeps its folder apart.
+fn diagnosed_case(opts: &VerdictOptions, label: &str, tag: u64) -> Diagnosis {
+    let case = plan(opts)
+        .unwrap()
+        .into_iter()
+        .find(|c| c.split == Split::Eval && c.truth.label() == label)
+        .unwrap();
+    let dir = tempdir(case.seed ^ tag);
+    let data = record(opts, &case, &dir).unwrap();
+    let (model, p_nom) = nominal_model("nsection", Some(2)).unwrap();
+    let p0 = seeded_start(model.as_ref(), &p_nom, opts.perturb, case.perturb_seed);
+    let d = diagnose(model.as_ref(), &p0, &data, &opts.diagnose).unwrap();
+    let _ = std::fs::remove_dir_all(&dir);
+    eprintln!("{}: {}", d.verdict.verdict, d.verdict.reason);
+    d
+}
+
 fn tempdir(seed: u64) -> std::path::PathBuf {
     let dir = std::env::temp_dir().join(format!("stirling-steps-{}-{seed}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
@@ -154,18 +172,7 @@ fn a_leak_the_calibration_absorbed_is_named_after_a_pressure_lag() {
         seeds: (1, 1),
         ..Default::default()
     };
-    let case = plan(&opts)
-        .unwrap()
-        .into_iter()
-        .find(|c| c.split == Split::Eval && c.truth.label() == "leak+sensor_lag")
-        .unwrap();
-    let dir = tempdir(case.seed);
-    let data = record(&opts, &case, &dir).unwrap();
-    let (model, p_nom) = nominal_model("nsection", Some(2)).unwrap();
-    let p0 = seeded_start(model.as_ref(), &p_nom, opts.perturb, case.perturb_seed);
-    let d = diagnose(model.as_ref(), &p0, &data, &opts.diagnose).unwrap();
-    let _ = std::fs::remove_dir_all(&dir);
-    eprintln!("{}: {}", d.verdict.verdict, d.verdict.reason);
+    let d = diagnosed_case(&opts, "leak+sensor_lag", 0);
     assert_eq!(d.verdict.verdict, "effect", "{}", d.verdict.reason);
     assert_eq!(named(&d), ["leak", "sensor_lag"], "{}", d.verdict.reason);
     check_steps(&d);
@@ -292,18 +299,7 @@ fn a_lag_beside_an_outside_cause_is_named_with_the_remainder() {
         mixed_strength: Some(1.0),
         ..Default::default()
     };
-    let case = plan(&opts)
-        .unwrap()
-        .into_iter()
-        .find(|c| c.truth.label() == "sensor_lag+outside:h_speed")
-        .unwrap();
-    let dir = tempdir(case.seed ^ 0xA11);
-    let data = record(&opts, &case, &dir).unwrap();
-    let (model, p_nom) = nominal_model("nsection", Some(2)).unwrap();
-    let p0 = seeded_start(model.as_ref(), &p_nom, opts.perturb, case.perturb_seed);
-    let d = diagnose(model.as_ref(), &p0, &data, &opts.diagnose).unwrap();
-    let _ = std::fs::remove_dir_all(&dir);
-    eprintln!("{}: {}", d.verdict.verdict, d.verdict.reason);
+    let d = diagnosed_case(&opts, "sensor_lag+outside:h_speed", 0xA11);
     assert_eq!(d.verdict.effects, ["sensor_lag"], "{}", d.verdict.reason);
     assert!(d.verdict.unexplained_remainder, "{}", d.verdict.reason);
     assert!(

@@ -229,38 +229,24 @@ fn verdict(
                 ),
             }
         }
-        (_, None) if gap > noise_bar(n_held) => Verdict {
-            verdict: "unexplained".into(),
-            effect: None,
-            effects: Vec::new(),
-            unexplained_remainder: true,
-            free_run_worse: false,
-            closure_fraction: None,
-            ci_low: None,
-            ci_high: None,
+        (_, None) if gap > noise_bar(n_held) => nothing_named(
+            "unexplained",
             gap,
-            reason: format!(
+            format!(
                 "the calibrated model misses the held-out pressure by {gap:.3} noise variances, \
                  more than noise alone leaves ({:.3}: 1 + 3 sqrt(4/N), N = {n_held}), yet no \
                  candidate is significant at {level:.1e}: a cause the candidates do not see, or \
                  one the calibration took into its parameters",
                 noise_bar(n_held)
             ),
-        },
-        (_, None) => Verdict {
-            verdict: "no_significant_gap".into(),
-            effect: None,
-            effects: Vec::new(),
-            unexplained_remainder: false,
-            free_run_worse: false,
-            closure_fraction: None,
-            ci_low: None,
-            ci_high: None,
+        ),
+        (_, None) => nothing_named(
+            "no_significant_gap",
             gap,
-            reason: format!(
+            format!(
                 "no candidate is significant at {level:.1e} (held-out error {gap:.3} noise variances)"
             ),
-        },
+        ),
         (None, Some(r)) => Verdict {
             verdict: "unexplained".into(),
             effect: Some(r.effect.clone()),
@@ -281,6 +267,23 @@ fn verdict(
                 r.ci_high.unwrap_or(f64::NAN),
             ),
         },
+    }
+}
+
+/// A verdict that names nothing and has no candidate to show: `no_significant_gap`, or
+/// `unexplained` (then with a remainder).
+fn nothing_named(verdict: &str, gap: f64, reason: String) -> Verdict {
+    Verdict {
+        verdict: verdict.into(),
+        effect: None,
+        effects: Vec::new(),
+        unexplained_remainder: verdict == "unexplained",
+        free_run_worse: false,
+        closure_fraction: None,
+        ci_low: None,
+        ci_high: None,
+        gap,
+        reason,
     }
 }
 
