@@ -198,6 +198,18 @@ fn verdict(
             .collect::<Vec<_>>()
             .join(", ")
     };
+    let base = Verdict {
+        verdict: String::new(),
+        effect: top.map(|r| r.effect.clone()),
+        effects: Vec::new(),
+        unexplained_remainder: true,
+        free_run_worse: false,
+        closure_fraction,
+        ci_low,
+        ci_high,
+        gap,
+        reason: String::new(),
+    };
     match (named, top) {
         (Some(name), Some(r)) => {
             // a sensor effect is fitted on the driven stage itself (no refit): its entry's
@@ -212,11 +224,6 @@ fn verdict(
                 effect: Some(name.into()),
                 effects: vec![name.into()],
                 unexplained_remainder: remainder,
-                free_run_worse: false,
-                closure_fraction,
-                ci_low,
-                ci_high,
-                gap,
                 reason: format!(
                     "`{name}` fitted with the gas parameters: {} (p = {:.1e}, significant at {level:.1e}), held-out BIC {:+.1}, closes {:.3} [{:.3}, {:.3}] of the held-out gap ({gap:.3} -> {after:.3} noise variances){}",
                     params(r),
@@ -227,36 +234,30 @@ fn verdict(
                     r.ci_high.unwrap_or(f64::NAN),
                     if remainder { "; a significant remainder stays above the noise" } else { "" }
                 ),
+                ..base
             }
         }
-        (_, None) if gap > noise_bar(n_held) => nothing_named(
-            "unexplained",
-            gap,
-            format!(
+        (_, None) if gap > noise_bar(n_held) => Verdict {
+            verdict: "unexplained".into(),
+            reason: format!(
                 "the calibrated model misses the held-out pressure by {gap:.3} noise variances, \
                  more than noise alone leaves ({:.3}: 1 + 3 sqrt(4/N), N = {n_held}), yet no \
                  candidate is significant at {level:.1e}: a cause the candidates do not see, or \
                  one the calibration took into its parameters",
                 noise_bar(n_held)
             ),
-        ),
-        (_, None) => nothing_named(
-            "no_significant_gap",
-            gap,
-            format!(
+            ..base
+        },
+        (_, None) => Verdict {
+            verdict: "no_significant_gap".into(),
+            unexplained_remainder: false,
+            reason: format!(
                 "no candidate is significant at {level:.1e} (held-out error {gap:.3} noise variances)"
             ),
-        ),
+            ..base
+        },
         (None, Some(r)) => Verdict {
             verdict: "unexplained".into(),
-            effect: Some(r.effect.clone()),
-            effects: Vec::new(),
-            unexplained_remainder: true,
-            free_run_worse: false,
-            closure_fraction,
-            ci_low,
-            ci_high,
-            gap,
             reason: format!(
                 "{} candidate(s) significant at {level:.1e}, but none lowers the held-out BIC by more than 10 and closes more than 0.5 of the gap with confidence (best: `{}`, held-out BIC {:+.1}, closure {:.3} [{:.3}, {:.3}])",
                 significant.len(),
@@ -266,24 +267,8 @@ fn verdict(
                 r.ci_low.unwrap_or(f64::NAN),
                 r.ci_high.unwrap_or(f64::NAN),
             ),
+            ..base
         },
-    }
-}
-
-/// A verdict that names nothing and has no candidate to show: `no_significant_gap`, or
-/// `unexplained` (then with a remainder).
-fn nothing_named(verdict: &str, gap: f64, reason: String) -> Verdict {
-    Verdict {
-        verdict: verdict.into(),
-        effect: None,
-        effects: Vec::new(),
-        unexplained_remainder: verdict == "unexplained",
-        free_run_worse: false,
-        closure_fraction: None,
-        ci_low: None,
-        ci_high: None,
-        gap,
-        reason,
     }
 }
 

@@ -7,7 +7,7 @@ use std::time::Instant;
 use serde::Serialize;
 use stirling_dsl::Model;
 
-use super::plan::{set_label, Planned, Split, Truth, VerdictOptions, REMAINDER};
+use super::plan::{named_label, Planned, Split, Truth, VerdictOptions};
 use super::record::{record, seeded_start, signature, Signature};
 use crate::diagnose::run::diagnose;
 use crate::diagnose::steps::StepRule;
@@ -33,7 +33,7 @@ pub struct Outcome {
     /// The right verdict (alternatives joined by ` | `: [`super::plan::is_right`]).
     pub expected: String,
     /// The diagnosis said a gap remains that the named effects do not explain (its verdict
-    /// label then ends in [`REMAINDER`]).
+    /// label then ends in [`REMAINDER`](super::plan::REMAINDER)).
     pub remainder: bool,
     /// Candidates the diagnosis considered (the Bonferroni count).
     pub candidates: usize,
@@ -79,16 +79,11 @@ pub struct StepBrief {
 }
 
 /// The verdict label of a diagnosis: the set of named effects (`a+b`, ending in
-/// [`REMAINDER`] when the diagnosis says a gap remains), `unexplained` or
+/// [`REMAINDER`](super::plan::REMAINDER) when the diagnosis says a gap remains), `unexplained` or
 /// `no_significant_gap`.
 pub fn verdict_label(d: &Diagnosis) -> String {
     if d.verdict.verdict == "effect" && !d.verdict.effects.is_empty() {
-        let tail = if d.verdict.unexplained_remainder {
-            REMAINDER
-        } else {
-            ""
-        };
-        format!("{}{tail}", set_label(&d.verdict.effects))
+        named_label(&d.verdict.effects, d.verdict.unexplained_remainder)
     } else {
         d.verdict.verdict.clone()
     }
@@ -128,8 +123,7 @@ impl Outcome {
             cumulative = s.cumulative_low;
         }
         if !named.is_empty() && cumulative > th.min_closure {
-            let tail = if self.remainder { REMAINDER } else { "" };
-            format!("{}{tail}", set_label(&named))
+            named_label(&named, self.remainder)
         } else if self.ranking.iter().any(|r| r.p_value < level) || self.gap > GROSS_GAP {
             "unexplained".into()
         } else {

@@ -41,6 +41,12 @@ pub enum Truth {
 /// library does not explain.
 pub const REMAINDER: &str = "+remainder";
 
+/// The label of a named set, ending in [`REMAINDER`] when a gap is said to remain.
+pub fn named_label(names: &[String], remainder: bool) -> String {
+    let tail = if remainder { REMAINDER } else { "" };
+    format!("{}{tail}", set_label(names))
+}
+
 /// Whether `verdict` is right for `expected`: one of its alternatives (` | `); a named set
 /// with a remainder counts as the set unless the alternative asks for the remainder itself.
 pub fn is_right(expected: &str, verdict: &str) -> bool {
