@@ -31,6 +31,9 @@ pub fn diagnose(
     if !crate::layout::StateLayout::flywheels(model).is_empty() {
         return super::kinematic::diagnose(model, p0, data, opts);
     }
+    let mut opts = opts.clone();
+    (opts.fit.sim.rtol, opts.fit.sim.atol) = (opts.rtol, opts.rtol);
+    let opts = &opts;
     let first = diagnose_once(model, p0, data, opts)?;
     let mut d = super::restarted::second_pass(model, p0, data, opts, &first)
         .map_or(first, |second| *second);
