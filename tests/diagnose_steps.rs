@@ -167,9 +167,17 @@ fn a_leak_the_calibration_absorbed_is_named_after_a_pressure_lag() {
     // the nominal parameters' estimates it lowers the held-out BIC by more than ten times
     // the usual bar (steps::RESET_P, docs/diagnosis.md). On five other records of the pair
     // (seeds 47 to 51 of `diagnosed_at`) the leak stays unnamed: docs/diagnosis.md.
+    // The record is that narrow: at the diagnosis's default tolerance (5e-7, the runs twice
+    // as fast) the leak's score after the lag moves past the reset start's bar and the verdict
+    // is the lag alone (docs/diagnosis.md, "Timing of the steps"); the mechanism is tested at
+    // the fit's own tolerance, where it was found (and at 3e-7 it holds too).
     let opts = VerdictOptions {
         clean: (4, 20),
         seeds: (1, 1),
+        diagnose: DiagnoseOptions {
+            rtol: 1e-7,
+            ..Default::default()
+        },
         ..Default::default()
     };
     let d = diagnosed_case(&opts, "leak+sensor_lag", 0);

@@ -52,6 +52,10 @@ pub struct DiagnoseArgs {
     /// does not change, the ranking of the non-significant candidates is filled in)
     #[arg(long)]
     pub fit_all: bool,
+    /// Integration tolerance of the driven runs (relative, and absolute on the scaled states;
+    /// the fit's own default is 1e-7)
+    #[arg(long, default_value_t = diagnose::DIAGNOSE_RTOL)]
+    pub rtol: f64,
     /// Write report.md and SVG figures into this directory (created if missing)
     #[arg(long)]
     pub report: Option<PathBuf>,
@@ -128,6 +132,13 @@ fn prior_arg(v: f64) -> anyhow::Result<Option<f64>> {
     Ok((v > 0.0).then_some(v))
 }
 
+fn rtol_arg(v: f64) -> anyhow::Result<f64> {
+    if !(v.is_finite() && v > 0.0 && v < 1e-2) {
+        bail!("--rtol must be a tolerance in (0, 0.01), got {v}");
+    }
+    Ok(v)
+}
+
 fn effects_arg(s: &str) -> Option<Vec<String>> {
     if s.trim() == "all" {
         None
@@ -178,6 +189,7 @@ pub fn run(a: &DiagnoseArgs) -> anyhow::Result<()> {
         },
         effects: effects_arg(&a.effects),
         prior: prior_arg(a.prior)?,
+        rtol: rtol_arg(a.rtol)?,
         train,
         holdout,
         progress: Some(|line: &str| common::note(line)),
@@ -264,6 +276,7 @@ fn run_self_check(a: &DiagnoseArgs) -> anyhow::Result<()> {
         jobs: a.jobs,
         diagnose: DiagnoseOptions {
             prior: prior_arg(a.prior)?,
+            rtol: rtol_arg(a.rtol)?,
             ..Default::default()
         },
         ..Default::default()

@@ -203,7 +203,7 @@ fn a_lab_record_of_the_gamma_engine_is_fitted_from_the_command_line() {
         let se = e["std_error"].as_f64().unwrap();
         assert!((a - b).abs() <= 0.1 * se, "{}: {a} vs {b}", e["name"]);
     }
-    // refused: no angle, too few samples, the flywheel's friction freed (the defaults)
+    // refused: no angle, too few samples, a Coulomb torque and a load both freed
     let p_only = dir.join("p_only.csv");
     let args = rig_args("p", &p_only);
     ok(&args.iter().map(String::as_str).collect::<Vec<_>>());
@@ -221,8 +221,21 @@ fn a_lab_record_of_the_gamma_engine_is_fitted_from_the_command_line() {
         &["15 samples are too few to fit"],
     );
     support::fails_with(
-        &["fit", &gamma, "--data", support::s(&rec)],
-        &["`cf, Tc` of `gamma_ltd` act on the flywheel", "--free"],
+        &[
+            "fit",
+            &gamma,
+            "--data",
+            support::s(&rec),
+            "--free",
+            "hp,Tc,Tl",
+        ],
+        &["`Tc, Tl` of `gamma_ltd` cannot be told apart", "free one"],
+    );
+    // the defaults (the declared `free cf, Tc`): the flywheel's torque balance
+    let out = ok(&["fit", &gamma, "--data", support::s(&rec)]);
+    assert!(
+        out.contains("flywheel's torque balance") && out.contains("T_friction"),
+        "{out}"
     );
     // the diagnosis runs on it (its candidates: the effects the file names), and says why
     // no simulated gap; a record sampled below 10 samples a revolution is refused by its

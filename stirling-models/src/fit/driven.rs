@@ -181,32 +181,7 @@ impl Stage<'_> {
         trial: bool,
     ) -> Result<StageRun, FitError> {
         let th = self.values(u);
-        let Prepared {
-            p,
-            z0,
-            mut given,
-            mut columns,
-            col_of,
-        } = self.prepare(&th, trial)?;
-        if !sens {
-            columns.clear();
-        }
-        let mut signals = self.signals_from(first);
-        let (gain, lag) = self.apply_sensors(&th, &mut given, &mut signals);
-        let zscale: Vec<f64> = {
-            let s = state_scale(self.model, &p);
-            self.free.iter().map(|&i| s[i]).collect()
-        };
-        let sys = Driven {
-            model: self.model,
-            p,
-            base: self.base.clone(),
-            free: self.free.clone(),
-            given,
-            signals,
-            columns,
-            zscale,
-        };
+        let (sys, z0, (gain, lag), col_of) = self.system(&th, first, trial, sens)?;
         let rows = match &self.restarts {
             Some(r) if r.every < last - first => {
                 self.integrate_restarted(&sys, &z0, (first, last), r, &gain)?
@@ -224,6 +199,72 @@ impl Stage<'_> {
             self.sensor_columns(u, first, last, &mut dyhat)?;
         }
         Ok(StageRun { first, yhat, dyhat })
+    }
+
+    /// The full model state (free states simulated, prescribed ones from their signals) at
+    /// every sample `first..=last`, at the variables `u`, without sensitivities (the
+    /// flywheel's torque balance of a kinematic engine reads the gas it drives from here).
+    pub fn full_states(
+        &self,
+        u: &[f64],
+        first: usize,
+        last: usize,
+    ) -> Result<Vec<Vec<f64>>, FitError> {
+        let (sys, z0, ..) = self.system(&self.values(u), first, false, false)?;
+        let rows = self.integrate_window(&sys, &z0, last - first)?;
+        Ok(rows
+            .iter()
+            .enumerate()
+            .map(|(k, z)| sys.full_state(k as f64 * self.dt, &z[..self.free.len()]))
+            .collect())
+    }
+
+    /// The driven system at the variable values `th` from sample `first` (sensitivity
+    /// columns when `sens`), its initial free states, the sensors' gains and lags, and the
+    /// column of each variable.
+    #[allow(clippy::type_complexity)]
+    fn system(
+        &self,
+        th: &[f64],
+        first: usize,
+        trial: bool,
+        sens: bool,
+    ) -> Result<
+        (
+            Driven<'_>,
+            Vec<f64>,
+            (Vec<f64>, Vec<f64>),
+            Vec<Option<usize>>,
+        ),
+        FitError,
+    > {
+        let Prepared {
+            p,
+            z0,
+            mut given,
+            mut columns,
+            col_of,
+        } = self.prepare(th, trial)?;
+        if !sens {
+            columns.clear();
+        }
+        let mut signals = self.signals_from(first);
+        let sensors = self.apply_sensors(th, &mut given, &mut signals);
+        let zscale: Vec<f64> = {
+            let s = state_scale(self.model, &p);
+            self.free.iter().map(|&i| s[i]).collect()
+        };
+        let sys = Driven {
+            model: self.model,
+            p,
+            base: self.base.clone(),
+            free: self.free.clone(),
+            given,
+            signals,
+            columns,
+            zscale,
+        };
+        Ok((sys, z0, sensors, col_of))
     }
 
     /// The prescribed signals with their time origin moved to sample `first`.

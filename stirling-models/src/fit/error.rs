@@ -133,12 +133,8 @@ pub enum FitError {
         wheels: usize,
         bodies: usize,
     },
-    #[error("fit: a kinematic engine's fit drives the gas with the measured angle and identifies gas parameters only; `{names}` of `{model}` act on the flywheel (friction, damper, load), which it does not identify: free gas parameters instead (--free, some of: {gas})")]
-    KinematicMechanics {
-        model: String,
-        names: String,
-        gas: String,
-    },
+    #[error("fit: the flywheel's parameters `{names}` of `{model}` cannot be told apart by its torque balance (the measured angle's acceleration against the fitted gas's torque), or one acts on nothing it sees: free fewer of them (a Coulomb torque and a load are one torque at a steady speed; free one)")]
+    KinematicFlywheel { model: String, names: String },
     #[error("{file}: fit: the flywheel's angle `{angle}` turns {revolutions:.3} revolutions in the {seconds:.3} s of the training block: the engine stands (or stopped), and a kinematic engine's fit drives the gas with the measured motion; record it running, over at least a few revolutions (or the angle column is not the flywheel's)")]
     KinematicStands {
         file: String,

@@ -1,10 +1,10 @@
 //! The fit of a kinematic engine (a flywheel driving cranks, docs/physics.md section 12): the
 //! record gives the pressure `p` and the flywheel's angle; stage 2 drives the gas with the
-//! measured angle (`stage.rs`) and identifies the free gas parameters and the pressure offset.
-//!
-//! Stage 1 (the mechanics driven by the measured pressure) does not run: the flywheel's
-//! friction and load are not identified, and freeing one is refused by name. The multiple
-//! shooting and the free run (simulations of the free engine) are skipped with a note.
+//! measured angle (`stage.rs`) and identifies the free gas parameters and the pressure offset;
+//! then, when free parameters act on the flywheel (its friction and load), stage 1 fits them
+//! to the wheel's torque balance: the measured angle's acceleration against the fitted gas's
+//! torque (`flywheel.rs`). The multiple shooting and the free run (simulations of the free
+//! engine) are skipped with a note.
 
 use std::time::Instant;
 
@@ -20,6 +20,8 @@ use crate::layout::StateLayout;
 
 /// The measured angle: the flywheel, the column, the unwrapping and the speed check.
 pub mod angle;
+/// Stage 1: the flywheel's friction and load from its torque balance.
+pub mod flywheel;
 /// Stage 2 driven by the measured angle.
 pub mod stage;
 /// The gas's starting state, fitted before the parameters.
@@ -42,9 +44,6 @@ pub(super) fn identify<'a>(
     let clock = Instant::now();
     angle::check_speed(angle, rec.data, rec.tr, rec.dt)?;
     let (mech, gas) = classify(model, p0, free)?;
-    if !mech.is_empty() {
-        return Err(mechanics_refused(model, p0, &mech));
-    }
     let (stage, burn) = stage::stage(model, layout, rec, angle, p0, &gas, opts)?;
     let stage = start::fitted_start(stage, rec, burn, opts)?;
     let solved = fit_stage(&stage, rec.tr, rec.ho, burn, opts)?;
@@ -66,10 +65,33 @@ pub(super) fn identify<'a>(
             _ => {}
         }
     }
+    let fitted = FittedStage {
+        stage,
+        u: solved.lm.x.clone(),
+        first: rec.tr.0,
+        last: rec.tr.1,
+        keep: solved.keep,
+    };
+    let stage1 = if mech.is_empty() {
+        None
+    } else {
+        Some(flywheel::fit(
+            model,
+            &mut p,
+            (&fitted, burn),
+            angle,
+            rec,
+            &mech,
+        )?)
+    };
     let mut notes = vec![format!(
-        "kinematic engine: stage 1 (the flywheel's mechanics from the measured pressure) does \
-         not run; the gas is driven by the measured angle `{}`",
-        angle.name
+        "kinematic engine: the gas is driven by the measured angle `{}`; {}",
+        angle.name,
+        if mech.is_empty() {
+            "stage 1 (the flywheel's friction and load) does not run: none of its parameters is free"
+        } else {
+            "stage 1 fits the flywheel's parameters to its torque balance, after the gas"
+        }
     )];
     for (asked, what) in [
         (opts.multiple_shooting.is_some(), "multiple shooting"),
@@ -88,7 +110,7 @@ pub(super) fn identify<'a>(
         model: model.name().into(),
         n: model.n(),
         params: crate::params::named(model, &p),
-        stage1: None,
+        stage1,
         stage2: Some(solved.fit.clone()),
         train: rec.train,
         holdout: rec.holdout,
@@ -98,35 +120,5 @@ pub(super) fn identify<'a>(
         free_run: None,
         notes,
     };
-    let fitted = FittedStage {
-        stage,
-        u: solved.lm.x.clone(),
-        first: rec.tr.0,
-        last: rec.tr.1,
-        keep: solved.keep,
-    };
     Ok((id, vec![fitted]))
-}
-
-/// The error for free parameters that act on the flywheel (`mech`), naming the model's gas
-/// parameters that may be freed instead.
-fn mechanics_refused(model: &dyn Model, p0: &[f64], mech: &[usize]) -> FitError {
-    let names = |js: &[usize]| {
-        js.iter()
-            .map(|&j| model.params()[j].name.to_string())
-            .collect::<Vec<_>>()
-    };
-    let gas: Vec<String> = model
-        .params()
-        .iter()
-        .map(|i| i.name.to_string())
-        .filter(|n| {
-            matches!(classify(model, p0, std::slice::from_ref(n)), Ok((m, g)) if m.is_empty() && !g.is_empty())
-        })
-        .collect();
-    FitError::KinematicMechanics {
-        model: model.name().into(),
-        names: names(mech).join(", "),
-        gas: gas.join(","),
-    }
 }
