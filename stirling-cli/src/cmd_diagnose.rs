@@ -56,6 +56,10 @@ pub struct DiagnoseArgs {
     /// the fit's own default is 1e-7)
     #[arg(long, default_value_t = diagnose::DIAGNOSE_RTOL)]
     pub rtol: f64,
+    /// Family-wise significance level of the candidates' score screen (Bonferroni over the
+    /// candidates)
+    #[arg(long, default_value_t = 0.01)]
+    pub alpha: f64,
     /// Write report.md and SVG figures into this directory (created if missing)
     #[arg(long)]
     pub report: Option<PathBuf>,
@@ -132,6 +136,13 @@ fn prior_arg(v: f64) -> anyhow::Result<Option<f64>> {
     Ok((v > 0.0).then_some(v))
 }
 
+fn alpha_arg(v: f64) -> anyhow::Result<f64> {
+    if !(v.is_finite() && v > 0.0 && v < 1.0) {
+        bail!("--alpha must be a significance level in (0, 1), got {v}");
+    }
+    Ok(v)
+}
+
 fn rtol_arg(v: f64) -> anyhow::Result<f64> {
     if !(v.is_finite() && v > 0.0 && v < 1e-2) {
         bail!("--rtol must be a tolerance in (0, 0.01), got {v}");
@@ -190,6 +201,7 @@ pub fn run(a: &DiagnoseArgs) -> anyhow::Result<()> {
         effects: effects_arg(&a.effects),
         prior: prior_arg(a.prior)?,
         rtol: rtol_arg(a.rtol)?,
+        alpha: alpha_arg(a.alpha)?,
         train,
         holdout,
         progress: Some(|line: &str| common::note(line)),
@@ -277,6 +289,7 @@ fn run_self_check(a: &DiagnoseArgs) -> anyhow::Result<()> {
         diagnose: DiagnoseOptions {
             prior: prior_arg(a.prior)?,
             rtol: rtol_arg(a.rtol)?,
+            alpha: alpha_arg(a.alpha)?,
             ..Default::default()
         },
         ..Default::default()
