@@ -44,9 +44,9 @@ pub fn case_row(c: &Outcome) -> String {
     )
 }
 
-/// Right / total per class of record on the evaluation set.
+/// Right / total per class of record on the evaluation set (the verdicts as run).
 fn class_line(v: &VerdictCheck) -> String {
-    v.eval
+    v.eval_default
         .classes
         .iter()
         .map(|(k, r, n)| format!("{k} {r}/{n} ({})", pct(*r as f64 / *n as f64)))
@@ -54,18 +54,21 @@ fn class_line(v: &VerdictCheck) -> String {
         .join(", ")
 }
 
-/// The summary lines: accuracy and false alarms on the evaluation set.
+/// The summary lines: accuracy and false alarms on the evaluation set, the verdicts as the
+/// diagnosis gave them first; then the tuned thresholds' relabelling (each run's steps cut
+/// where a step fails them: a bound on what those thresholds would give, not a run at them;
+/// docs/diagnosis.md, run-j).
 pub fn headline(v: &VerdictCheck) -> String {
     let t = &v.tuned.thresholds;
     let classes = class_line(v);
     format!(
-        "evaluation set: verdicts right {}/{} ({}), false alarms on clean records {}/{} ({}); with the diagnosis's default thresholds {}/{} right, {}/{} false alarms\n\
-         thresholds tuned on {} tuning cases: score level {:.1e} (family-wise), held-out BIC change < {}, closure lower bound > {} ({}/{} right there)\n\
+        "evaluation set: verdicts right {}/{} ({}), false alarms on clean records {}/{} ({}), the diagnosis's default thresholds, as run\n\
          by class: {classes}\n\
+         thresholds tuned on {} tuning cases: score level {:.1e} (family-wise), held-out BIC change < {}, closure lower bound > {} ({}/{} right there); relabelled with them (each run's steps cut where one fails them, not a run at them): {}/{} right, {}/{} false alarms\n\
          {} cases, {:.0} s wall, {:.0} s summed over cases",
-        v.eval.right, v.eval.total, pct(v.eval.accuracy()), v.eval.false_alarms, v.eval.clean, pct(v.eval.false_alarm_rate()),
-        v.eval_default.right, v.eval_default.total, v.eval_default.false_alarms, v.eval_default.clean,
+        v.eval_default.right, v.eval_default.total, pct(v.eval_default.accuracy()), v.eval_default.false_alarms, v.eval_default.clean, pct(v.eval_default.false_alarm_rate()),
         v.tuned.total, t.alpha, t.strong_bic, t.min_closure, v.tuned.right, v.tuned.total,
+        v.eval.right, v.eval.total, v.eval.false_alarms, v.eval.clean,
         v.cases.len(), v.seconds, v.case_seconds
     )
 }
@@ -80,10 +83,10 @@ pub fn markdown(v: &VerdictCheck) -> String {
         v.rate,
         headline(v).replace('\n', "\n\n")
     );
-    s += "## Evaluation set, tuned thresholds\n\n";
-    s += &v.eval.markdown();
-    s += "\n## Evaluation set, the diagnosis's default thresholds\n\n";
+    s += "## Evaluation set, the diagnosis's default thresholds (as run)\n\n";
     s += &v.eval_default.markdown();
+    s += "\n## Evaluation set, relabelled with the tuned thresholds (steps cut, not a run)\n\n";
+    s += &v.eval.markdown();
     s += "\n## Tuning set (thresholds chosen here)\n\n";
     s += &v.tune.markdown();
     s += "\n## What each truth does to the record (mean against the clean records)\n\n";
