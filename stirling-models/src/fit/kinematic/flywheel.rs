@@ -12,7 +12,8 @@
 //!
 //! The intervals come from the angle's noise carried through the smoothing, the two
 //! derivatives and the estimator by Monte Carlo ([`AngleNoise::cov`]), scaled up when the
-//! model misses the acceleration by more than the noise does. At a steady speed the Coulomb torque and a load are one
+//! model misses the acceleration by more than the noise does, plus the gas's own uncertainty
+//! (`gas_spread.rs`). At a steady speed the Coulomb torque and a load are one
 //! torque (`tanh(omega / w_eps) = 1` at every sample) and the viscous torque `cf omega` nearly
 //! one with them: their correlation is reported as a warning and their intervals are as wide
 //! as that makes them; a record that speeds up or slows down separates them.
@@ -23,6 +24,7 @@ use nalgebra::{DMatrix, DVector};
 use stirling_dsl::{JacSink, Model};
 
 use super::angle::Angle;
+use super::gas_spread::Balance;
 use crate::fit::record::Record;
 use crate::fit::report::{ChannelFit, Estimate, FitStats};
 use crate::fit::stage_fit::FittedStage;
@@ -42,21 +44,22 @@ pub const NAME: &str =
 
 /// What the torque balance sees at each sample: the model's state and the measured
 /// acceleration.
-struct Samples {
+pub(super) struct Samples {
     /// Full model states (gas from stage 2, angle and speed from the record).
-    x: Vec<Vec<f64>>,
+    pub x: Vec<Vec<f64>>,
     /// Measured angular acceleration (rad/s^2).
-    acc: Vec<f64>,
+    pub acc: Vec<f64>,
     /// Times (s).
-    t: Vec<f64>,
+    pub t: Vec<f64>,
 }
 
 /// Fit the flywheel's parameters `mech` (indices into `p`) on the training block after the
-/// burn-in, the gas as fitted (`gas`, `p` with its estimates); `p` gets the fitted values.
+/// burn-in, the gas as fitted (`gas`, its statistics `gas_stats`, `p` with its estimates);
+/// `p` gets the fitted values.
 pub fn fit(
     model: &dyn Model,
     p: &mut [f64],
-    (gas, burn): (&FittedStage, usize),
+    (gas, gas_stats, burn): (&FittedStage, &FitStats, usize),
     angle: &Angle,
     rec: &Record,
     mech: &[usize],
@@ -95,8 +98,24 @@ pub fn fit(
         len: angle.data.len(),
         first: rec.tr.0 + burn,
     };
-    let stats = stats(model, (p, &p0), mech, (&r, &jm), (&noise, rec))
+    let balance = Balance {
+        first: rec.tr.0 + burn,
+        last: rec.tr.1,
+        acc: &acc,
+        t0: rec.t0,
+        dt: rec.dt,
+        speed: angle.speed,
+        mech,
+    };
+    let (gas_cov, skipped) = balance.gas_cov(model, p, gas, gas_stats)?;
+    let mut stats = stats(model, (p, &p0), mech, (&r, &jm), (&noise, rec), &gas_cov)
         .ok_or_else(|| singular(model, mech))?;
+    if !skipped.is_empty() {
+        stats.warnings.push(format!(
+            "the gas's uncertainty in {} could not be carried into the flywheel's intervals (the gas moved by a standard error could not be integrated): they are too narrow by that part",
+            skipped.join(", ")
+        ));
+    }
     let mut fits = vec![channel(model, p, angle.speed, &train, "train")];
     if let Some((a, b)) = rec.ho {
         fits.push(channel(model, p, angle.speed, &block(a, b), "holdout"));
@@ -114,7 +133,7 @@ pub fn fit(
 }
 
 /// Residuals `acc - omega'` and their Jacobian in the parameters `mech` (`-d omega'/d p`).
-fn rows(
+pub(super) fn rows(
     model: &dyn Model,
     p: &[f64],
     speed: usize,
@@ -145,7 +164,7 @@ fn rows(
 
 /// The Gauss-Newton step `argmin |r - J d|`, the columns equilibrated; `None` when a column
 /// is zero or the columns are dependent.
-fn least_squares(jm: &DMatrix<f64>, r: &DVector<f64>) -> Option<DVector<f64>> {
+pub(super) fn least_squares(jm: &DMatrix<f64>, r: &DVector<f64>) -> Option<DVector<f64>> {
     let norms: Vec<f64> = jm.column_iter().map(|c| c.norm()).collect();
     if norms.iter().any(|&v| !(v > 0.0 && v.is_finite())) {
         return None;
@@ -163,17 +182,19 @@ fn least_squares(jm: &DMatrix<f64>, r: &DVector<f64>) -> Option<DVector<f64>> {
     ))
 }
 
-/// The estimates with intervals from the angle's noise ([`AngleNoise::cov`]), their
-/// correlations and the warnings for correlated pairs.
+/// The estimates with intervals from the angle's noise ([`AngleNoise::cov`]) and the gas's
+/// uncertainty (`gas_cov`, [`Balance::gas_cov`]), their correlations and the warnings for
+/// correlated pairs.
 fn stats(
     model: &dyn Model,
     (p, p0): (&[f64], &[f64]),
     mech: &[usize],
     (r, jm): (&DVector<f64>, &DMatrix<f64>),
     (noise, rec): (&AngleNoise, &Record),
+    gas_cov: &DMatrix<f64>,
 ) -> Option<FitStats> {
     let bread = (jm.transpose() * jm).try_inverse()?;
-    let cov = noise.cov(&bread, jm, r, rec);
+    let cov = noise.cov(&bread, jm, r, rec) + gas_cov;
     let mut names: Vec<String> = mech
         .iter()
         .map(|&j| model.params()[j].name.to_string())

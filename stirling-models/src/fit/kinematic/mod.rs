@@ -22,6 +22,8 @@ use crate::layout::StateLayout;
 pub mod angle;
 /// Stage 1: the flywheel's friction and load from its torque balance.
 pub mod flywheel;
+/// The gas's uncertainty carried into the flywheel's estimates.
+mod gas_spread;
 /// Stage 2 driven by the measured angle.
 pub mod stage;
 /// The gas's starting state, fitted before the parameters.
@@ -75,14 +77,8 @@ pub(super) fn identify<'a>(
     let stage1 = if mech.is_empty() {
         None
     } else {
-        Some(flywheel::fit(
-            model,
-            &mut p,
-            (&fitted, burn),
-            angle,
-            rec,
-            &mech,
-        )?)
+        let gas = (&fitted, &solved.fit.stats, burn);
+        Some(flywheel::fit(model, &mut p, gas, angle, rec, &mech)?)
     };
     let mut notes = vec![format!(
         "kinematic engine: the gas is driven by the measured angle `{}`; {}",
