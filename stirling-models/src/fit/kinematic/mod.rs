@@ -20,6 +20,8 @@ use crate::layout::StateLayout;
 
 /// The measured angle: the flywheel, the column, the unwrapping and the speed check.
 pub mod angle;
+/// The angle's noise carried into the flywheel's estimates.
+mod angle_noise;
 /// Stage 1: the flywheel's friction and load from its torque balance.
 pub mod flywheel;
 /// The gas's uncertainty carried into the flywheel's estimates.
