@@ -25,6 +25,8 @@
 //!   [`floquet_arnoldi`](crate::sim::floquet_arnoldi): the matrix-free route.
 
 mod adapter;
+/// Block Arnoldi on an operator applied to blocks of vectors.
+pub mod block_arnoldi;
 /// A linear solver for block-diagonal Newton matrices whose blocks repeat.
 pub mod block_lu;
 /// Periodic motion: settling, the cycle figures.
@@ -60,6 +62,8 @@ pub mod schmidt;
 pub mod sens;
 /// Limit cycles by single shooting.
 pub mod shooting;
+/// The Radau stage matrix assembled by precomputed positions.
+mod stage_slots;
 /// The ODE systems the integrator runs.
 pub mod system;
 /// Monodromy-vector products without the monodromy matrix.

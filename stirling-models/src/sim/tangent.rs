@@ -101,6 +101,47 @@ impl TangentFlow<'_> {
         Ok(())
     }
 
+    /// `V <- D^-1 Phi D V` for the `k` columns of `v` (column-major `n x k`): one sweep over
+    /// the steps, each stage matrix factored once (or its kept factors used) for all columns.
+    pub fn apply_block(&mut self, v: &mut [f64], k: usize) -> Result<(), SimError> {
+        let n = self.n;
+        if v.len() != n * k {
+            return Err(SimError::DimensionMismatch {
+                expected: n * k,
+                found: v.len(),
+            });
+        }
+        self.products += k;
+        let mut rhs = vec![0.0; 3 * n * k];
+        let mut work = Vec::new();
+        for s in 0..self.steps.len() {
+            for (col, block) in v.chunks_exact(n).zip(rhs.chunks_exact_mut(3 * n)) {
+                for i in 0..3 {
+                    block[i * n..(i + 1) * n].copy_from_slice(col);
+                }
+            }
+            if s < self.cache.len() {
+                let mut w1 = vec![0.0; 3 * n];
+                for block in rhs.chunks_exact_mut(3 * n) {
+                    self.cache[s].solve(block, &mut w1);
+                }
+            } else {
+                self.factor(s)?;
+                self.sparse
+                    .lu
+                    .solve_columns(&mut rhs, k, &mut work)
+                    .map_err(|_| SimError::SolverFailure {
+                        t: self.steps[s].0,
+                        why: "tangent step: singular stage matrix".into(),
+                    })?;
+            }
+            for (col, block) in v.chunks_exact_mut(n).zip(rhs.chunks_exact(3 * n)) {
+                col.copy_from_slice(&block[2 * n..]);
+            }
+        }
+        Ok(())
+    }
+
     /// Factor step `k`'s stage matrix into `sparse.lu` (kept in the cache while the budget
     /// lasts and `k` is the next uncached step).
     fn factor(&mut self, k: usize) -> Result<(), SimError> {

@@ -251,13 +251,14 @@ fn refactor(
             x[p.row_inv[ai[e]]] += av[e];
         }
         let last = p.u_ptr[j + 1] - 1;
-        for e in p.u_ptr[j]..last {
-            let r = p.u_idx[e];
+        let (ui, uv) = (&p.u_idx[p.u_ptr[j]..last], &mut v.u[p.u_ptr[j]..last]);
+        for (&r, u) in ui.iter().zip(uv) {
             let xr = x[r];
             x[r] = 0.0;
-            v.u[e] = xr;
-            for k in p.l_ptr[r] + 1..p.l_ptr[r + 1] {
-                x[p.l_idx[k]] -= v.l[k] * xr;
+            *u = xr;
+            let (a, b) = (p.l_ptr[r] + 1, p.l_ptr[r + 1]);
+            for (&i, &l) in p.l_idx[a..b].iter().zip(&v.l[a..b]) {
+                x[i] -= l * xr;
             }
         }
         let pivot = x[j];
