@@ -17,7 +17,7 @@
 //! `Z = [V_0 .. V_{m-1}]`, `Z_+ = [Z, V_m]`; the Ritz values are the eigenvalues of `H`'s square
 //! top (`Z^T A Z`).
 
-use nalgebra::DMatrix;
+use nalgebra::{Complex, DMatrix, DVector};
 
 use super::floquet_arnoldi::ritz_values;
 use super::SimError;
@@ -165,6 +165,52 @@ impl BlockArnoldi {
         ritz_values(&self.h_top())
     }
 
+    /// The Ritz values with their residuals `|A Z y - theta Z y|` (`y` the unit Ritz vector of
+    /// `Z^T A Z`), largest modulus first: from `H` alone (`A Z = Z_+ H`), no product.
+    pub fn ritz_residuals(&self) -> Vec<((f64, f64), f64)> {
+        let (rows, m) = (self.basis.len(), self.applied);
+        let top = self.h_top();
+        let h = DMatrix::from_fn(rows, m, |r, c| {
+            Complex::new(self.h[c].get(r).copied().unwrap_or(0.0), 0.0)
+        });
+        let scale = top.amax().max(f64::MIN_POSITIVE);
+        self.ritz()
+            .into_iter()
+            .map(|(re, im)| {
+                let theta = Complex::new(re, im);
+                // inverse iteration, shifted off the eigenvalue by round-off
+                let shift = theta + Complex::new(1e-13 * scale, 1e-13 * scale);
+                let a = DMatrix::from_fn(m, m, |r, c| {
+                    Complex::new(top[(r, c)], 0.0) - if r == c { shift } else { 0.0.into() }
+                });
+                let lu = a.lu();
+                let mut y = DVector::from_fn(m, |i, _| Complex::new(1.0 + 0.1 * i as f64, 0.0));
+                for _ in 0..2 {
+                    y = lu.solve(&y).unwrap_or_else(|| y.clone());
+                    let ny = y.norm();
+                    if ny > 0.0 && ny.is_finite() {
+                        y /= Complex::new(ny, 0.0);
+                    }
+                }
+                let mut r = &h * &y;
+                for i in 0..m {
+                    r[i] -= theta * y[i];
+                }
+                ((re, im), r.norm())
+            })
+            .collect()
+    }
+
+    /// Remove from `v` its components on the applied basis vectors `Z` (twice).
+    pub fn orthogonalize(&self, v: &mut [f64]) {
+        for _ in 0..2 {
+            for b in &self.basis[..self.applied] {
+                let c = dot(v, b);
+                axpy(v, -c, b);
+            }
+        }
+    }
+
     /// `v <- Z_+ H Z^T v`: the operator as far as the space knows it (zero on the rest).
     pub fn apply_low_rank(&self, v: &mut [f64]) {
         let c: Vec<f64> = self.basis[..self.applied]
@@ -204,6 +250,20 @@ impl BlockArnoldi {
         }
         out
     }
+}
+
+/// `k` fixed pseudo-random columns of length `n` (xorshift from `seed`, entries in
+/// `[-0.5, 0.5)`), column-major: reproducible start blocks.
+pub fn pseudo_random_block(n: usize, k: usize, seed: u64) -> Vec<f64> {
+    let mut s: u64 = 0x9e37_79b9_7f4a_7c15 ^ seed.wrapping_mul(0xbf58_476d_1ce4_e5b9);
+    (0..n * k)
+        .map(|_| {
+            s ^= s << 13;
+            s ^= s >> 7;
+            s ^= s << 17;
+            (s >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+        })
+        .collect()
 }
 
 #[cfg(test)]
@@ -250,9 +310,7 @@ mod tests {
     }
 
     fn start(n: usize, k: usize) -> Vec<f64> {
-        (0..n * k)
-            .map(|i| ((i * 37 + 11) % 101) as f64 / 101.0 - 0.5)
-            .collect()
+        pseudo_random_block(n, k, 1)
     }
 
     #[test]

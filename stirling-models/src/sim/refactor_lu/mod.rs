@@ -83,6 +83,11 @@ impl LuSnapshot {
         solve_with(&self.pattern, &self.values, x, work);
     }
 
+    /// `X <- A^-1 X` for the `k` columns of `x` (column-major); `work` is resized to `n k`.
+    pub fn solve_columns(&self, x: &mut [f64], k: usize, work: &mut Vec<f64>) {
+        solve_many(&self.pattern, &self.values, x, k, work);
+    }
+
     /// Bytes of the values (the pattern is shared).
     pub fn bytes(&self) -> usize {
         8 * (self.values.l.len() + self.values.u.len() + self.values.u_inv_diag.len())
