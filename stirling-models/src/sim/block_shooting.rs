@@ -9,7 +9,7 @@
 //! - **Products by blocks.** A product factors every step's `3n x 3n` stage matrix; the Krylov
 //!   route keeps those factors for its ~50 single-vector products (5 GB at nsection n = 1000).
 //!   Here the monodromy is applied to a block of columns per sweep over the steps
-//!   ([`TangentFlow::apply_block`]: each step factored once for all columns, nothing kept), and a
+//!   ([`TangentFlow::apply_block`](crate::sim::tangent::TangentFlow::apply_block): each step factored once for all columns, nothing kept), and a
 //!   few sweeps of block Arnoldi ([`crate::sim::block_arnoldi`]) give the space the multipliers
 //!   live in. Memory: the recorded stage states (`3 n` per step) and a few dozen vectors.
 //! - **Newton on a low-rank surrogate.** All but a handful of multipliers are ~0 (the stiff
@@ -27,7 +27,7 @@
 //! - **Multipliers on the converged orbit.** Once the residual is below tolerance the orbit is
 //!   recorded at the shot's tolerance and block Arnoldi runs on the same discrete `Phi` as the
 //!   dense route, from the surrogate's dominant images (already near the slow subspace), until the
-//!   leading Ritz values' residuals (from `H`, [`BlockArnoldi::ritz_residuals`]) or their change
+//!   leading Ritz values' residuals (from `H`, [`BlockArnoldi::ritz_residuals`](crate::sim::block_arnoldi::BlockArnoldi::ritz_residuals)) or their change
 //!   over the last sweep fall below [`BlockOptions::tol`]: two sweeps at n = 100 and 1000. The
 //!   multipliers equal the dense route's to round-off times their conditioning; the double
 //!   multiplier 1 (a Jordan block) splits by the square root of the Ritz residual, or of the
@@ -301,13 +301,19 @@ pub fn shoot_block_counted(
         res = r.iter().fold(0.0f64, |a, v| a.max(v.abs()));
         if res < opts.tol {
             let k = bopts.final_block.max(1);
-            let mut start = sur
-                .as_ref()
-                .map_or(Vec::new(), |b| b.ba.dominant_images(k));
+            let mut start = sur.as_ref().map_or(Vec::new(), |b| b.ba.dominant_images(k));
             let have = start.len() / n.max(1);
             start.extend(pseudo_random_block(n, k.saturating_sub(have), 2));
             let floquet = multipliers(
-                model, p, &x, t_per, opts, bopts, start, &mut stats, &mut counts,
+                model,
+                p,
+                &x,
+                t_per,
+                opts,
+                bopts,
+                start,
+                &mut stats,
+                &mut counts,
             )?;
             let cycle = LimitCycle {
                 x0: x,
@@ -354,7 +360,9 @@ pub fn shoot_block_counted(
                     run_recorded(model, p, &xe, t_per, &opts.sim, &mut |_, _, _| Ok(()))?;
                 stats.add(&st);
                 counts.differences += 1;
-                let u = (0..n).map(|j| (pe[j] - phi[j]) / (eps * sec.s[j])).collect();
+                let u = (0..n)
+                    .map(|j| (pe[j] - phi[j]) / (eps * sec.s[j]))
+                    .collect();
                 sg.extra.push((w, u));
             }
         }

@@ -29,10 +29,10 @@
 mod adapter;
 /// Block Arnoldi on an operator applied to blocks of vectors.
 pub mod block_arnoldi;
-/// Block shooting (large cycles, memory linear in the states).
-pub mod block_shooting;
 /// A linear solver for block-diagonal Newton matrices whose blocks repeat.
 pub mod block_lu;
+/// Block shooting (large cycles, memory linear in the states).
+pub mod block_shooting;
 /// Periodic motion: settling, the cycle figures.
 pub mod cycle;
 /// Dense-output helpers of the step loop (crossings, step hook, error mapping).

@@ -145,7 +145,7 @@ mod tests {
         let (_, a) = super::super::monodromy::radau3();
         let t = |s: f64| {
             vec![
-                (0, 0, -1.0 * s),
+                (0, 0, -s),
                 (1, 0, 2.0),
                 (0, 1, 0.5 * s),
                 (1, 1, -3.0),

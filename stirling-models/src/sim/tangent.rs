@@ -261,12 +261,7 @@ pub(super) fn factor_step(
         let x = &stage_x[(3 * k + j) * n..(3 * k + j + 1) * n];
         scaled_triplets(sys, t0 + c[j] * h, x, scale, &mut trip[j]);
     }
-    let stage = StageStep {
-        n,
-        h,
-        a: &a,
-        trip,
-    };
+    let stage = StageStep { n, h, a: &a, trip };
     stage
         .factor_sparse(sparse)
         .map_err(|e| SimError::SolverFailure {
