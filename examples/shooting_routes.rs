@@ -95,8 +95,14 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let mut shots: Vec<(&str, LimitCycle)> = Vec::new();
         if model.n_states() <= block_max {
             let t = Instant::now();
-            let (b, c) =
-                shoot_block_counted(model, &p, &st.x0, st.period, &opts, &BlockOptions::default())?;
+            let (b, c) = shoot_block_counted(
+                model,
+                &p,
+                &st.x0,
+                st.period,
+                &opts,
+                &BlockOptions::default(),
+            )?;
             show("block", &b, t.elapsed().as_secs_f64());
             println!(
                 "          {} surrogate(s) ({} sweeps, {} Radau steps), {} difference run(s); multipliers: {} sweeps, {} columns, {} Radau steps",

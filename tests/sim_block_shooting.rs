@@ -1,12 +1,13 @@
 //! The block shooting route against the dense one: block products equal single products on any
-//! number of factoring threads, and at nsection n = 10 and n = 100 the same limit cycle and the
-//! same leading Floquet multipliers (to 1e-6) as the dense monodromy's.
+//! number of factoring threads; at nsection n = 10 the same limit cycle as the dense route and
+//! the same leading Floquet multipliers (to 1e-6), at n = 100 the dense monodromy's multipliers
+//! on the block route's cycle.
 
 use stirling::dsl::{Closure, Model};
 use stirling::models::family::NSection;
 use stirling::models::sim::{
-    self, shoot, shoot_block_counted, tangent::flow_with_tangent, BlockOptions, ShootingOptions,
-    SimOptions,
+    self, floquet_multipliers_scaled, flow_with_monodromy, shoot, shoot_block_counted,
+    tangent::flow_with_tangent, BlockOptions, LimitCycle, ShootingOptions, SimOptions,
 };
 
 /// The settled cycle of the default engine at `n` (start: displacer at 5 mm).
@@ -53,23 +54,46 @@ fn block_products_equal_single_products_on_any_thread_count() {
     assert!(tf.apply_block_threads(&mut [0.0; 4], k, 1).is_err());
 }
 
-/// Both routes from the same settled cycle: the same cycle, and every multiplier of the block
-/// route above 1e-6 within 1e-6 of one of the dense route's.
-fn routes_agree(n_sections: usize) {
-    let model = NSection::new(n_sections, Closure::Full).unwrap();
+/// Every multiplier of `b` above 1e-6 within `tol` of one of `dense`.
+fn multipliers_agree(b: &LimitCycle, dense: &[(f64, f64)], tol: f64) {
+    eprintln!("dense {:?}", &dense[..b.floquet.len()]);
+    eprintln!("block {:?}", b.floquet);
+    assert!(b.floquet.len() >= 8);
+    assert!(b.trivial_multiplier_error() < 1e-6);
+    let mut worst = 0.0f64;
+    for &(re, im) in &b.floquet {
+        if re.hypot(im) < 1e-6 {
+            continue; // the cloud near 0
+        }
+        let near = dense
+            .iter()
+            .map(|&(a, b)| (a - re).hypot(b - im))
+            .fold(f64::MAX, f64::min);
+        worst = worst.max(near);
+    }
+    eprintln!("worst multiplier difference {worst:.2e}");
+    assert!(worst < tol, "multipliers differ by {worst:e}");
+}
+
+fn block(model: &NSection, p: &[f64], st: &sim::Settled) -> LimitCycle {
+    let opts = ShootingOptions::default();
+    let bopts = BlockOptions::default();
+    let (b, c) = shoot_block_counted(model, p, &st.x0, st.period, &opts, &bopts).unwrap();
+    eprintln!("{c:?}");
+    // nothing kept: the multipliers from a few sweeps
+    assert!(c.sweeps <= 4, "{c:?}");
+    b
+}
+
+/// n = 10: both routes from the same settled cycle reach the same cycle, and the multipliers
+/// agree to 1e-6.
+#[test]
+fn block_route_equals_dense_route_at_n10() {
+    let model = NSection::new(10, Closure::Full).unwrap();
     let p = model.default_params();
     let st = settled(&model, &p);
-    let opts = ShootingOptions::default();
-    let d = shoot(&model, &p, &st.x0, st.period, &opts).unwrap();
-    let (b, c) = shoot_block_counted(
-        &model,
-        &p,
-        &st.x0,
-        st.period,
-        &opts,
-        &BlockOptions::default(),
-    )
-    .unwrap();
+    let d = shoot(&model, &p, &st.x0, st.period, &ShootingOptions::default()).unwrap();
+    let b = block(&model, &p, &st);
     let s = sim::state_scale(&model, &p);
     let dx = max_abs(
         d.x0.iter()
@@ -78,38 +102,23 @@ fn routes_agree(n_sections: usize) {
             .map(|((a, b), w)| (a - b) / w),
     );
     let dt = (d.period - b.period).abs() / d.period;
-    eprintln!("n = {n_sections}: {c:?}");
     eprintln!("period difference {dt:.2e}, scaled x0 difference {dx:.2e}");
-    eprintln!("dense {:?}", &d.floquet[..b.floquet.len()]);
-    eprintln!("block {:?}", b.floquet);
     assert!(dt < 1e-9, "period: {dt:e}");
     assert!(dx < 1e-7, "x0: {dx:e}");
-    assert!(b.floquet.len() >= 8);
-    assert!(b.trivial_multiplier_error() < 1e-6);
-    let mut worst = 0.0f64;
-    for &(re, im) in &b.floquet {
-        if re.hypot(im) < 1e-6 {
-            continue; // the cloud near 0
-        }
-        let near = d
-            .floquet
-            .iter()
-            .map(|&(a, b)| (a - re).hypot(b - im))
-            .fold(f64::MAX, f64::min);
-        worst = worst.max(near);
-    }
-    eprintln!("worst multiplier difference {worst:.2e}");
-    assert!(worst < 1e-6, "multipliers differ by {worst:e}");
-    // nothing kept: the multipliers from at most a few sweeps
-    assert!(c.sweeps <= 4, "{c:?}");
+    multipliers_agree(&b, &d.floquet, 1e-6);
 }
 
+/// n = 100 (208 states): the block route's multipliers are the dense monodromy's on the same
+/// orbit (one dense monodromy instead of a dense shot keeps the test cheap in a debug build).
 #[test]
-fn block_route_equals_dense_route_at_n10() {
-    routes_agree(10);
-}
-
-#[test]
-fn block_route_equals_dense_route_at_n100() {
-    routes_agree(100);
+fn block_route_equals_dense_monodromy_at_n100() {
+    let model = NSection::new(100, Closure::Full).unwrap();
+    let p = model.default_params();
+    let st = settled(&model, &p);
+    let b = block(&model, &p, &st);
+    let n = model.n_states();
+    let opts = ShootingOptions::default().sim;
+    let (_, mono, _) = flow_with_monodromy(&model, &p, &b.x0, b.period, &opts).unwrap();
+    let dense = floquet_multipliers_scaled(&mono, n, &sim::state_scale(&model, &p));
+    multipliers_agree(&b, &dense, 1e-6);
 }
