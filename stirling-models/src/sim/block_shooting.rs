@@ -417,3 +417,51 @@ pub fn shoot_block_counted(
         why: "Newton did not converge".into(),
     })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn moved_matches_nearest_values() {
+        let a = [(1.0, 0.0), (0.1, 0.2), (0.1, -0.2)];
+        let swapped = [(1.0, 0.0), (0.1, -0.2), (0.1, 0.2)];
+        assert_eq!(moved_from(&a, &swapped), 0.0);
+        assert!(moved_from(&a, &[]).is_infinite());
+        let shifted = [(1.0 + 4e-9, 0.0), (0.1, 0.2), (0.1, -0.2)];
+        assert!((moved_from(&shifted, &a) - 4e-9).abs() < 1e-15);
+    }
+
+    #[test]
+    fn the_surrogate_is_exact_on_its_space_and_its_extra_directions() {
+        // A = diag(0.5, 0.25, 0, 0) plus a coupling of e4 into e1: the space of e1 and e2
+        // misses it, the extra direction e4 carries it
+        let n = 4;
+        let a = |v: &[f64]| vec![0.5 * v[0] + 2.0 * v[3], 0.25 * v[1], 0.0, 0.0];
+        let start = [1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0];
+        let mut ba = BlockArnoldi::new(n, &start, 2).unwrap();
+        ba.sweep(&mut |x: &mut [f64], k: usize| {
+            for col in x.chunks_exact_mut(n).take(k) {
+                let y = a(col);
+                col.copy_from_slice(&y);
+            }
+            Ok(())
+        })
+        .unwrap();
+        let mut sg = Surrogate {
+            ba,
+            extra: Vec::new(),
+        };
+        let r = [0.3, -0.2, 0.0, 0.7];
+        let w = sg.new_direction(&r).expect("e4 is new");
+        assert!((w[3] - 1.0).abs() < 1e-15 && w[..3].iter().all(|x| x.abs() < 1e-15));
+        sg.extra.push((w.clone(), a(&w)));
+        assert!(sg.new_direction(&r).is_none(), "nothing new left");
+        let mut v = r.to_vec();
+        sg.apply(&mut v);
+        let want = a(&r);
+        for (g, w) in v.iter().zip(&want) {
+            assert!((g - w).abs() < 1e-15, "{v:?} vs {want:?}");
+        }
+    }
+}
