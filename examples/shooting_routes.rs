@@ -1,20 +1,23 @@
 //! Limit cycle with Floquet multipliers of `nsection` (full closure, default engine) by the
-//! dense-monodromy route and the Newton-Krylov route: the timing table of
-//! docs/performance.md ("Limit cycles at large n").
+//! block route, the Newton-Krylov route and the dense-monodromy route: the timing tables of
+//! docs/performance.md ("Limit cycles at large n", "Floquet at large n").
 //!
-//! `cargo run --release --example shooting_routes [-- --ns 100,400,1000 --dense-max 1000]`
+//! `cargo run --release --example shooting_routes [-- --ns 100,400,1000 --dense-max 1000
+//! --krylov-max 2100 --block-max 100000]`
 //!
 //! For every n: settle from the displacer at 5 mm (timed apart), then shoot from the settled
-//! cycle by each route (the dense one only up to `--dense-max` states), and print the wall
-//! times, their ratio, the Newton iterations, the counters, the leading multipliers and the
-//! difference of the two cycles. One timed run per route (a shot at n = 1000 takes minutes):
+//! cycle by each route (the block one up to `--block-max` states, the Krylov one up to
+//! `--krylov-max`, the dense one up to `--dense-max`), and print the wall times, the Newton
+//! iterations, the counters, the leading multipliers, the peak memory so far, and the
+//! differences of the cycles and multipliers from the dense route's. One timed run per route (a shot at n = 1000 takes minutes):
 //! timings, not statistics; read them with the machine load (`uptime`) beside.
 
 use std::time::Instant;
 
 use stirling::dsl::Closure;
 use stirling::models::sim::{
-    self, shoot, shoot_krylov_counted, KrylovOptions, LimitCycle, ShootingOptions, SimOptions,
+    self, shoot, shoot_block_counted, shoot_krylov_counted, BlockOptions, KrylovOptions,
+    LimitCycle, ShootingOptions, SimOptions,
 };
 
 fn arg<T: std::str::FromStr>(args: &[String], name: &str) -> Option<T> {
@@ -62,6 +65,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         None => vec![100, 400, 1000],
     };
     let dense_max: usize = arg(&args, "--dense-max").unwrap_or(1000);
+    let krylov_max: usize = arg(&args, "--krylov-max").unwrap_or(2100);
+    let block_max: usize = arg(&args, "--block-max").unwrap_or(usize::MAX);
     let opts = ShootingOptions::default();
     for n in ns {
         let model = stirling::models::build("nsection", Some(n), Closure::Full)?;
@@ -87,33 +92,66 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             st.t,
             t.elapsed().as_secs_f64()
         );
-        let t = Instant::now();
-        let kopts = KrylovOptions::default();
-        let (k, c) = shoot_krylov_counted(model, &p, &st.x0, st.period, &opts, &kopts)?;
-        let tk = t.elapsed().as_secs_f64();
-        show("krylov", &k, tk);
-        println!(
-            "          {} GMRES products, {} Arnoldi products; {} Radau steps, {} with stored factors",
-            c.gmres_products, c.arnoldi_products, c.steps, c.cached_steps
-        );
-        println!("          peak RSS so far {:.0} MB", peak_rss_mb());
+        let mut shots: Vec<(&str, LimitCycle)> = Vec::new();
+        if model.n_states() <= block_max {
+            let t = Instant::now();
+            let (b, c) = shoot_block_counted(
+                model,
+                &p,
+                &st.x0,
+                st.period,
+                &opts,
+                &BlockOptions::default(),
+            )?;
+            show("block", &b, t.elapsed().as_secs_f64());
+            println!(
+                "          {} surrogate(s) ({} sweeps, {} Radau steps), {} difference run(s); multipliers: {} sweeps, {} columns, {} Radau steps",
+                c.surrogates, c.surrogate_sweeps, c.surrogate_steps, c.differences, c.sweeps, c.columns, c.steps
+            );
+            println!("          peak RSS so far {:.0} MB", peak_rss_mb());
+            shots.push(("block", b));
+        }
+        if model.n_states() <= krylov_max {
+            let t = Instant::now();
+            let kopts = KrylovOptions::default();
+            let (k, c) = shoot_krylov_counted(model, &p, &st.x0, st.period, &opts, &kopts)?;
+            show("krylov", &k, t.elapsed().as_secs_f64());
+            println!(
+                "          {} GMRES products, {} Arnoldi products; {} Radau steps, {} with stored factors",
+                c.gmres_products, c.arnoldi_products, c.steps, c.cached_steps
+            );
+            println!("          peak RSS so far {:.0} MB", peak_rss_mb());
+            shots.push(("krylov", k));
+        }
         if model.n_states() <= dense_max {
             let t = Instant::now();
             let d = shoot(model, &p, &st.x0, st.period, &opts)?;
-            let td = t.elapsed().as_secs_f64();
-            show("dense", &d, td);
+            show("dense", &d, t.elapsed().as_secs_f64());
             let s = sim::state_scale(model, &p);
-            let dx =
-                d.x0.iter()
-                    .zip(&k.x0)
-                    .zip(&s)
-                    .map(|((a, b), w)| ((a - b) / w).abs())
+            for (route, k) in &shots {
+                let dx =
+                    d.x0.iter()
+                        .zip(&k.x0)
+                        .zip(&s)
+                        .map(|((a, b), w)| ((a - b) / w).abs())
+                        .fold(0.0, f64::max);
+                // every multiplier of the route above 1e-6 against the nearest dense one
+                let worst = k
+                    .floquet
+                    .iter()
+                    .filter(|m| m.0.hypot(m.1) >= 1e-6)
+                    .map(|&(re, im)| {
+                        d.floquet
+                            .iter()
+                            .map(|&(a, b)| (a - re).hypot(b - im))
+                            .fold(f64::MAX, f64::min)
+                    })
                     .fold(0.0, f64::max);
-            println!(
-                "          dense / krylov time {:.2}; period difference {:.2e}, scaled x0 difference {dx:.2e}",
-                td / tk,
-                (d.period - k.period).abs() / d.period
-            );
+                println!(
+                    "          {route} vs dense: period {:.2e}, scaled x0 {dx:.2e}, multipliers {worst:.2e}",
+                    (d.period - k.period).abs() / d.period
+                );
+            }
         }
     }
     Ok(())

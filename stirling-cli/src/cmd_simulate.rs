@@ -62,8 +62,9 @@ pub struct SimulateArgs {
     /// Run until periodic, refine by shooting, report the cycle
     #[arg(long)]
     pub limit_cycle: bool,
-    /// Shooting route of --limit-cycle: auto (dense monodromy up to 400 states, Newton-Krylov
-    /// with the leading Floquet multipliers up to 2100 (nsection n = 1000), none above), dense, krylov, or none
+    /// Shooting route of --limit-cycle: auto (dense monodromy up to 400 states, the block route
+    /// with the leading Floquet multipliers above), dense, block, krylov (stored stage factors:
+    /// gigabytes at 2000 states), or none
     #[arg(long, value_enum, default_value_t = ShootingArg::Auto, requires = "limit_cycle")]
     pub shooting: ShootingArg,
 }
@@ -73,6 +74,7 @@ pub struct SimulateArgs {
 pub enum ShootingArg {
     Auto,
     Dense,
+    Block,
     Krylov,
     None,
 }
@@ -82,6 +84,7 @@ impl From<ShootingArg> for sim::Shooting {
         match a {
             ShootingArg::Auto => sim::Shooting::Auto,
             ShootingArg::Dense => sim::Shooting::Dense,
+            ShootingArg::Block => sim::Shooting::Block,
             ShootingArg::Krylov => sim::Shooting::Krylov,
             ShootingArg::None => sim::Shooting::Never,
         }
@@ -378,6 +381,9 @@ fn print_summary(o: &mut impl Write, s: &SimSummary) -> std::io::Result<()> {
                 sim::ShootingRoute::Dense => "dense monodromy (all multipliers)",
                 sim::ShootingRoute::Krylov => {
                     "Newton-Krylov (GMRES), leading multipliers by Arnoldi"
+                }
+                sim::ShootingRoute::Block => {
+                    "Newton on a low-rank monodromy, leading multipliers by block Arnoldi"
                 }
                 sim::ShootingRoute::Settled => "none (the settled cycle as measured)",
             };

@@ -18,9 +18,10 @@ fn shooting(s: &str) -> Res<Shooting> {
         "auto" => Ok(Shooting::Auto),
         "dense" => Ok(Shooting::Dense),
         "krylov" => Ok(Shooting::Krylov),
+        "block" => Ok(Shooting::Block),
         "none" => Ok(Shooting::Never),
         _ => Err(Failure::option(format!(
-            "shooting = `{s}`: expected \"auto\", \"dense\", \"krylov\" or \"none\""
+            "shooting = `{s}`: expected \"auto\", \"dense\", \"block\", \"krylov\" or \"none\""
         ))),
     }
 }

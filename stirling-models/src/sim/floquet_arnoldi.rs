@@ -74,7 +74,11 @@ fn start_vector(n: usize) -> Vec<f64> {
 
 /// Ritz values of the leading `j x j` block of `h`, largest modulus first.
 fn ritz(h: &[Vec<f64>], j: usize) -> Vec<(f64, f64)> {
-    let m = DMatrix::from_fn(j, j, |r, c| h[r][c]);
+    ritz_values(&DMatrix::from_fn(j, j, |r, c| h[r][c]))
+}
+
+/// The eigenvalues of `m`, largest modulus first.
+pub(super) fn ritz_values(m: &DMatrix<f64>) -> Vec<(f64, f64)> {
     let mut ev: Vec<(f64, f64)> = m
         .complex_eigenvalues()
         .iter()
@@ -85,7 +89,7 @@ fn ritz(h: &[Vec<f64>], j: usize) -> Vec<(f64, f64)> {
 }
 
 /// The `k` leading values, a trailing conjugate pair kept whole.
-fn leading(ev: &[(f64, f64)], k: usize) -> Vec<(f64, f64)> {
+pub(super) fn leading(ev: &[(f64, f64)], k: usize) -> Vec<(f64, f64)> {
     let mut k = k.min(ev.len());
     if k > 0 && k < ev.len() && ev[k - 1].1 != 0.0 && ev[k].1 == -ev[k - 1].1 {
         k += 1;
@@ -94,7 +98,7 @@ fn leading(ev: &[(f64, f64)], k: usize) -> Vec<(f64, f64)> {
 }
 
 /// Largest change between two lists of leading Ritz values (relative to `max(1, |mu|)`).
-fn change(a: &[(f64, f64)], b: &[(f64, f64)]) -> f64 {
+pub(super) fn change(a: &[(f64, f64)], b: &[(f64, f64)]) -> f64 {
     if a.len() != b.len() {
         return f64::INFINITY;
     }

@@ -74,7 +74,7 @@ pub fn default_cache_bytes() -> usize {
 }
 
 /// The square Newton system at one iterate (see the module doc).
-struct Bordered<'a> {
+pub(super) struct Bordered<'a> {
     sec: &'a Section,
     /// `f / s * T` at the return point.
     field: Vec<f64>,
@@ -83,7 +83,7 @@ struct Bordered<'a> {
 }
 
 impl Bordered<'_> {
-    fn new<'a>(sec: &'a Section, f: &[f64], t_per: f64) -> Bordered<'a> {
+    pub(super) fn new<'a>(sec: &'a Section, f: &[f64], t_per: f64) -> Bordered<'a> {
         let field = f.iter().zip(&sec.s).map(|(f, s)| f / s * t_per).collect();
         let drop = sec
             .masses
@@ -94,7 +94,7 @@ impl Bordered<'_> {
     }
 
     /// Right-hand side from the scaled return residual `r` at `x`.
-    fn rhs(&self, r: &[f64], x: &[f64]) -> Vec<f64> {
+    pub(super) fn rhs(&self, r: &[f64], x: &[f64]) -> Vec<f64> {
         let (s, iy) = (&self.sec.s, self.sec.iy);
         let mut b: Vec<f64> = r.iter().map(|v| -v).collect();
         if let Some(k) = self.drop {
@@ -105,11 +105,16 @@ impl Bordered<'_> {
         b
     }
 
-    /// `out = A z` (`z = (dx / s, dT / T)`).
-    fn apply(&self, tf: &mut TangentFlow, z: &[f64], out: &mut [f64]) -> Result<(), SimError> {
+    /// `out = A z` (`z = (dx / s, dT / T)`), the monodromy's product `D^-1 Phi D v` by `phi`.
+    pub(super) fn apply(
+        &self,
+        phi: &mut dyn FnMut(&mut [f64]) -> Result<(), SimError>,
+        z: &[f64],
+        out: &mut [f64],
+    ) -> Result<(), SimError> {
         let n = self.field.len();
         out[..n].copy_from_slice(&z[..n]);
-        tf.apply(&mut out[..n])?;
+        phi(&mut out[..n])?;
         for i in 0..n {
             out[i] += self.field[i] * z[n] - z[i];
         }
@@ -197,7 +202,7 @@ pub fn shoot_krylov_counted(
         model.rhs(p, &phi, t_per, &mut f);
         let sys = Bordered::new(&sec, &f, t_per);
         let b = sys.rhs(&r, &x);
-        let mut op = |z: &[f64], out: &mut [f64]| sys.apply(&mut tf, z, out);
+        let mut op = |z: &[f64], out: &mut [f64]| sys.apply(&mut |v| tf.apply(v), z, out);
         let sol = gmres(
             &mut op,
             &b,

@@ -14,19 +14,25 @@
 //!
 //! [`limit_cycle`](crate::sim::limit_cycle) chains them: settle from a perturbed state, shoot,
 //! measure. Up to [`SHOOTING_MAX_STATES`](crate::sim::SHOOTING_MAX_STATES) states it shoots with
-//! the dense monodromy, above (up to
-//! [`KRYLOV_SHOOTING_MAX_STATES`](crate::sim::KRYLOV_SHOOTING_MAX_STATES)) by Newton-Krylov with
-//! the leading Floquet multipliers by Arnoldi, above that it measures the settled cycle;
-//! [`limit_cycle_with`](crate::sim::limit_cycle_with) chooses.
+//! the dense monodromy, above by the block route (Newton on a low-rank surrogate of the
+//! monodromy, the leading Floquet multipliers by block Arnoldi, memory linear in the states);
+//! [`limit_cycle_with`](crate::sim::limit_cycle_with) chooses, and can force the Newton-Krylov
+//! route (stored stage factors, single-vector products) or no shooting.
 //!
 //! - [`monodromy`](crate::sim::monodromy): the monodromy by Radau IIA along the BDF trajectory.
 //! - [`tangent`](crate::sim::tangent): monodromy-vector products along a recorded BDF trajectory.
 //! - [`krylov_shooting`](crate::sim::krylov_shooting), [`gmres`](crate::sim::gmres),
 //!   [`floquet_arnoldi`](crate::sim::floquet_arnoldi): the matrix-free route.
+//! - [`block_shooting`](crate::sim::block_shooting), [`block_arnoldi`](crate::sim::block_arnoldi),
+//!   [`tangent_sweep`](crate::sim::tangent_sweep): the block route.
 
 mod adapter;
+/// Block Arnoldi on an operator applied to blocks of vectors.
+pub mod block_arnoldi;
 /// A linear solver for block-diagonal Newton matrices whose blocks repeat.
 pub mod block_lu;
+/// Block shooting (large cycles, memory linear in the states).
+pub mod block_shooting;
 /// Periodic motion: settling, the cycle figures.
 pub mod cycle;
 /// Dense-output helpers of the step loop (crossings, step hook, error mapping).
@@ -60,16 +66,21 @@ pub mod schmidt;
 pub mod sens;
 /// Limit cycles by single shooting.
 pub mod shooting;
+/// The Radau stage matrix assembled by precomputed positions.
+mod stage_slots;
 /// The ODE systems the integrator runs.
 pub mod system;
 /// Monodromy-vector products without the monodromy matrix.
 pub mod tangent;
+/// Block products with the stage matrices factored on several threads.
+pub mod tangent_sweep;
 /// Cycle work.
 pub mod work;
 
 use serde::Serialize;
 use stirling_dsl::Model;
 
+pub use block_shooting::{shoot_block, shoot_block_counted, BlockCounts, BlockOptions};
 pub use cycle::{figures, periodic, settle, CycleFigures, Settled};
 pub use floquet_arnoldi::ArnoldiOptions;
 pub use integrate::{
@@ -134,34 +145,28 @@ pub struct LimitCycleReport {
     pub route: ShootingRoute,
 }
 
-/// Above this many states [`Shooting::Auto`] shoots by Newton-Krylov instead of the
+/// Above this many states [`Shooting::Auto`] shoots by the block route instead of the
 /// dense monodromy: that is dense `n x n` and each Radau step solves for all `n` columns
 /// (nsection n = 100, 208 states: about 16 s for the whole `limit_cycle` in release;
-/// n = 1000 would take hours).
+/// n = 1000 would take hours). The block route has no upper limit: nsection n = 1000 shoots
+/// in about 12 s and 0.2 GB, n = 10,000 in minutes (docs/performance.md, issue 37).
 pub const SHOOTING_MAX_STATES: usize = 400;
-
-/// Above this many states [`Shooting::Auto`] measures the settled cycle without shooting.
-/// nsection n = 1000 (2008 states) shoots by Krylov in about two minutes with 5 GB of kept
-/// stage factors (docs/performance.md); finer models need more memory than a workstation
-/// is sure to have, so `auto` stops there; `--shooting krylov` still forces the route at any
-/// size (past the memory budget the stage matrices are refactored per product: same
-/// numbers, slower).
-pub const KRYLOV_SHOOTING_MAX_STATES: usize = 2100;
 
 /// Whether and how [`limit_cycle_with`] refines the settled cycle by shooting (and so
 /// reports Floquet multipliers).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum Shooting {
-    /// Dense up to [`SHOOTING_MAX_STATES`] states, Krylov up to
-    /// [`KRYLOV_SHOOTING_MAX_STATES`], the settled cycle above.
+    /// Dense up to [`SHOOTING_MAX_STATES`] states, the block route above.
     #[default]
     Auto,
-    /// Shoot at any size: dense up to [`SHOOTING_MAX_STATES`] states, Krylov above.
+    /// The same as `Auto` (which shoots at every size since the block route).
     Always,
     /// The dense monodromy route at any size (all multipliers).
     Dense,
-    /// The Newton-Krylov route at any size (the leading multipliers).
+    /// The Newton-Krylov route at any size (the leading multipliers; stage factors kept).
     Krylov,
+    /// The block route at any size (the leading multipliers; nothing kept).
+    Block,
     /// Measure the cycle from the last simulated period (no Floquet multipliers).
     Never,
 }
@@ -175,6 +180,9 @@ pub enum ShootingRoute {
     Dense,
     /// Newton-Krylov on monodromy-vector products; the leading multipliers by Arnoldi.
     Krylov,
+    /// Newton on a low-rank surrogate of the monodromy; the leading multipliers by block
+    /// Arnoldi on block products.
+    Block,
     /// No shooting: the settled cycle as measured.
     Settled,
 }
@@ -185,13 +193,13 @@ impl Shooting {
         let by_size = if n_states <= SHOOTING_MAX_STATES {
             ShootingRoute::Dense
         } else {
-            ShootingRoute::Krylov
+            ShootingRoute::Block
         };
         match self {
-            Shooting::Auto if n_states > KRYLOV_SHOOTING_MAX_STATES => ShootingRoute::Settled,
             Shooting::Auto | Shooting::Always => by_size,
             Shooting::Dense => ShootingRoute::Dense,
             Shooting::Krylov => ShootingRoute::Krylov,
+            Shooting::Block => ShootingRoute::Block,
             Shooting::Never => ShootingRoute::Settled,
         }
     }
@@ -273,6 +281,14 @@ pub fn limit_cycle_with(
             settled.period,
             &sh,
             &KrylovOptions::default(),
+        )?),
+        ShootingRoute::Block => Some(shoot_block(
+            model,
+            p,
+            &settled.x0,
+            settled.period,
+            &sh,
+            &BlockOptions::default(),
         )?),
         ShootingRoute::Settled => None,
     };
@@ -404,9 +420,9 @@ mod route_tests {
     #[test]
     fn auto_routes_by_size_and_forced_routes_hold() {
         assert_eq!(Shooting::Auto.route(28), ShootingRoute::Dense);
-        assert_eq!(Shooting::Auto.route(808), ShootingRoute::Krylov);
-        assert_eq!(Shooting::Auto.route(2008), ShootingRoute::Krylov);
-        assert_eq!(Shooting::Auto.route(2101), ShootingRoute::Settled);
+        assert_eq!(Shooting::Auto.route(808), ShootingRoute::Block);
+        assert_eq!(Shooting::Auto.route(20008), ShootingRoute::Block);
+        assert_eq!(Shooting::Block.route(28), ShootingRoute::Block);
         assert_eq!(Shooting::Krylov.route(2008), ShootingRoute::Krylov);
         assert_eq!(Shooting::Dense.route(808), ShootingRoute::Dense);
         assert_eq!(Shooting::Never.route(28), ShootingRoute::Settled);

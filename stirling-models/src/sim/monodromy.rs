@@ -26,9 +26,9 @@ use faer::sparse::{Pair, SparseColMat, SymbolicSparseColMat};
 use nalgebra::DMatrix;
 use stirling_dsl::Model;
 
-use super::adapter::scatter;
 use super::integrate::{integrate, Hooks, SimOptions, SolverStats};
 use super::refactor_lu::RefactorLu;
+use super::stage_slots::StageSlots;
 use super::system::{state_scale, ModelSystem, OdeSystem};
 use super::SimError;
 
@@ -64,6 +64,8 @@ pub(super) struct SparseStage {
     /// Right-hand sides and work of the many-column solve (the dense monodromy's columns).
     many: Vec<f64>,
     many_work: Vec<f64>,
+    /// Where the Jacobian triplets land in `mat`.
+    slots: StageSlots,
 }
 
 impl SparseStage {
@@ -94,6 +96,7 @@ impl SparseStage {
             work: vec![0.0; 3 * n],
             many: Vec::new(),
             many_work: Vec::new(),
+            slots: StageSlots::default(),
         })
     }
 }
@@ -218,24 +221,16 @@ impl From<super::refactor_lu::Singular> for StageError {
 impl StageStep<'_> {
     /// Assemble the stage matrix into `sp` and factorize it into `sp.lu`.
     pub(super) fn factor_sparse(&self, sp: &mut SparseStage) -> Result<(), StageError> {
-        let (n, h, a) = (self.n, self.h, self.a);
         let (sym, vals) = sp.mat.parts_mut();
-        vals.fill(0.0);
-        let mut shifted = Vec::with_capacity(self.trip[0].len());
-        for i in 0..3 {
-            for j in 0..3 {
-                shifted.clear();
-                shifted.extend(
-                    self.trip[j]
-                        .iter()
-                        .map(|&(r, cc, v)| (i * n + r, j * n + cc, -h * a[i][j] * v)),
-                );
-                scatter(sym.col_ptr(), sym.row_idx(), vals, &shifted);
-            }
-            shifted.clear();
-            shifted.extend((0..n).map(|k| (i * n + k, i * n + k, 1.0)));
-            scatter(sym.col_ptr(), sym.row_idx(), vals, &shifted);
-        }
+        sp.slots.assemble(
+            sym.col_ptr(),
+            sym.row_idx(),
+            vals,
+            self.n,
+            self.h,
+            self.a,
+            self.trip,
+        );
         sp.lu.factor(sp.mat.as_ref())?;
         Ok(())
     }

@@ -36,20 +36,22 @@ use super::SimError;
 
 /// The recorded orbit and the operator `v -> D^-1 Phi D v`.
 pub struct TangentFlow<'m> {
-    sys: ModelSystem<'m>,
-    n: usize,
+    pub(super) sys: ModelSystem<'m>,
+    pub(super) n: usize,
     /// `(t0, h)` of every Radau step.
-    steps: Vec<(f64, f64)>,
+    pub(super) steps: Vec<(f64, f64)>,
     /// The states at the three stage times, `3 n` per step.
-    stage_x: Vec<f64>,
+    pub(super) stage_x: Vec<f64>,
     sparse: SparseStage,
+    /// The Jacobian's structural pattern (the stage matrices' of the parallel sweep).
+    pub(super) pattern: Vec<(usize, usize)>,
     /// The factors of the first steps' stage matrices.
     cache: Vec<LuSnapshot>,
     /// Bytes the cache may hold, and holds.
     cache_budget: usize,
     cache_used: usize,
     trip: [Vec<(usize, usize, f64)>; 3],
-    scale: Vec<f64>,
+    pub(super) scale: Vec<f64>,
     /// Products applied so far.
     pub products: usize,
     /// Stage-matrix factorizations so far.
@@ -101,29 +103,87 @@ impl TangentFlow<'_> {
         Ok(())
     }
 
+    /// `V <- D^-1 Phi D V` for the `k` columns of `v` (column-major `n x k`): one sweep over
+    /// the steps, each stage matrix factored once (or its kept factors used) for all columns.
+    /// Without kept factors the stage matrices are factored on
+    /// [`sweep_threads`](crate::sim::tangent_sweep::sweep_threads) threads.
+    pub fn apply_block(&mut self, v: &mut [f64], k: usize) -> Result<(), SimError> {
+        self.apply_block_threads(v, k, super::tangent_sweep::sweep_threads())
+    }
+
+    /// [`TangentFlow::apply_block`] with `threads` factoring threads (1: all on this one). The
+    /// products agree to round-off whatever the count (each thread keeps its own pivots).
+    pub fn apply_block_threads(
+        &mut self,
+        v: &mut [f64],
+        k: usize,
+        threads: usize,
+    ) -> Result<(), SimError> {
+        let n = self.n;
+        if v.len() != n * k {
+            return Err(SimError::DimensionMismatch {
+                expected: n * k,
+                found: v.len(),
+            });
+        }
+        self.products += k;
+        if self.cache.is_empty() && threads > 1 && self.steps.len() > 2 * threads {
+            let rec = super::tangent_sweep::Recorded {
+                sys: &self.sys,
+                steps: &self.steps,
+                stage_x: &self.stage_x,
+                scale: &self.scale,
+                pattern: &self.pattern,
+            };
+            super::tangent_sweep::apply_block_parallel(&rec, v, k, threads)?;
+            self.factorizations += self.steps.len();
+            self.jacobian_calls += 3 * self.steps.len();
+            return Ok(());
+        }
+        let mut rhs = vec![0.0; 3 * n * k];
+        let mut work = Vec::new();
+        for s in 0..self.steps.len() {
+            for (col, block) in v.chunks_exact(n).zip(rhs.chunks_exact_mut(3 * n)) {
+                for i in 0..3 {
+                    block[i * n..(i + 1) * n].copy_from_slice(col);
+                }
+            }
+            if s < self.cache.len() {
+                let mut w1 = vec![0.0; 3 * n];
+                for block in rhs.chunks_exact_mut(3 * n) {
+                    self.cache[s].solve(block, &mut w1);
+                }
+            } else {
+                self.factor(s)?;
+                self.sparse
+                    .lu
+                    .solve_columns(&mut rhs, k, &mut work)
+                    .map_err(|_| SimError::SolverFailure {
+                        t: self.steps[s].0,
+                        why: "tangent step: singular stage matrix".into(),
+                    })?;
+            }
+            for (col, block) in v.chunks_exact_mut(n).zip(rhs.chunks_exact(3 * n)) {
+                col.copy_from_slice(&block[2 * n..]);
+            }
+        }
+        Ok(())
+    }
+
     /// Factor step `k`'s stage matrix into `sparse.lu` (kept in the cache while the budget
     /// lasts and `k` is the next uncached step).
     fn factor(&mut self, k: usize) -> Result<(), SimError> {
-        let (c, a) = radau3();
-        let (t0, h) = self.steps[k];
-        let n = self.n;
-        for j in 0..3 {
-            let x = &self.stage_x[(3 * k + j) * n..(3 * k + j + 1) * n];
-            scaled_triplets(&self.sys, t0 + c[j] * h, x, &self.scale, &mut self.trip[j]);
-            self.jacobian_calls += 1;
-        }
-        let stage = StageStep {
-            n,
-            h,
-            a: &a,
-            trip: &self.trip,
-        };
-        stage
-            .factor_sparse(&mut self.sparse)
-            .map_err(|e| SimError::SolverFailure {
-                t: t0,
-                why: format!("tangent step: {e}"),
-            })?;
+        let t0 = self.steps[k].0;
+        factor_step(
+            &self.sys,
+            &self.stage_x,
+            self.steps[k],
+            k,
+            &self.scale,
+            &mut self.trip,
+            &mut self.sparse,
+        )?;
+        self.jacobian_calls += 3;
         self.factorizations += 1;
         if k == self.cache.len() && self.cache_used < self.cache_budget {
             let kept = self
@@ -184,6 +244,32 @@ impl TangentFlow<'_> {
     }
 }
 
+/// Factor the stage matrix of step `k` (at `(t0, h)`, stage states in `stage_x`) into
+/// `sparse.lu`, with `trip` as the Jacobians' buffers.
+pub(super) fn factor_step(
+    sys: &ModelSystem<'_>,
+    stage_x: &[f64],
+    (t0, h): (f64, f64),
+    k: usize,
+    scale: &[f64],
+    trip: &mut [Vec<(usize, usize, f64)>; 3],
+    sparse: &mut SparseStage,
+) -> Result<(), SimError> {
+    let (c, a) = radau3();
+    let n = scale.len();
+    for j in 0..3 {
+        let x = &stage_x[(3 * k + j) * n..(3 * k + j + 1) * n];
+        scaled_triplets(sys, t0 + c[j] * h, x, scale, &mut trip[j]);
+    }
+    let stage = StageStep { n, h, a: &a, trip };
+    stage
+        .factor_sparse(sparse)
+        .map_err(|e| SimError::SolverFailure {
+            t: t0,
+            why: format!("tangent step: {e}"),
+        })
+}
+
 /// The flow `phi(x0, T)` and the recorded orbit for products with its monodromy, with
 /// `substeps` Radau steps per BDF step and at most `cache_bytes` of stored stage factors.
 pub fn flow_with_tangent<'m>(
@@ -203,6 +289,7 @@ pub fn flow_with_tangent<'m>(
         steps: Vec::new(),
         stage_x: Vec::new(),
         sparse: SparseStage::new(n, &pattern)?,
+        pattern,
         cache: Vec::new(),
         cache_budget: cache_bytes,
         cache_used: 0,

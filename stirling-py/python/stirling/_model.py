@@ -321,8 +321,8 @@ class Model:
         """Run until the motion repeats (at most ``t_max`` s), refine the periodic orbit by
         shooting and measure it: frequency, strokes, phase, pressure amplitudes, Floquet
         multipliers, work per cycle and power. ``shooting``: ``"auto"`` (dense monodromy up to
-        400 states, Newton-Krylov up to 2100, the settled cycle above), ``"dense"``,
-        ``"krylov"`` or ``"none"``. The other arguments as :meth:`simulate`."""
+        400 states, the block route with the leading multipliers above), ``"dense"``,
+        ``"block"``, ``"krylov"`` or ``"none"``. The other arguments as :meth:`simulate`."""
         t_max = _time(t_max, "t_max")
         start = self._start(x0, perturb)
         with reporter(progress, "settling", "s") as cb:

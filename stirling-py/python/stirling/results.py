@@ -565,7 +565,7 @@ class LimitCycle(Fields):
 
     @property
     def route(self) -> str:
-        """``dense``, ``krylov`` (shot) or ``settled`` (measured, not shot)."""
+        """``dense``, ``block``, ``krylov`` (shot) or ``settled`` (measured, not shot)."""
         return self._raw["route"]
 
     def __repr__(self) -> str:

@@ -83,6 +83,11 @@ impl LuSnapshot {
         solve_with(&self.pattern, &self.values, x, work);
     }
 
+    /// `X <- A^-1 X` for the `k` columns of `x` (column-major); `work` is resized to `n k`.
+    pub fn solve_columns(&self, x: &mut [f64], k: usize, work: &mut Vec<f64>) {
+        solve_many(&self.pattern, &self.values, x, k, work);
+    }
+
     /// Bytes of the values (the pattern is shared).
     pub fn bytes(&self) -> usize {
         8 * (self.values.l.len() + self.values.u.len() + self.values.u_inv_diag.len())
@@ -251,13 +256,14 @@ fn refactor(
             x[p.row_inv[ai[e]]] += av[e];
         }
         let last = p.u_ptr[j + 1] - 1;
-        for e in p.u_ptr[j]..last {
-            let r = p.u_idx[e];
+        let (ui, uv) = (&p.u_idx[p.u_ptr[j]..last], &mut v.u[p.u_ptr[j]..last]);
+        for (&r, u) in ui.iter().zip(uv) {
             let xr = x[r];
             x[r] = 0.0;
-            v.u[e] = xr;
-            for k in p.l_ptr[r] + 1..p.l_ptr[r + 1] {
-                x[p.l_idx[k]] -= v.l[k] * xr;
+            *u = xr;
+            let (a, b) = (p.l_ptr[r] + 1, p.l_ptr[r + 1]);
+            for (&i, &l) in p.l_idx[a..b].iter().zip(&v.l[a..b]) {
+                x[i] -= l * xr;
             }
         }
         let pivot = x[j];
