@@ -215,7 +215,8 @@ class CasadiModel:
         if err:
             res["error"] = err
         for k_out, k_in in (("steps", "nsteps"), ("rhs_calls", "nfevals"), ("jacobian_calls", "njevals"),
-                            ("lu_factorizations", "nlinsetups"), ("error_test_failures", "netfails"), ("jacobian_calls", "n_call_jacF")):
+                            ("lu_factorizations", "nlinsetups"), ("error_test_failures", "netfails"), ("jacobian_calls", "n_call_jacF"),
+                            ("newton_iterations", "nniters"), ("newton_failures", "nncfails")):
             if k_in in st:
                 res[k_out] = int(st[k_in])
         if ok:

@@ -207,6 +207,24 @@ def print_table(rows, t_end):
                  fmt_r(ratio(s["ours"], s["casadi"])), fmt_r(ratio(s["ours"], s["scipy"])), fmt_t(poles)]
         print("| " + " | ".join(cells) + " |")
     print(f"\nsim = {t_end:g} s of engine time from rest with the displacer moved 5 mm; ratios > 1x mean ours is faster.")
+    print_solver_work(rows)
+
+
+def print_solver_work(rows):
+    """The integrators' work for the simulated second: steps, Newton iterations (per step),
+    Newton-matrix factorizations and error-test failures, ours beside CVODES's (its fastest run)."""
+    print("\n| n | steps ours | steps CVODES | Newton it. ours | Newton it. CVODES | Newton/step ours "
+          "| Newton/step CVODES | LU ours | LU CVODES | err. test fails ours | err. test fails CVODES |")
+    print("|" + "|".join(["---"] * 11) + "|")
+    for r in rows:
+        o = r["sim_detail"]["ours"] or {}
+        cs = [c for c in r["sim_detail"]["casadi"] if c.get("ok")]
+        c = min(cs, key=lambda s: s["seconds"]) if cs else {}
+        per = lambda d: f"{d['newton_iterations'] / d['steps']:.2f}" if d.get("steps") and d.get("newton_iterations") is not None else "-"
+        cells = [str(r["n"])] + [str(d.get(k, "-")) for k in ("steps", "newton_iterations") for d in (o, c)]
+        cells += [per(o), per(c)]
+        cells += [str(d.get(k, "-")) for k in ("lu_factorizations", "error_test_failures") for d in (o, c)]
+        print("| " + " | ".join(cells) + " |")
 
 
 def plot(rows):

@@ -266,6 +266,7 @@ fn main() {
                 "steps": tr.stats.steps, "rhs_calls": tr.stats.rhs_calls,
                 "jacobian_calls": tr.stats.jacobian_calls, "lu_factorizations": tr.stats.lu_factorizations,
                 "error_test_failures": tr.stats.error_test_failures, "newton_failures": tr.stats.newton_failures,
+                "newton_iterations": tr.stats.newton_iterations,
                 "x_end": tr.x_end,
             }),
             Err(e) => json!({"ok": false, "error": e.to_string(), "seconds": med, "runs": runs}),

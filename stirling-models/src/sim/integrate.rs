@@ -85,6 +85,8 @@ pub struct SolverStats {
     pub lu_factorizations: usize,
     pub error_test_failures: usize,
     pub newton_failures: usize,
+    /// Newton iterations of the corrector, over every step (accepted or not).
+    pub newton_iterations: usize,
 }
 
 impl SolverStats {
@@ -96,6 +98,7 @@ impl SolverStats {
         self.lu_factorizations += o.lu_factorizations;
         self.error_test_failures += o.error_test_failures;
         self.newton_failures += o.newton_failures;
+        self.newton_iterations += o.newton_iterations;
     }
 }
 
@@ -316,6 +319,7 @@ fn solver_stats<'a, 's: 'a, M: Backend, S: OdeSolverMethod<'a, Eqn<'s, M>>>(
         lu_factorizations: st.number_of_linear_solver_setups,
         error_test_failures: st.number_of_error_test_failures,
         newton_failures: st.number_of_nonlinear_solver_fails,
+        newton_iterations: st.number_of_nonlinear_solver_iterations,
     }
 }
 
