@@ -269,6 +269,47 @@ fn moved_from(now: &[(f64, f64)], last: &[(f64, f64)]) -> f64 {
         .fold(if last.is_empty() { f64::INFINITY } else { 0.0 }, f64::max)
 }
 
+/// A Newton update of the start `x` and the period, kept so that it can be taken back.
+struct Update {
+    dx: Vec<f64>,
+    dt: f64,
+    halvings: usize,
+}
+
+/// Halvings of a Newton update whose return map fails before the shot gives up.
+const MAX_HALVINGS: usize = 6;
+
+/// The return map from `x` over `t_per`; when the run fails after a Newton update (`last`),
+/// half of that update is taken back and the run tried again, up to [`MAX_HALVINGS`] times.
+/// Why: the surrogate's Newton step is exact only on the surrogate's space, and at n = 10,000
+/// a full step led to a start from which the BDF could not take its first step (the step size
+/// collapsed at t = 1.6e-14 s, docs/performance.md).
+fn run_from_update(
+    model: &dyn Model,
+    p: &[f64],
+    (x, t_per): (&mut Vec<f64>, &mut f64),
+    opts: &ShootingOptions,
+    mut last: Option<&mut Update>,
+) -> Result<(Vec<f64>, SolverStats), SimError> {
+    loop {
+        let err = match run_recorded(model, p, x, *t_per, &opts.sim, &mut |_, _, _| Ok(())) {
+            Ok(v) => return Ok(v),
+            Err(e) => e,
+        };
+        let Some(u) = last.as_deref_mut().filter(|u| u.halvings < MAX_HALVINGS) else {
+            return Err(err);
+        };
+        for (xj, dj) in x.iter_mut().zip(u.dx.iter_mut()) {
+            *dj *= 0.5;
+            *xj -= *dj;
+        }
+        *t_per /= 1.0 + u.dt;
+        u.dt *= 0.5;
+        *t_per *= 1.0 + u.dt;
+        u.halvings += 1;
+    }
+}
+
 /// [`shoot_block`] with its work counters.
 pub fn shoot_block_counted(
     model: &dyn Model,
@@ -294,8 +335,22 @@ pub fn shoot_block_counted(
     let mut res = f64::INFINITY;
     // steps on the current surrogate, and the residual it was built at
     let (mut chord, mut at_build) = (0usize, f64::INFINITY);
+    // the last Newton update (in state units, and the period's factor), and its halvings
+    let mut last: Option<Update> = None;
     for it in 1..=opts.max_iter {
-        let (phi, st) = run_recorded(model, p, &x, t_per, &opts.sim, &mut |_, _, _| Ok(()))?;
+        let updated = last.is_some();
+        let (phi, st) = run_from_update(model, p, (&mut x, &mut t_per), opts, last.as_mut())
+            .map_err(|e| match e {
+                e if !updated => e,
+                e @ SimError::ShootingFailed { .. } => e,
+                e => SimError::ShootingFailed {
+                    iterations: it,
+                    residual: res,
+                    why: format!(
+                        "the return map failed from Newton's update and from {MAX_HALVINGS} halvings of it: {e}"
+                    ),
+                },
+            })?;
         stats.add(&st);
         let r: Vec<f64> = (0..n).map(|i| (phi[i] - x[i]) / sec.s[i]).collect();
         res = r.iter().fold(0.0f64, |a, v| a.max(v.abs()));
@@ -399,10 +454,16 @@ pub fn shoot_block_counted(
                 ),
             });
         }
+        let dx: Vec<f64> = (0..n).map(|j| sol.x[j] * sec.s[j]).collect();
         for j in 0..n {
-            x[j] += sol.x[j] * sec.s[j];
+            x[j] += dx[j];
         }
         t_per *= 1.0 + sol.x[n];
+        last = Some(Update {
+            dx,
+            dt: sol.x[n],
+            halvings: 0,
+        });
         if !(t_per > 0.0) {
             return Err(SimError::ShootingFailed {
                 iterations: it,

@@ -402,7 +402,11 @@ mod tests {
             let mut x = rhs(40);
             lu.solve(&mut x).expect("factored");
             check(&x, &d);
-            assert!(lu.factor_entries() >= nnz, "{order:?}: {} < {nnz}", lu.factor_entries());
+            assert!(
+                lu.factor_entries() >= nnz,
+                "{order:?}: {} < {nnz}",
+                lu.factor_entries()
+            );
         }
     }
 
