@@ -225,7 +225,7 @@ pub fn run(args: &Args) -> Result<Summary, Box<dyn Error>> {
     let (_, end) = whole_revolutions(&th)?;
     let (th, v, pm, pf) = (&th[..end], &v[..end], &pm[..end], &pf[..end]);
     let diff: Vec<f64> = pf.iter().zip(pm.iter()).map(|(a, b)| a - b).collect();
-    let noise = noise_sigma(&pm);
+    let noise = noise_sigma(pm);
     let rms_difference = (diff.iter().map(|d| d * d).sum::<f64>() / diff.len() as f64).sqrt();
     let to_plot = |p: &[f64]| -> Vec<(f64, f64)> {
         v.iter()
