@@ -274,6 +274,8 @@ struct Update {
     dx: Vec<f64>,
     dt: f64,
     halvings: usize,
+    /// The state the full update moved most, and by how much (in its scale).
+    largest: (usize, f64),
 }
 
 /// Halvings of a Newton update whose return map fails before the shot gives up.
@@ -338,16 +340,16 @@ pub fn shoot_block_counted(
     // the last Newton update (in state units, and the period's factor), and its halvings
     let mut last: Option<Update> = None;
     for it in 1..=opts.max_iter {
-        let updated = last.is_some();
+        let moved = last.as_ref().map(|u| u.largest);
         let (phi, st) = run_from_update(model, p, (&mut x, &mut t_per), opts, last.as_mut())
-            .map_err(|e| match e {
-                e if !updated => e,
-                e @ SimError::ShootingFailed { .. } => e,
-                e => SimError::ShootingFailed {
+            .map_err(|e| match (e, moved) {
+                (e, None) | (e @ SimError::ShootingFailed { .. }, _) => e,
+                (e, Some((j, by))) => SimError::ShootingFailed {
                     iterations: it,
                     residual: res,
                     why: format!(
-                        "the return map failed from Newton's update and from {MAX_HALVINGS} halvings of it: {e}"
+                        "the return map failed from Newton's update (which moved `{}` most, by {by:.3e} of its scale) and from {MAX_HALVINGS} halvings of it: {e}",
+                        model.states().get(j).map_or("?", |s| s.name.as_str())
                     ),
                 },
             })?;
@@ -459,10 +461,18 @@ pub fn shoot_block_counted(
             x[j] += dx[j];
         }
         t_per *= 1.0 + sol.x[n];
+        let largest = (0..n).fold((0, 0.0f64), |m, j| {
+            if sol.x[j].abs() > m.1 {
+                (j, sol.x[j].abs())
+            } else {
+                m
+            }
+        });
         last = Some(Update {
             dx,
             dt: sol.x[n],
             halvings: 0,
+            largest,
         });
         if !(t_per > 0.0) {
             return Err(SimError::ShootingFailed {
