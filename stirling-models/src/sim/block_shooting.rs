@@ -283,9 +283,10 @@ const MAX_HALVINGS: usize = 6;
 
 /// The return map from `x` over `t_per`; when the run fails after a Newton update (`last`),
 /// half of that update is taken back and the run tried again, up to [`MAX_HALVINGS`] times.
-/// Why: the surrogate's Newton step is exact only on the surrogate's space, and at n = 10,000
-/// a full step led to a start from which the BDF could not take its first step (the step size
-/// collapsed at t = 1.6e-14 s, docs/performance.md).
+/// Why: the surrogate's Newton step is exact only on the surrogate's space, so a full step
+/// can overshoot. It did not help the one failure seen (n = 10,000, docs/performance.md):
+/// there the update moved no state by more than 2.6e-4 of its scale and the BDF still could
+/// not take its first step from it, so the error names the state the update moved most.
 fn run_from_update(
     model: &dyn Model,
     p: &[f64],
