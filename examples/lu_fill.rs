@@ -80,12 +80,7 @@ fn main() {
         let p = m.default_params();
         let a = newton_matrix(&m, &p, c);
         let reps = (20_000 / m.n_states()).max(5);
-        for order in [
-            ColumnOrder::Colamd,
-            ColumnOrder::Banded,
-            ColumnOrder::Amd,
-            ColumnOrder::Natural,
-        ] {
+        for order in ColumnOrder::ALL {
             let mut lu = RefactorLu::with_order(a.symbolic(), order);
             lu.factor(a.as_ref()).expect("a regular Newton matrix");
             let t_factor = time(reps, || lu.factor(a.as_ref()).expect("regular"));

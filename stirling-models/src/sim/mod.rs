@@ -66,6 +66,8 @@ pub mod schmidt;
 pub mod sens;
 /// Limit cycles by single shooting.
 pub mod shooting;
+/// A Newton update of the block route's shot, and its halvings.
+mod shot_update;
 /// The Radau stage matrix assembled by precomputed positions.
 mod stage_slots;
 /// The ODE systems the integrator runs.

@@ -391,12 +391,7 @@ mod tests {
         let d = matrix(40, 0.7);
         let a = sparse(&d);
         let nnz = a.compute_nnz();
-        for order in [
-            ColumnOrder::Colamd,
-            ColumnOrder::Amd,
-            ColumnOrder::Natural,
-            ColumnOrder::Banded,
-        ] {
+        for order in ColumnOrder::ALL {
             let mut lu = RefactorLu::with_order(a.symbolic(), order);
             lu.factor(a.as_ref()).expect("regular");
             let mut x = rhs(40);

@@ -29,6 +29,16 @@ pub enum ColumnOrder {
     Banded,
 }
 
+impl ColumnOrder {
+    /// Every order, the default first.
+    pub const ALL: [ColumnOrder; 4] = [
+        ColumnOrder::Colamd,
+        ColumnOrder::Banded,
+        ColumnOrder::Amd,
+        ColumnOrder::Natural,
+    ];
+}
+
 /// The permutation `(forward, inverse)` for `sym` in `order`; the natural order when the
 /// ordering fails (it only reorders, so any permutation is correct).
 pub(super) fn column_order(
