@@ -117,6 +117,15 @@ pub struct DiagnoseArgs {
     /// effect alone with an unexplained remainder
     #[arg(long, default_value_t = 1.0, value_parser = ranges::non_negative)]
     pub mixed_strength: f64,
+    /// Self-check: only the cases of these truths, by the labels of the confusion matrix
+    /// (e.g. `end_stops+leak,sensor_gain,clean`); each keeps the seeds and start it has in the
+    /// whole self-check
+    #[arg(long, value_delimiter = ',')]
+    pub cases: Option<Vec<String>>,
+    /// Self-check: keep every case's record and start in OUT/records (`case<k>.csv`,
+    /// `case<k>.start.json`), to diagnose one again by hand with `--data` and `--params`
+    #[arg(long)]
+    pub keep_records: bool,
     /// Self-check: cases run at once (each diagnosis also uses both cores)
     #[arg(long, default_value_t = 2, value_parser = ranges::at_least_one)]
     pub jobs: usize,
@@ -286,6 +295,8 @@ fn run_self_check(a: &DiagnoseArgs) -> anyhow::Result<()> {
         channels: a.channels.clone(),
         seed: a.seed,
         jobs: a.jobs,
+        only: a.cases.clone(),
+        records: a.keep_records.then(|| a.out.join("records")),
         diagnose: DiagnoseOptions {
             prior: prior_arg(a.prior)?,
             rtol: rtol_arg(a.rtol)?,

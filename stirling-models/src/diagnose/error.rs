@@ -46,6 +46,8 @@ pub enum DiagnoseError {
     UnknownEffect { name: String, known: String },
     #[error("the self-check's evaluation set is empty (no evaluation seed and no clean evaluation record): give --seeds TUNE:EVAL or --clean TUNE:EVAL with EVAL >= 1")]
     EmptyEvaluation,
+    #[error("the self-check has no case `{label}` (--cases): its cases are {known}")]
+    UnknownCase { label: String, known: String },
     #[error("effect `{name}` is named twice in the candidates: name each once")]
     DuplicateEffect { name: String },
     #[error("effect `{effect}` does not apply to `{model}` (it applies to {applies})")]

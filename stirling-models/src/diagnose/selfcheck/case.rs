@@ -96,7 +96,7 @@ impl Bench<'_> {
             truth: truth.to_string(),
             source,
         })?;
-        let data = super::record::through_csv(out, &self.dir, k)?;
+        let data = super::record::through_csv(out, &self.dir, k, false)?;
         let d = diagnose(self.model, &self.p0, &data, &opts.diagnose)?;
         let mut case = self.read_case(d, truth, strength, set);
         case.seconds = t.elapsed().as_secs_f64();

@@ -18,7 +18,16 @@ pub fn run_all(
     plan: &[Planned],
     progress: &(dyn Fn(&Outcome, usize, usize) + Sync),
 ) -> Result<Vec<Outcome>, DiagnoseError> {
-    let dir = super::case::scratch_dir()?;
+    let dir = match &opts.records {
+        Some(d) => {
+            std::fs::create_dir_all(d).map_err(|source| DiagnoseError::Io {
+                path: d.clone(),
+                source,
+            })?;
+            d.clone()
+        }
+        None => super::case::scratch_dir()?,
+    };
     let next = AtomicUsize::new(0);
     let done = AtomicUsize::new(0);
     let results: Mutex<Vec<Outcome>> = Mutex::new(Vec::with_capacity(plan.len()));
@@ -35,7 +44,9 @@ pub fn run_all(
             s.spawn(worker);
         }
     });
-    let _ = std::fs::remove_dir(&dir);
+    if opts.records.is_none() {
+        let _ = std::fs::remove_dir(&dir);
+    }
     let mut out = results.into_inner().unwrap_or_else(|e| e.into_inner());
     out.sort_by_key(|o| o.index);
     Ok(out)

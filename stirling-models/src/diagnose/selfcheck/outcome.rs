@@ -209,6 +209,21 @@ impl Outcome {
 
 /// Run case `c`: rig record through a CSV in `dir`, diagnosis from its seeded start. A rig
 /// or diagnosis error is kept in the outcome (a wrong case), not returned.
+/// The diagnosis's start `p0` as a parameter file (every parameter by name, JSON).
+fn write_start(model: &dyn Model, p0: &[f64], path: &Path) -> Result<(), DiagnoseError> {
+    let map: serde_json::Map<String, serde_json::Value> = model
+        .params()
+        .iter()
+        .zip(p0)
+        .map(|(q, v)| (q.name.to_string(), serde_json::json!(v)))
+        .collect();
+    let text = serde_json::to_string_pretty(&map).unwrap_or_default();
+    std::fs::write(path, text).map_err(|source| DiagnoseError::Io {
+        path: path.to_path_buf(),
+        source,
+    })
+}
+
 pub fn run_case(
     opts: &VerdictOptions,
     model: &dyn Model,
@@ -222,6 +237,9 @@ pub fn run_case(
         let data = record(opts, c, dir)?;
         let sig = signature(&data);
         let p0 = seeded_start(model, p_nom, opts.perturb, c.perturb_seed);
+        if opts.records.is_some() {
+            write_start(model, &p0, &dir.join(format!("case{}.start.json", c.index)))?;
+        }
         Ok((diagnose(model, &p0, &data, &opts.diagnose)?, sig))
     };
     let mut out = match attempt() {

@@ -157,6 +157,15 @@ pub struct VerdictOptions {
     pub diagnose: DiagnoseOptions,
     /// Cases run at once (each diagnosis also uses the rayon pool).
     pub jobs: usize,
+    /// Only the cases of these truths (their labels, [`Truth::label`]: `leak`,
+    /// `end_stops+leak`, `outside:h_speed`, `clean`); `None`: every case. The kept cases keep
+    /// their index in the whole plan, so their seeds and starts are those of a full run.
+    pub only: Option<Vec<String>>,
+    /// Keep every case's record (`case<k>.csv`) and the diagnosis's start
+    /// (`case<k>.start.json`, parameters by name) in this directory, so that one case can be
+    /// diagnosed again by hand (`stirling diagnose nsection --n 2 --data case<k>.csv --params
+    /// case<k>.start.json`); `None`: records are removed once read.
+    pub records: Option<std::path::PathBuf>,
 }
 
 impl Default for VerdictOptions {
@@ -180,6 +189,8 @@ impl Default for VerdictOptions {
             channels: ["p", "x", "y"].map(String::from).to_vec(),
             diagnose: DiagnoseOptions::default(),
             jobs: 2,
+            only: None,
+            records: None,
         }
     }
 }
@@ -324,7 +335,7 @@ pub fn plan(opts: &VerdictOptions) -> Result<Vec<Planned>, DiagnoseError> {
     }
     cases.extend(eval);
     cases.extend(mixed.into_iter().flatten());
-    Ok(cases
+    let all: Vec<Planned> = cases
         .into_iter()
         .enumerate()
         .map(|(index, (truth, split, seed))| Planned {
@@ -334,7 +345,42 @@ pub fn plan(opts: &VerdictOptions) -> Result<Vec<Planned>, DiagnoseError> {
             seed,
             perturb_seed: seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) ^ index as u64,
         })
-        .collect())
+        .collect();
+    match &opts.only {
+        None => Ok(all),
+        Some(only) => keep_only(all, only),
+    }
+}
+
+/// The cases whose truth is one of `only` (labels, in any order of a set's names); an
+/// unknown label is refused with the labels the plan has, and a selection without an
+/// evaluation case is refused as an empty evaluation.
+fn keep_only(all: Vec<Planned>, only: &[String]) -> Result<Vec<Planned>, DiagnoseError> {
+    let canon = |l: &str| {
+        let names: Vec<String> = l.split('+').map(|s| s.trim().to_string()).collect();
+        set_label(&names)
+    };
+    let wanted: Vec<String> = only.iter().map(|l| canon(l)).collect();
+    let mut labels: Vec<String> = Vec::new();
+    for l in all.iter().map(|c| c.truth.label()) {
+        if !labels.contains(&l) {
+            labels.push(l);
+        }
+    }
+    if let Some(bad) = wanted.iter().find(|w| !labels.iter().any(|l| canon(l) == **w)) {
+        return Err(DiagnoseError::UnknownCase {
+            label: bad.clone(),
+            known: labels.join(", "),
+        });
+    }
+    let kept: Vec<Planned> = all
+        .into_iter()
+        .filter(|c| wanted.contains(&canon(&c.truth.label())))
+        .collect();
+    if !kept.iter().any(|c| c.split == Split::Eval) {
+        return Err(DiagnoseError::EmptyEvaluation);
+    }
+    Ok(kept)
 }
 
 #[cfg(test)]
@@ -418,5 +464,41 @@ mod tests {
             ..Default::default()
         };
         assert!(plan(&o).unwrap_err().to_string().contains("bounce"));
+    }
+
+    #[test]
+    fn cases_picks_truths_by_label_and_keeps_their_seeds() {
+        let all = plan(&VerdictOptions::default()).unwrap();
+        let only = plan(&VerdictOptions {
+            only: Some(vec!["leak+end_stops".into(), "clean".into()]),
+            ..Default::default()
+        })
+        .unwrap();
+        assert!(only
+            .iter()
+            .all(|c| ["end_stops+leak", "clean"].contains(&c.truth.label().as_str())));
+        assert_eq!(only.iter().filter(|c| c.truth == Truth::Clean).count(), 30);
+        assert_eq!(only.len(), 32);
+        for c in &only {
+            assert_eq!(&all[c.index], c, "case {} moved", c.index);
+        }
+    }
+
+    #[test]
+    fn cases_refuses_an_unknown_label_and_an_empty_evaluation() {
+        let e = plan(&VerdictOptions {
+            only: Some(vec!["leak+leak".into()]),
+            ..Default::default()
+        })
+        .unwrap_err();
+        assert!(matches!(e, DiagnoseError::UnknownCase { .. }), "{e}");
+        assert!(e.to_string().contains("end_stops+leak"), "{e}");
+        let e = plan(&VerdictOptions {
+            only: Some(vec!["leak".into()]),
+            seeds: (1, 0),
+            ..Default::default()
+        })
+        .unwrap_err();
+        assert!(matches!(e, DiagnoseError::EmptyEvaluation), "{e}");
     }
 }

@@ -101,7 +101,7 @@ pub fn record(opts: &VerdictOptions, c: &Planned, dir: &Path) -> Result<Measured
         let sig = signature(&run(&partner)?.data);
         cfg.effects = stops_inside(&cfg.effects, &sig);
     }
-    through_csv(run(&cfg)?, dir, c.index)
+    through_csv(run(&cfg)?, dir, c.index, opts.records.is_some())
 }
 
 /// The rig settings without the end stops' (`kc`, `xmax`, `ymax`).
@@ -134,8 +134,13 @@ fn stops_inside(set: &[String], sig: &Signature) -> Vec<String> {
 pub const STOP_FRACTIONS: [f64; 2] = [1.08, 0.73];
 
 /// A rig record written to `dir/case<k>.csv` and read back (the diagnosis sees only what a
-/// user's CSV holds); the file is removed after reading.
-pub fn through_csv(out: rig::RigOutput, dir: &Path, k: usize) -> Result<Measured, DiagnoseError> {
+/// user's CSV holds); the file is removed after reading unless `keep`.
+pub fn through_csv(
+    out: rig::RigOutput,
+    dir: &Path,
+    k: usize,
+    keep: bool,
+) -> Result<Measured, DiagnoseError> {
     let path = dir.join(format!("case{k}.csv"));
     write_csv(&path, &out.data, &[]).map_err(|source| DiagnoseError::Io {
         path: path.clone(),
@@ -143,7 +148,9 @@ pub fn through_csv(out: rig::RigOutput, dir: &Path, k: usize) -> Result<Measured
     })?;
     drop(out);
     let data = read_csv(&path)?;
-    let _ = std::fs::remove_file(&path);
+    if !keep {
+        let _ = std::fs::remove_file(&path);
+    }
     Ok(data)
 }
 
