@@ -72,6 +72,25 @@ fn an_empty_self_check_evaluation_set_is_refused_up_front() {
 }
 
 #[test]
+fn an_unknown_self_check_case_is_refused_with_the_labels_there_are() {
+    let dir = scratch("msg_selfcheck_cases");
+    let start = std::time::Instant::now();
+    fails_with(
+        &[
+            "diagnose",
+            "--self-check",
+            "--cases",
+            "leak+leak",
+            "--out",
+            s(&dir),
+        ],
+        &["no case `leak+leak`", "end_stops+leak", "outside:h_speed"],
+    );
+    assert!(start.elapsed().as_secs_f64() < 10.0);
+    assert!(!dir.join("selfcheck.json").exists());
+}
+
+#[test]
 fn a_root_locus_names_the_parameter_value_where_it_fails() {
     fails_with(
         &[

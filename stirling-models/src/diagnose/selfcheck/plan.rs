@@ -367,7 +367,10 @@ fn keep_only(all: Vec<Planned>, only: &[String]) -> Result<Vec<Planned>, Diagnos
             labels.push(l);
         }
     }
-    if let Some(bad) = wanted.iter().find(|w| !labels.iter().any(|l| canon(l) == **w)) {
+    if let Some(bad) = wanted
+        .iter()
+        .find(|w| !labels.iter().any(|l| canon(l) == **w))
+    {
         return Err(DiagnoseError::UnknownCase {
             label: bad.clone(),
             known: labels.join(", "),
