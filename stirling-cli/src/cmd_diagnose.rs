@@ -34,6 +34,12 @@ pub struct DiagnoseArgs {
     /// model declares; the calibration stays inside them
     #[arg(long, value_name = "FILE")]
     pub bounds: Option<PathBuf>,
+    /// Restart stage 1 from the measured body states every this many cycles, from the first
+    /// step on (what the diagnosis's second pass for end stops does by itself, at 0.25, when
+    /// one run explains nothing): for records whose bodies hit stops; the steps then follow
+    /// the restarted rule (docs/diagnosis.md, Method step 6)
+    #[arg(long, value_name = "CYCLES", allow_negative_numbers = true, value_parser = ranges::restart_cycles)]
+    pub restart_cycles: Option<f64>,
     /// Nominal parameters the calibration frees, comma-separated (default: those the model
     /// declares `free`; on a kinematic engine, its film coefficients and flow resistances)
     #[arg(long, value_delimiter = ',')]
@@ -205,6 +211,7 @@ pub fn run(a: &DiagnoseArgs) -> anyhow::Result<()> {
                 .free
                 .as_ref()
                 .map(|v| v.iter().map(|s| s.trim().to_string()).collect()),
+            restart_cycles: a.restart_cycles,
             ..Default::default()
         },
         effects: effects_arg(&a.effects),

@@ -152,6 +152,15 @@ fn multiple_shooting_and_finite_values() {
     for v in ["-1", "0", "1e9", "nan"] {
         let fit = ["fit", "cv1", "--data", "r.csv", "--restart-cycles", v];
         refused(&fit, "--restart-cycles", v, "");
+        let diagnose = [
+            "diagnose",
+            "nsection",
+            "--data",
+            "r.csv",
+            "--restart-cycles",
+            v,
+        ];
+        refused(&diagnose, "--restart-cycles", v, "");
     }
     let locus = [
         "locus", "schmidt", "--param", "Th", "--from", "nan", "--to", "2",
