@@ -41,7 +41,7 @@ fn diagnosed_with(rate: f64, effects: Vec<String>, seed: u64, candidates: &[&str
         ..Default::default()
     };
     let dir = tempdir(seed);
-    let data = through_csv(rig::run(&cfg).unwrap(), &dir, 0).unwrap();
+    let data = through_csv(rig::run(&cfg).unwrap(), &dir, 0, false).unwrap();
     let (model, p_nom) = nominal_model("nsection", Some(2)).unwrap();
     let p0 = seeded_start(model.as_ref(), &p_nom, 0.08, seed ^ 0x5EED);
     let opts = DiagnoseOptions {

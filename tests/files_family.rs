@@ -87,15 +87,21 @@ fn same_description(a: &dyn Model, b: &dyn Model) {
     }
 }
 
-/// The largest relative difference so far and what it was in.
+/// The floor of [`Worst::see_matrix`] for two codes of the same operations in another order.
+const CANCELLED: f64 = 1e-9;
+/// The floor for the folded model, whose multiply-adds are fused ([`CompiledModel::folded`]).
+const FUSED_CANCELLED: f64 = 1e-4;
+
+/// The largest relative difference so far, what it was in, and the floor of
+/// [`Worst::see_matrix`] (a fraction of a row's largest entry).
 #[derive(Clone, Copy, Debug)]
-struct Worst(f64, &'static str);
+struct Worst(f64, &'static str, f64);
 
 impl Worst {
     fn see(&mut self, what: &'static str, a: &[f64], b: &[f64]) {
         let r = rel(a, b);
         if r > self.0 {
-            *self = Worst(r, what);
+            *self = Worst(r, what, self.2);
         }
     }
 
@@ -105,6 +111,16 @@ impl Worst {
     /// (-0.048 in a row whose entries reach 1.6e10 at n = 100), where the two codes' sums in
     /// another order differ by 1e-12 of the entry and 3e-24 of the row.
     fn see_matrix(&mut self, what: &'static str, rows: usize, a: &[f64], b: &[f64]) {
+        self.see_matrix_floor(what, rows, (a, b), self.2);
+    }
+
+    fn see_matrix_floor(
+        &mut self,
+        what: &'static str,
+        rows: usize,
+        (a, b): (&[f64], &[f64]),
+        floor: f64,
+    ) {
         let cols = a.len() / rows.max(1);
         for r in 0..rows {
             let row_max = (0..cols)
@@ -112,9 +128,9 @@ impl Worst {
                 .fold(0.0, f64::max);
             for c in 0..cols {
                 let (x, y) = (a[r + rows * c], b[r + rows * c]);
-                let m = x.abs().max(y.abs()).max(1e-9 * row_max);
+                let m = x.abs().max(y.abs()).max(floor * row_max);
                 if m > 0.0 && (x - y).abs() / m > self.0 {
-                    *self = Worst((x - y).abs() / m, what);
+                    *self = Worst((x - y).abs() / m, what, self.2);
                 }
             }
         }
@@ -192,7 +208,7 @@ fn sensors(a: &dyn Model, b: &dyn Model, p: &[f64], x: &[f64], w: &mut Worst) {
 
 #[test]
 fn family_files_are_the_macro_models() {
-    let mut worst = Worst(0.0, "");
+    let mut worst = Worst(0.0, "", CANCELLED);
     for (name, build, ns) in members() {
         for &closure in &[Closure::Full, Closure::Frozen] {
             for &n in ns {
@@ -200,7 +216,7 @@ fn family_files_are_the_macro_models() {
                 let b = build(n, closure);
                 same_description(a.as_ref(), b.as_ref());
                 let mut r = rng(n as u64 * 7 + 3);
-                let mut w = Worst(0.0, "");
+                let mut w = Worst(0.0, "", CANCELLED);
                 for k in 0..4 {
                     let mut p = b.default_params();
                     if k > 0 {
@@ -287,7 +303,10 @@ fn folded_parameters_give_the_same_model() {
                 frhs < rhs && fjac < jac,
                 "{name} n = {n}: folded tapes {frhs}, {fjac} against {rhs}, {jac}"
             );
-            let mut w = Worst(0.0, "");
+            // fused multiply-adds round a cancelled entry once where the macro rounds twice:
+            // `d P'/d m` at n = 10 (3.19e4 in a row reaching 7.6e12) moved by 2e-9 of itself,
+            // 9e-18 of its row
+            let mut w = Worst(0.0, "", FUSED_CANCELLED);
             for spread in [Spread::Wide, Spread::Balanced] {
                 let x = random_state(&m, &p, spread, &mut r);
                 compare_at(&folded, &m, &p, &x, &mut w);

@@ -119,10 +119,11 @@ fn jit_is_the_interpreter_on_every_family_file() {
                     let spread = [Spread::Wide, Spread::Balanced][k % 2];
                     let x = random_state(&interp, &p, spread, &mut r);
                     check(name, n, &jit, &interp, &p, &x);
-                    // folded in: both paths, and the JIT's folded code against the interpreter
+                    // folded in: the JIT's folded code against the interpreter's folded tape
+                    // (with the parameters as inputs the folded model is not the same bits:
+                    // its multiply-adds are fused, `files_family` bounds it against the macro)
                     let (jf, inf) = (jit.folded(&p), interp.folded(&p));
                     check(name, n, &jf, &inf, &p, &x);
-                    check(name, n, &jf, &interp, &p, &x);
                     assert!(jf.native_tapes() > 0, "{name} n = {n}: folded ran natively");
                 }
                 assert_eq!(interp.native_tapes(), 0);

@@ -33,7 +33,7 @@ enum Command {
         json: bool,
     },
     /// Sim-to-real gap diagnosis: where the gap lies, which omitted effect, how far it closes
-    Diagnose(cmd_diagnose::DiagnoseArgs),
+    Diagnose(Box<cmd_diagnose::DiagnoseArgs>),
     /// Virtual test rig: truth model plus effects, noise and offsets -> measured CSV + truth sidecar
     Rig(cmd_rig::RigArgs),
     /// Two-stage identification from measured data (mechanics, then gas), with intervals and fit %

@@ -92,16 +92,7 @@ impl Layout {
     }
 }
 
-/// The operands of an instruction (none for a leaf).
-pub(crate) fn operands(op: &Op) -> ([u32; 2], usize) {
-    match *op {
-        Op::X(_) | Op::P(_) | Op::V(_) | Op::K(_) => ([0, 0], 0),
-        Op::Neg(a) | Op::Powi(a, _) | Op::Func(_, a) => ([a, 0], 1),
-        Op::Add(a, b) | Op::Sub(a, b) | Op::Mul(a, b) | Op::Div(a, b) | Op::Powf(a, b) => {
-            ([a, b], 2)
-        }
-    }
-}
+pub(crate) use stirling_dsl::compiled::operands;
 
 /// Whether `op` reads an input or is a number (emitted again where a later function needs
 /// it, never kept in the scratch array).
@@ -193,6 +184,11 @@ pub(crate) fn function(
                 }
                 r(k as u32)
             }
+            Op::MulAdd(..) | Op::MulSub(..) | Op::NegMulAdd(..) => {
+                let (args, _) = operands(&op);
+                let (x, y, z) = (r(args[0]), r(args[1]), r(args[2]));
+                fused(&mut b, op, x, y, z)
+            }
             _ => {
                 let (args, count) = operands(&op);
                 let a = r(args[0]);
@@ -260,7 +256,30 @@ pub(crate) fn arith(
         Op::X(_) | Op::P(_) | Op::V(_) | Op::K(_) => {
             return Err(JitError::Codegen("a leaf is not an operation".into()))
         }
+        // its callers emit it with its three operands ([`fused`])
+        Op::MulAdd(..) | Op::MulSub(..) | Op::NegMulAdd(..) => {
+            return Err(JitError::Codegen(
+                "a multiply-add has three operands".into(),
+            ))
+        }
     })
+}
+
+/// A fused multiply-add (`op` one of [`Op::MulAdd`], [`Op::MulSub`], [`Op::NegMulAdd`]) on
+/// `a`, `b`, `c`: one `fma`, a negated operand by `fneg` (x86 folds it into the instruction:
+/// `vfmsub`, `vfnmadd`).
+pub(crate) fn fused(b: &mut FunctionBuilder, op: Op, a: Value, x: Value, c: Value) -> Value {
+    match op {
+        Op::MulSub(..) => {
+            let c = b.ins().fneg(c);
+            b.ins().fma(a, x, c)
+        }
+        Op::NegMulAdd(..) => {
+            let a = b.ins().fneg(a);
+            b.ins().fma(a, x, c)
+        }
+        _ => b.ins().fma(a, x, c),
+    }
 }
 
 /// The value of leaf instruction `k`, loaded (`None` for any other instruction). A number is

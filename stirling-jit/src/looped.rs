@@ -43,7 +43,7 @@ impl Numbers {
         }
         for s in &rep.body {
             let leaves = match *s {
-                Step::Leaf(l) => [Some(l), None],
+                Step::Leaf(l) => [Some(l), None, None],
                 Step::Op { args, .. } => args.map(|a| match a {
                     Arg::Leaf(l) => Some(l),
                     _ => None,
@@ -150,15 +150,21 @@ impl Emit<'_, '_> {
             } else {
                 let (a, count) = operands(&op);
                 let x = self.reg(a[0] as usize, vals, exit)?;
-                let (x, y) = if count == 2 {
+                if count == 3 {
                     let y = self.reg(a[1] as usize, vals, exit)?;
-                    let mem =
-                        |q: u32| leaf(&self.tape.ops[q as usize]) || vals[q as usize].is_none();
-                    commuted(op, x, y, [mem(a[0]), mem(a[1])])
+                    let z = self.reg(a[2] as usize, vals, exit)?;
+                    crate::build::fused(&mut self.b, op, x, y, z)
                 } else {
-                    (x, x)
-                };
-                arith(&mut self.b, &self.imports, &mut self.minus_zero, op, x, y)?
+                    let (x, y) = if count == 2 {
+                        let y = self.reg(a[1] as usize, vals, exit)?;
+                        let mem =
+                            |q: u32| leaf(&self.tape.ops[q as usize]) || vals[q as usize].is_none();
+                        commuted(op, x, y, [mem(a[0]), mem(a[1])])
+                    } else {
+                        (x, x)
+                    };
+                    arith(&mut self.b, &self.imports, &mut self.minus_zero, op, x, y)?
+                }
             };
             vals[k] = Some(val);
             while let Some(&(r, out)) = self.stores.get(s) {
@@ -496,8 +502,8 @@ fn body(e: &mut Emit, vals: &[Option<Value>]) -> Result<HashMap<usize, Exit>, Ji
             }
             Step::Op { op, args } => {
                 let (_, count) = operands(&op);
-                let mut v = [e.consts; 2];
-                let mut mem = [false; 2];
+                let mut v = [e.consts; 3];
+                let mut mem = [false; 3];
                 for k in 0..count {
                     v[k] = match args[k] {
                         Arg::Leaf(l) => {
@@ -519,12 +525,16 @@ fn body(e: &mut Emit, vals: &[Option<Value>]) -> Result<HashMap<usize, Exit>, Ji
                         }
                     };
                 }
-                let (x, y) = if count == 2 {
-                    commuted(op, v[0], v[1], mem)
+                if count == 3 {
+                    crate::build::fused(&mut e.b, op, v[0], v[1], v[2])
                 } else {
-                    (v[0], v[0])
-                };
-                arith(&mut e.b, &e.imports, &mut e.minus_zero, op, x, y)?
+                    let (x, y) = if count == 2 {
+                        commuted(op, v[0], v[1], [mem[0], mem[1]])
+                    } else {
+                        (v[0], v[0])
+                    };
+                    arith(&mut e.b, &e.imports, &mut e.minus_zero, op, x, y)?
+                }
             }
         };
         own[t] = Some(val);

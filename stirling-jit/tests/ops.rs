@@ -21,6 +21,12 @@ fn tape() -> Tape {
     for (a, b) in [(0, 1), (1, 2), (2, 3), (3, 4), (0, 4)] {
         ops.extend([Op::Add(a, b), Op::Sub(a, b), Op::Mul(a, b), Op::Div(a, b)]);
         ops.push(Op::Powf(a, b));
+        let c = (a + b + 1) % 5;
+        ops.extend([
+            Op::MulAdd(a, b, c),
+            Op::MulSub(a, b, c),
+            Op::NegMulAdd(a, b, c),
+        ]);
     }
     for a in 0..5 {
         ops.push(Op::Neg(a));

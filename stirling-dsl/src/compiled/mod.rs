@@ -32,4 +32,4 @@ pub use instance::InstanceError;
 pub use model::{CompileError, CompiledModel};
 pub use repeat::{Arg, LoopLeaf, Repeat, Step};
 pub use runner::{Jit, Runner};
-pub use tape::{Op, Tape};
+pub use tape::{fused_value, operands, Op, Tape};

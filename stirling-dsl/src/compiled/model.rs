@@ -264,15 +264,23 @@ impl CompiledModel {
 
     /// This model with the parameters `p` folded in: every parameter expression of every
     /// function computed once, at `p` (what a simulation or a sweep point can use; a fit
-    /// keeps the parameters as inputs). Called with `p` (the same bits) it gives bit for bit
-    /// what this model gives; called with any other vector (even `-0.0` for `0.0`) it
+    /// keeps the parameters as inputs). Called with `p` (the same bits) it gives what this model
+    /// gives: bit for bit, except the right-hand side and the Jacobian, whose sums of products
+    /// are fused multiply-adds (one rounding for two, as a C compiler contracts them; an entry
+    /// moves by an ulp of its products, [`Tape::fold_fused`]); called with any other vector (even `-0.0` for `0.0`) it
     /// computes with the parameters as inputs, so a changed parameter is never silently
     /// ignored.
     pub fn folded(&self, p: &[f64]) -> CompiledModel {
         let jit = self.jit;
-        let folded = self
+        let mut folded = self
             .f
             .map(|f| Function::new(f.tape.fold(p), f.places.clone()).with_jit(jit));
+        // the simulation's work with its multiply-adds fused (`Tape::fold_fused`)
+        let fused =
+            |f: &Function| Function::new(f.tape.fold_fused(p), f.places.clone()).with_jit(jit);
+        folded.rhs = fused(&self.f.rhs);
+        folded.jac = fused(&self.f.jac);
+        folded.rhs_jac = fused(&self.f.rhs_jac);
         CompiledModel {
             def: Arc::clone(&self.def),
             n: self.n,

@@ -48,7 +48,7 @@ pub enum Step {
     /// A leaf (computed only where an output stores it; its users read it themselves).
     Leaf(LoopLeaf),
     /// An operation: `op`'s kind (its operand registers meaningless) on `args`.
-    Op { op: Op, args: [Arg; 2] },
+    Op { op: Op, args: [Arg; 3] },
 }
 
 /// A run of `count` sections of a tape, the same instructions each: iteration `i` stands
@@ -92,6 +92,9 @@ fn shape(op: Op) -> Op {
         Op::Neg(_) => Op::Neg(0),
         Op::Powi(_, k) => Op::Powi(0, k),
         Op::Func(f, _) => Op::Func(f, 0),
+        Op::MulAdd(..) => Op::MulAdd(0, 0, 0),
+        Op::MulSub(..) => Op::MulSub(0, 0, 0),
+        Op::NegMulAdd(..) => Op::NegMulAdd(0, 0, 0),
         leaf => leaf,
     }
 }
@@ -236,7 +239,7 @@ impl Finder<'_> {
             return None;
         }
         let (_, count) = operands(&op);
-        let mut args = [Arg::Leaf(LoopLeaf::K(0.0)); 2];
+        let mut args = [Arg::Leaf(LoopLeaf::K(0.0)); 3];
         for (a, slot) in args.iter_mut().enumerate().take(count) {
             *slot = self.arg(t, a)?;
         }
@@ -384,6 +387,9 @@ mod tests {
         }
     }
 
+    /// An operand slot an instruction does not use.
+    const UNUSED: Arg = Arg::Leaf(LoopLeaf::K(0.0));
+
     #[test]
     fn the_interior_sections_are_one_body() {
         let t = chain(10);
@@ -393,14 +399,18 @@ mod tests {
         let prev = Arg::Prev { t: 1, init: 3 };
         let sub = Step::Op {
             op: Op::Sub(0, 0),
-            args: [Arg::Leaf(LoopLeaf::X { base: 1, step: 1 }), prev],
+            args: [Arg::Leaf(LoopLeaf::X { base: 1, step: 1 }), prev, UNUSED],
         };
         assert_eq!(r.body[1], sub);
         assert_eq!(
             r.body[3].clone(),
             Step::Op {
                 op: Op::Mul(0, 0),
-                args: [Arg::Body(1), Arg::Leaf(LoopLeaf::P { base: 0, step: 0 })],
+                args: [
+                    Arg::Body(1),
+                    Arg::Leaf(LoopLeaf::P { base: 0, step: 0 }),
+                    UNUSED,
+                ],
             }
         );
         // outputs 2j and 2j + 1 of section j: 2 and 3 in the first iteration, step 2

@@ -26,6 +26,25 @@ pub enum Op {
     Powi(u32, i32),
     Powf(u32, u32),
     Func(Func, u32),
+    /// `a * b + c` rounded once (IEEE 754 fused multiply-add, Rust's `f64::mul_add`): only
+    /// in tapes with the parameters folded in ([`Tape::fold`]), where it replaces a product
+    /// used by one sum alone.
+    MulAdd(u32, u32, u32),
+    /// `a * b - c` rounded once (`a.mul_add(b, -c)`; negation is exact).
+    MulSub(u32, u32, u32),
+    /// `c - a * b` rounded once (`(-a).mul_add(b, c)`).
+    NegMulAdd(u32, u32, u32),
+}
+
+/// The value of a fused instruction ([`Op::MulAdd`], [`Op::MulSub`], [`Op::NegMulAdd`]) on
+/// its operands' values; `None` for any other instruction.
+pub fn fused_value(op: &Op, a: f64, b: f64, c: f64) -> Option<f64> {
+    match op {
+        Op::MulAdd(..) => Some(a.mul_add(b, c)),
+        Op::MulSub(..) => Some(a.mul_add(b, -c)),
+        Op::NegMulAdd(..) => Some((-a).mul_add(b, c)),
+        _ => None,
+    }
 }
 
 /// A straight-line program: its instructions and the registers holding its outputs.
@@ -79,13 +98,14 @@ fn heights(arena: &Arena, roots: &[Id]) -> Vec<u32> {
 }
 
 /// The operands of an instruction (none for a leaf).
-pub(crate) fn operands(op: &Op) -> ([u32; 2], usize) {
+pub fn operands(op: &Op) -> ([u32; 3], usize) {
     match *op {
-        Op::X(_) | Op::P(_) | Op::V(_) | Op::K(_) => ([0, 0], 0),
-        Op::Neg(a) | Op::Powi(a, _) | Op::Func(_, a) => ([a, 0], 1),
+        Op::X(_) | Op::P(_) | Op::V(_) | Op::K(_) => ([0, 0, 0], 0),
+        Op::Neg(a) | Op::Powi(a, _) | Op::Func(_, a) => ([a, 0, 0], 1),
         Op::Add(a, b) | Op::Sub(a, b) | Op::Mul(a, b) | Op::Div(a, b) | Op::Powf(a, b) => {
-            ([a, b], 2)
+            ([a, b, 0], 2)
         }
+        Op::MulAdd(a, b, c) | Op::MulSub(a, b, c) | Op::NegMulAdd(a, b, c) => ([a, b, c], 3),
     }
 }
 
@@ -101,6 +121,9 @@ pub(crate) fn renumber(op: Op, to: &[u32]) -> Op {
         Op::Neg(a) => Op::Neg(r(a)),
         Op::Powi(a, k) => Op::Powi(r(a), k),
         Op::Func(f, a) => Op::Func(f, r(a)),
+        Op::MulAdd(a, b, c) => Op::MulAdd(r(a), r(b), r(c)),
+        Op::MulSub(a, b, c) => Op::MulSub(r(a), r(b), r(c)),
+        Op::NegMulAdd(a, b, c) => Op::NegMulAdd(r(a), r(b), r(c)),
         leaf => leaf,
     }
 }
@@ -294,6 +317,9 @@ impl Tape {
                 Op::Powi(a, k) => g(a).powi(k),
                 Op::Powf(a, b) => g(a).powf(g(b)),
                 Op::Func(f, a) => f.apply(g(a)),
+                Op::MulAdd(a, b, c) | Op::MulSub(a, b, c) | Op::NegMulAdd(a, b, c) => {
+                    fused_value(op, g(a), g(b), g(c)).unwrap_or(f64::NAN)
+                }
             };
             regs.push(val);
         }
