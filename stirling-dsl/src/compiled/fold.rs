@@ -151,4 +151,46 @@ mod tests {
             }
         }
     }
+
+    /// `x0 * x1 + x2`, `x0 * x2 - x1`, `x2 - x1 * x0` and a product read twice: the three
+    /// sums of a product read once fuse (and the products go), the fourth stays; the fused
+    /// values are `mul_add`'s, not the two roundings'.
+    #[test]
+    fn sums_of_products_read_once_fuse() {
+        let t = Tape {
+            ops: vec![
+                Op::X(0),
+                Op::X(1),
+                Op::X(2),
+                Op::Mul(0, 1),
+                Op::Add(3, 2),
+                Op::Mul(0, 2),
+                Op::Sub(5, 1),
+                Op::Mul(1, 0),
+                Op::Sub(2, 7),
+                Op::Mul(1, 2),
+                Op::Add(9, 9),
+            ],
+            outputs: vec![4, 6, 8, 10],
+            split: None,
+            sections: Vec::new(),
+        };
+        let f = t.fold_fused(&[]);
+        let count = |pred: fn(&Op) -> bool| f.ops.iter().filter(|o| pred(o)).count();
+        assert_eq!(count(|o| matches!(o, Op::MulAdd(..))), 1, "{:?}", f.ops);
+        assert_eq!(count(|o| matches!(o, Op::MulSub(..))), 1, "{:?}", f.ops);
+        assert_eq!(count(|o| matches!(o, Op::NegMulAdd(..))), 1, "{:?}", f.ops);
+        assert_eq!(count(|o| matches!(o, Op::Mul(..))), 1, "{:?}", f.ops);
+        let x = [0.1, 3.0, 1.0 / 3.0];
+        let (mut a, mut b) = (Vec::new(), Vec::new());
+        f.run(&[], &x, &[], &mut a);
+        t.run(&[], &x, &[], &mut b);
+        let out = |t: &Tape, r: &[f64], k: usize| r[t.outputs[k] as usize];
+        assert_eq!(out(&f, &a, 0), x[0].mul_add(x[1], x[2]));
+        assert_eq!(out(&f, &a, 1), x[0].mul_add(x[2], -x[1]));
+        assert_eq!(out(&f, &a, 2), (-x[1]).mul_add(x[0], x[2]));
+        assert_eq!(out(&f, &a, 3), out(&t, &b, 3));
+        // unfused, `fold` keeps the operations one for one
+        assert_eq!(t.fold(&[]).ops, t.ops);
+    }
 }
