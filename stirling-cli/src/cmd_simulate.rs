@@ -344,7 +344,7 @@ fn plots(
 fn print_summary(o: &mut impl Write, s: &SimSummary) -> std::io::Result<()> {
     writeln!(
         o,
-        "model {} (n = {}, closure {}, {} states), t_end = {:.4} s",
+        "model {} (n = {}, closure {}, {} states), t_end = {} s",
         s.model, s.n, s.closure, s.n_states, s.t_end
     )?;
     if let (Some(f), Some(xa), Some(ya), Some(ph)) = (s.frequency_hz, s.x_amp, s.y_amp, s.phase_deg)
