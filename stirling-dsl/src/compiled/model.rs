@@ -264,12 +264,12 @@ impl CompiledModel {
 
     /// This model with the parameters `p` folded in: every parameter expression of every
     /// function computed once, at `p` (what a simulation or a sweep point can use; a fit
-    /// keeps the parameters as inputs). Called with `p` (the same bits) it gives what this model
-    /// gives: bit for bit, except the right-hand side and the Jacobian, whose sums of products
-    /// are fused multiply-adds (one rounding for two, as a C compiler contracts them; an entry
-    /// moves by an ulp of its products, [`Tape::fold_fused`]); called with any other vector (even `-0.0` for `0.0`) it
-    /// computes with the parameters as inputs, so a changed parameter is never silently
-    /// ignored.
+    /// keeps the parameters as inputs). Called with `p` (the same bits) it gives what this
+    /// model gives: bit for bit, except the right-hand side and the Jacobian, whose sums of
+    /// products are fused multiply-adds (one rounding for two, as a C compiler contracts them;
+    /// an entry moves by an ulp of its products, [`super::Tape::fold_fused`]); called with any
+    /// other vector (even `-0.0` for `0.0`) it computes with the parameters as inputs, so a
+    /// changed parameter is never silently ignored.
     pub fn folded(&self, p: &[f64]) -> CompiledModel {
         let jit = self.jit;
         let mut folded = self
