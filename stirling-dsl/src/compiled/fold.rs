@@ -34,7 +34,7 @@ impl Tape {
     }
 
     /// [`Tape::fold`] with every sum of a product nothing else reads fused into one
-    /// multiply-add ([`fuse_mul_add`]).
+    /// multiply-add (`fuse_mul_add`).
     pub fn fold_fused(&self, p: &[f64]) -> Tape {
         self.fold_with(p, true)
     }
