@@ -319,6 +319,11 @@ fn run_self_check(a: &DiagnoseArgs) -> anyhow::Result<()> {
         a.force,
         "--out",
     )?;
+    if a.keep_records {
+        let records = a.out.join("records");
+        let kept = ["case*.csv", "case*.start.json"];
+        files::prepare_dir(&records, &kept, a.force, "--keep-records")?;
+    }
     let clock = std::time::Instant::now();
     let progress = |c: &selfcheck::outcome::Outcome, done: usize, total: usize| {
         let el = clock.elapsed().as_secs_f64();

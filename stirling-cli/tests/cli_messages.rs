@@ -91,6 +91,28 @@ fn an_unknown_self_check_case_is_refused_with_the_labels_there_are() {
 }
 
 #[test]
+fn kept_self_check_records_are_not_overwritten_without_force() {
+    let dir = scratch("msg_selfcheck_records");
+    let records = dir.join("records");
+    std::fs::create_dir_all(&records).unwrap();
+    std::fs::write(records.join("case3.csv"), "t,p,x,y\n").unwrap();
+    fails_with(
+        &[
+            "diagnose",
+            "--self-check",
+            "--keep-records",
+            "--out",
+            s(&dir),
+        ],
+        &["--keep-records", "case3.csv", "pass --force to overwrite"],
+    );
+    assert_eq!(
+        std::fs::read_to_string(records.join("case3.csv")).unwrap(),
+        "t,p,x,y\n"
+    );
+}
+
+#[test]
 fn a_root_locus_names_the_parameter_value_where_it_fails() {
     fails_with(
         &[
