@@ -63,6 +63,11 @@ impl Stage<'_> {
             let VarKind::Sensor(s) = &v.kind else {
                 continue;
             };
+            if v.scale == 0.0 {
+                // a value the stage is given, not fitted (a cut gain: `diagnose::joint`)
+                dyhat.iter_mut().flatten().for_each(|row| row[k] = 0.0);
+                continue;
+            }
             let val = v.initial + v.scale * u[k];
             let lo = if s.bounded() && val - DU * v.scale < 0.0 {
                 u[k]

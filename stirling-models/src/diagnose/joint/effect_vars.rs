@@ -105,6 +105,7 @@ impl EffectVars {
                     v.adds.push((si, var));
                 }
             }
+            cut_gain(nominal, &mut v.adds, q.name);
             if let Some((si, var, sigs)) = link((nominal, memo), &v.adds, &v.linked, q.name)? {
                 v.adds.push((si, var));
                 v.linked.push((si, sigs));
@@ -158,6 +159,35 @@ impl EffectVars {
             ext.u.push(0.0);
         }
         Some((ext, m))
+    }
+}
+
+/// A position gain that the gas stage reads its prescribed positions through is estimated
+/// there alone: in a mechanics stage that reads the gas stage's pressure differences
+/// (records without `p_hot`) the gain `name` is a given value (unit 0: no column), set to the
+/// gas stage's at every rebase ([`super::Joint::rebase`]). A cut estimator: stage 1 applies
+/// the gain to its position outputs but does not inform it. Why: stage 1's `x` rows cannot
+/// tell a gain from the displacer's own amplitude response, and fitted jointly they pulled
+/// `gain_x` to -7.3 % on a +5 % record (docs/diagnosis.md, "A position gain estimated where
+/// it is seen").
+fn cut_gain(nominal: &[FittedStage], adds: &mut [(usize, Var)], name: &str) {
+    let read_by_gas = adds.iter().any(|(s, v)| {
+        v.name == name
+            && !is_mechanics(&nominal[*s])
+            && matches!(&v.kind, VarKind::Sensor(Sensor::Gain { given, .. }) if !given.is_empty())
+    });
+    if !read_by_gas {
+        return;
+    }
+    for (s, v) in adds.iter_mut() {
+        let st = &nominal[*s];
+        if v.name == name
+            && is_mechanics(st)
+            && !st.stage.derived.is_empty()
+            && matches!(v.kind, VarKind::Sensor(Sensor::Gain { .. }))
+        {
+            v.scale = 0.0;
+        }
     }
 }
 

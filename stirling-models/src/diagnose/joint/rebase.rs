@@ -21,9 +21,11 @@
 //! Only where stage 1 sees how the variables it shares with the gas stage move the
 //! differences: a model effect's strength is linked into stage 1 (its first-order derivative
 //! is re-taken at each round), a pressure lag does not move them. A position gain does (the
-//! gas stage reads the positions through it) but has no link, so a round would move stage 1's
-//! input without stage 1's rows seeing why; on the self-check's gain records that drove the
-//! gain away (closure 0.86 to -437), so the joint of a gain keeps the nominal differences.
+//! gas stage reads the positions through it); it is estimated by the gas stage alone and
+//! given to stage 1 at each rebase (`effect_vars::cut_gain`): a round then moves stage 1's
+//! input and its gain together, as the two-step calibration would. (Informed by both stages
+//! and unlinked, a round moved stage 1's input without its rows seeing why: on the
+//! self-check's gain records that drove the gain away, closure 0.86 to -437.)
 
 use super::memo::Memo;
 use super::{is_mechanics, Joint};
@@ -42,6 +44,9 @@ pub struct DpLink {
     /// Per linked variable of the mechanics stage: its index there and the index of the gas
     /// stage's variable with the same joint index.
     linked: Vec<(usize, usize)>,
+    /// Per position gain the gas stage estimates: stage 1's given copy of it (index there,
+    /// unit 0) and the gas stage's variable (`effect_vars::cut_gain`).
+    cut: Vec<(usize, usize)>,
 }
 
 impl DpLink {
@@ -52,13 +57,22 @@ impl DpLink {
             .iter()
             .position(|(_, s)| is_mechanics(s) && !s.stage.derived.is_empty())?;
         let gas = stages.iter().position(|(_, s)| !is_mechanics(s))?;
-        let unlinked = stages[gas].1.stage.vars.iter().any(
-            |v| matches!(&v.kind, VarKind::Sensor(Sensor::Gain { given, .. }) if !given.is_empty()),
-        );
-        if unlinked {
-            return None;
-        }
         let ms = &stages[mech].1.stage;
+        // the gains the gas stage reads positions through, and stage 1's given copy of each
+        let mut cut = Vec::new();
+        for (g, v) in stages[gas].1.stage.vars.iter().enumerate() {
+            if !matches!(&v.kind, VarKind::Sensor(Sensor::Gain { given, .. }) if !given.is_empty())
+            {
+                continue;
+            }
+            let m = map[mech].iter().position(|&j| j == map[gas][g]);
+            match m {
+                Some(i) if ms.vars[i].scale == 0.0 => cut.push((i, g)),
+                // a gain stage 1 would inform without seeing how it moves the differences
+                Some(_) => return None,
+                None => {}
+            }
+        }
         let base = ms
             .given
             .iter()
@@ -79,6 +93,7 @@ impl DpLink {
             gas,
             base,
             linked,
+            cut,
         })
     }
 }
@@ -141,6 +156,9 @@ impl Joint<'_> {
         let mech = &mut self.stages[link.mech].1.stage;
         for (&s, d) in link.base.iter().zip(dp) {
             mech.signals[s] = d;
+        }
+        for &(mi, gi) in &link.cut {
+            mech.vars[mi].initial = values[gi];
         }
         for (&(mi, gi), d) in link.linked.iter().zip(sens) {
             if let VarKind::Linked { pairs, at } = &mut mech.vars[mi].kind {
