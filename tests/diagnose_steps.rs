@@ -140,6 +140,26 @@ fn coulomb_friction_and_a_leak_are_both_named() {
 }
 
 #[test]
+fn a_leak_beside_a_position_gain_is_named_with_it() {
+    // the gain, estimated in the gas stage, alone takes the leak's loss of pressure
+    // amplitude (`gain_x` near 20 % for 5 %) and leaves the leak's score near its null; the
+    // pair tried with the leading gain closes most of what the gain leaves
+    // (`pairs::absorbing_pair`, docs/diagnosis.md "A position gain estimated where it is seen")
+    let d = diagnosed_at(
+        2000.0,
+        &["leak", "sensor_gain"],
+        1.0,
+        1005,
+        &["leak", "sensor_gain", "regen_quadratic"],
+    );
+    assert_eq!(d.verdict.verdict, "effect", "{}", d.verdict.reason);
+    assert_eq!(named(&d), ["leak", "sensor_gain"], "{}", d.verdict.reason);
+    check_steps(&d);
+    let c = d.steps.last().unwrap().cumulative;
+    assert!(c.ci_low > 0.5, "cumulative closure {c:?}");
+}
+
+#[test]
 fn quadratic_regenerator_friction_and_a_pressure_lag_are_both_named() {
     let d = diagnosed(
         &["regen_quadratic", "sensor_lag"],

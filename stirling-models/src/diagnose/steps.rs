@@ -249,6 +249,11 @@ fn next(
         .find(|(i, a)| (*i == 0 || a.entry.from_reset) && passes(&a.entry, level, rule))
         .map(|(i, _)| i);
     if let Some(i) = pick {
+        if let Some(pair) =
+            pairs::absorbing_pair(ctx, on, &assessed[i], &assessed, (level, rule), opts)
+        {
+            return Some(pair);
+        }
         let a = assessed.swap_remove(i);
         let fit = a.fit?;
         return Some(Named {

@@ -161,11 +161,16 @@ impl Joint<'_> {
             mech.vars[mi].initial = values[gi];
         }
         for (&(mi, gi), d) in link.linked.iter().zip(sens) {
+            let cut = mech.vars[mi].scale == 0.0;
             if let VarKind::Linked { pairs, at } = &mut mech.vars[mi].kind {
                 for (&(_, s), sig) in pairs.iter().zip(d) {
                     mech.signals[s] = sig;
                 }
                 *at = values[gi];
+            }
+            if cut {
+                // a cut link: its value is where the differences were taken
+                mech.vars[mi].initial = values[gi];
             }
         }
         Ok(())
