@@ -5,6 +5,10 @@
 //! regenerator loss with a pressure lag from an independent model, each single fit left the
 //! gap 13-14 times larger) and close it together.
 //!
+//! A leading single is also tried with a partner that lowers the held-out BIC on its own
+//! ([`absorbing_pair`]): a single that absorbed its partner leaves the partner's score near
+//! its null, so no later step could name it.
+//!
 //! A pair is named when it clears the step's rule ([`super::steps::passes`]) and each member
 //! is needed: the pair lowers the held-out BIC strongly against the other member fitted alone
 //! (nested models: the member alone is the pair with one strength at its null, so the BIC

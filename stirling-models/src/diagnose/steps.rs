@@ -9,7 +9,9 @@
 //! remains clears [`MIN_STEP_CLOSURE`](crate::diagnose::steps::MIN_STEP_CLOSURE). When no single candidate does, but two or more are
 //! significant, pairs of them are fitted together (`pairs.rs`): two effects that each
 //! alone fit the wrong shape (a quadratic regenerator loss and a pressure lag) can close the
-//! gap together. Whether the named effects explain the gap is the verdict's
+//! gap together; and a leader that closes less than `pairs::LEAD_CLOSES` is also tried
+//! with each partner that lowers the held-out BIC strongly alone, in case it absorbed one
+//! (`pairs::absorbing_pair`). Whether the named effects explain the gap is the verdict's
 //! ([`decide`](crate::diagnose::verdict::decide)): the closure of the whole chain, not of its steps.
 
 use std::time::Instant;
