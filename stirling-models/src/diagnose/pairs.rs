@@ -41,13 +41,7 @@ pub fn best_pair(
     // the gap on its own: it is a step's business, not a pair's (on the self-check's cubic
     // spring, outside the library, Coulomb friction alone lowered it by 194 and, paired
     // with the end stops, closed 0.92 of the gap)
-    let mut pool: Vec<&Assessed> = assessed
-        .iter()
-        .filter(|a| a.entry.p_value < level && a.fit.is_some() && a.eval.is_some())
-        .filter(|a| a.entry.delta_bic.is_some_and(|d| d >= STRONG_BIC))
-        .collect();
-    pool.sort_by(|a, b| a.entry.p_value.total_cmp(&b.entry.p_value));
-    pool.truncate(PAIR_POOL);
+    let pool = significant(assessed, level, |d| d >= STRONG_BIC, PAIR_POOL);
     let pairs: Vec<(usize, usize)> = (0..pool.len())
         .flat_map(|i| (i + 1..pool.len()).map(move |j| (i, j)))
         .collect();
@@ -102,14 +96,11 @@ pub fn absorbing_pair(
     {
         return None;
     }
-    let mut pool: Vec<&Assessed> = assessed
-        .iter()
+    let pool: Vec<&Assessed> = significant(assessed, level, |d| d < STRONG_BIC, PAIR_POOL)
+        .into_iter()
         .filter(|a| a.entry.effect != lead.entry.effect)
-        .filter(|a| a.entry.p_value < level && a.fit.is_some() && a.eval.is_some())
-        .filter(|a| a.entry.delta_bic.is_some_and(|d| d < STRONG_BIC))
+        .take(PAIR_POOL - 1)
         .collect();
-    pool.sort_by(|a, b| a.entry.p_value.total_cmp(&b.entry.p_value));
-    pool.truncate(PAIR_POOL - 1);
     if pool.is_empty() {
         return None;
     }
@@ -142,6 +133,24 @@ pub fn absorbing_pair(
             let d = |n: &Named| n.entry.delta_bic.unwrap_or(f64::INFINITY);
             d(a).total_cmp(&d(b))
         })
+}
+
+/// The round's fitted candidates whose score is significant at `level` and whose held-out
+/// BIC change `keep` accepts, by p-value, at most `max`.
+fn significant(
+    assessed: &[Assessed],
+    level: f64,
+    keep: impl Fn(f64) -> bool,
+    max: usize,
+) -> Vec<&Assessed> {
+    let mut pool: Vec<&Assessed> = assessed
+        .iter()
+        .filter(|a| a.entry.p_value < level && a.fit.is_some() && a.eval.is_some())
+        .filter(|a| a.entry.delta_bic.is_some_and(&keep))
+        .collect();
+    pool.sort_by(|a, b| a.entry.p_value.total_cmp(&b.entry.p_value));
+    pool.truncate(max);
+    pool
 }
 
 /// The pair fitted together on the basis, when each member is needed.
