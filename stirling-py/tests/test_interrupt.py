@@ -16,8 +16,13 @@ import stirling
 
 CHILD = textwrap.dedent(
     """
-    import sys, time
+    import signal, sys, time
     import stirling
+
+    # Ctrl-C raises KeyboardInterrupt, as in an interactive session; a child started from a
+    # shell that ignores SIGINT (a background job, `nohup`) inherits the ignore and Python
+    # keeps it, so the signal would never arrive
+    signal.signal(signal.SIGINT, signal.default_int_handler)
 
     m = stirling.load("nsection", n=40)
     started = []
