@@ -102,6 +102,9 @@ pub struct FitOptions {
     /// Log-normal prior on the free model parameters around their starting values, as a log
     /// standard deviation (see [`prior`]; `None`: plain least squares).
     pub prior: Option<f64>,
+    /// Free parameters that carry no prior: their starting values are not estimates (an
+    /// effect's strength started at its typical value by the kinematic diagnosis).
+    pub no_prior: Vec<String>,
     /// Bounds `(name, lo, hi)` of free parameters, over those the model declares
     /// (`kd: 650.0 "N/m" in 100.0..2000.0`): a trial step outside is rejected, so the fit
     /// stays inside (and the start must be inside).
@@ -133,6 +136,7 @@ impl Default for FitOptions {
             drift_cut: 0.5,
             input_noise_draws: 40,
             prior: None,
+            no_prior: Vec::new(),
             bounds: Vec::new(),
             free_run: Some(free_run::FreeRunOptions::default()),
             multiple_shooting: None,
