@@ -43,6 +43,7 @@ mod joint_fit;
 pub mod kinematic;
 /// The model effects of a kinematic engine, fitted by the kinematic fit.
 mod kinematic_refit;
+mod kinematic_verdict;
 /// Where: residuals by channel, harmonic, phase of the cycle and subsystem.
 pub mod localize;
 /// Pairs of significant candidates tried together.

@@ -58,10 +58,7 @@ pub fn best_pair(
         .par_iter()
         .filter_map(|&(i, j)| try_pair(ctx, on, (pool[i], pool[j]), opts))
         .filter(|n| passes(&n.entry, level, rule))
-        .min_by(|a, b| {
-            let d = |n: &Named| n.entry.delta_bic.unwrap_or(f64::INFINITY);
-            d(a).total_cmp(&d(b))
-        })
+        .min_by(lower_bic)
 }
 
 /// A leading single that closes this much of what remained is not tried with a partner: an
@@ -129,10 +126,13 @@ pub fn absorbing_pair(
             );
             c.ci_low > super::verdict::MIN_CLOSURE
         })
-        .min_by(|a, b| {
-            let d = |n: &Named| n.entry.delta_bic.unwrap_or(f64::INFINITY);
-            d(a).total_cmp(&d(b))
-        })
+        .min_by(lower_bic)
+}
+
+/// The order of two named candidates by held-out BIC change (a missing one last).
+fn lower_bic(a: &Named, b: &Named) -> std::cmp::Ordering {
+    let d = |n: &Named| n.entry.delta_bic.unwrap_or(f64::INFINITY);
+    d(a).total_cmp(&d(b))
 }
 
 /// The round's fitted candidates whose score is significant at `level` and whose held-out

@@ -76,7 +76,7 @@ pub fn stage<'a>(
         terms.fold(first, |a, t| a + t)
     });
     let given = given_bodies(layout, x_off, used);
-    let mut vars = Var::params(model, p, free, opts.prior, &opts.bounds);
+    let mut vars = Var::params(model, p, free, opts);
     let outputs = pressure_outputs(layout, rec, &eq, &shift, &mut vars);
     let x_start = initial_state(model, layout, rec, p, &eq, x_off);
     // the gas stage integrates the walls with a heat capacity too (after the gas states, so

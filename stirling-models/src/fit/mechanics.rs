@@ -151,7 +151,7 @@ const MIN_SEGMENT: f64 = 8.0;
 /// The fit variables: free parameters, the four body initial states `z0`, the position offsets.
 fn variables(model: &dyn Model, inp: &MechInputs, z0: &[f64], opts: &FitOptions) -> Vec<Var> {
     let x_off = inp.x_off;
-    let mut vars = Var::params(model, inp.p, inp.free, opts.prior, &opts.bounds);
+    let mut vars = Var::params(model, inp.p, inp.free, opts);
     for (k, nm) in ["x(0)", "v(0)", "y(0)", "w(0)"].iter().enumerate() {
         vars.push(Var::initial(
             nm,

@@ -3,7 +3,7 @@
 
 use stirling_dsl::Model;
 
-use super::FitError;
+use super::{FitError, FitOptions};
 
 use crate::signal::noise_sigma;
 
@@ -26,23 +26,23 @@ pub struct Var {
 }
 
 impl Var {
-    /// The variables of the model parameters `free` (indices), scaled by their values, in
-    /// the bounds `bounds` gives (by name) or the model declares.
-    pub fn params(
-        model: &dyn Model,
-        p: &[f64],
-        free: &[usize],
-        prior: Option<f64>,
-        bounds: &[(String, f64, f64)],
-    ) -> Vec<Var> {
+    /// The variables of the model parameters `free` (indices), scaled by their values, with
+    /// the options' prior (except on those it names in `no_prior`), in the bounds the
+    /// options give (by name) or the model declares.
+    pub fn params(model: &dyn Model, p: &[f64], free: &[usize], opts: &FitOptions) -> Vec<Var> {
         free.iter()
-            .map(|&j| Var {
-                name: model.params()[j].name.into(),
-                initial: p[j],
-                scale: p[j].abs().max(1e-12),
-                kind: VarKind::Param(j),
-                prior,
-                bounds: param_bounds(model, j, bounds),
+            .map(|&j| {
+                let name = model.params()[j].name;
+                Var {
+                    name: name.into(),
+                    initial: p[j],
+                    scale: p[j].abs().max(1e-12),
+                    kind: VarKind::Param(j),
+                    prior: opts
+                        .prior
+                        .filter(|_| !opts.no_prior.iter().any(|n| n == name)),
+                    bounds: param_bounds(model, j, &opts.bounds),
+                }
             })
             .collect()
     }

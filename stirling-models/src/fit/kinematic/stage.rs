@@ -35,10 +35,7 @@ pub fn stage<'a>(
         Given::signal(angle.angle, 0, false, 0.0),
         Given::signal(angle.speed, 0, true, 0.0),
     ];
-    let mut vars = Var::params(model, p, free, opts.prior, &opts.bounds);
-    for v in vars.iter_mut().filter(|v| opts.no_prior.contains(&v.name)) {
-        v.prior = None;
-    }
+    let mut vars = Var::params(model, p, free, opts);
     let outputs = outputs(layout, rec, &eq, &mut vars);
     let mut x = eq.clone();
     let ta = rec.tr.0;
