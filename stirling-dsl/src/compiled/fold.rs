@@ -33,8 +33,9 @@ impl Tape {
         self.fold_with(p, false)
     }
 
-    /// [`Tape::fold`] with every sum of a product nothing else reads fused into one
-    /// multiply-add (`fuse_mul_add`).
+    /// [`Tape::fold`] with the rewrites of `peephole.rs` (constants reassociated, negations
+    /// absorbed, divisions by a number made products) and every sum of a product nothing
+    /// else reads fused into one multiply-add (`fuse_mul_add`).
     pub fn fold_fused(&self, p: &[f64]) -> Tape {
         self.fold_with(p, true)
     }
@@ -50,11 +51,14 @@ impl Tape {
                 c.map_or(*op, Op::K)
             })
             .collect();
-        let mut folded = folded;
-        if fuse {
-            fuse_mul_add(&mut folded, &self.outputs);
-        }
-        let (ops, outputs, sections) = prune(folded, &self.outputs, &self.sections);
+        let (ops, outputs, sections) = if fuse {
+            let (mut f, outputs, sections) =
+                super::peephole::simplify(folded, &self.outputs, &self.sections);
+            fuse_mul_add(&mut f, &outputs);
+            prune(f, &outputs, &sections)
+        } else {
+            prune(folded, &self.outputs, &self.sections)
+        };
         Tape {
             ops,
             outputs,

@@ -20,6 +20,7 @@ mod fold;
 mod functions;
 mod instance;
 mod model;
+mod peephole;
 mod plan;
 mod repeat;
 mod runner;
