@@ -206,12 +206,40 @@ fn a_hot_plate_of_finite_heat_capacity_is_named() {
 }
 
 #[test]
+fn more_bearing_friction_is_no_gas_effect_and_the_flywheel_check_finds_it() {
+    // three times the file's Coulomb torque of the bearings (3e-5 N m): the engine slower,
+    // its gas as the file's
+    let d = diagnosed(&[("Tc", 9e-5)], 7);
+    assert!(d.verdict.effects.is_empty(), "{:?}", d.verdict);
+    let f = d
+        .flywheel
+        .as_ref()
+        .expect("the gamma file's flywheel has friction");
+    assert!(f.differs, "{f:?}");
+    // the torque at the record's speeds: the file's with its Coulomb part 6e-5 N m larger
+    // (tanh(omega / w_eps) = 1 at these speeds)
+    let truth = f.file_value + 6e-5;
+    assert!(
+        f.ci_low < truth && truth < f.ci_high,
+        "{f:?}: truth {truth:.4e}"
+    );
+    assert!(
+        d.verdict.reason.contains("differs from the file's"),
+        "{}",
+        d.verdict.reason
+    );
+}
+
+#[test]
 fn a_clean_gamma_record_has_no_significant_gap() {
     for seed in [7, 3] {
         let d = diagnosed(&[], seed);
         assert_eq!(d.verdict.verdict, "no_significant_gap", "{:?}", d.verdict);
         assert!(d.verdict.effects.is_empty() && !d.verdict.unexplained_remainder);
         assert!(d.steps.is_empty());
+        // the flywheel's friction is the file's
+        let f = d.flywheel.as_ref().expect("checked");
+        assert!(!f.differs, "seed {seed}: {f:?}");
     }
 }
 

@@ -11,8 +11,9 @@
 //! What does not carry over: the second pass with stage 1 restarted (the end stops of a
 //! free body; no stage 1 runs), the simulated gap (its cycles are counted on the displacer's
 //! position `x`, which a kinematic record does not carry; its note says so), steps after the
-//! first. The flywheel's friction and load act on no driven row, so no effect on the flywheel
-//! can be tested.
+//! first. The flywheel's friction and load act on no driven row; they are checked against the
+//! file's by the kinematic fit's torque balance (`kinematic_flywheel.rs`), and the verdict's
+//! reason ends with that check.
 
 use std::collections::HashMap;
 use std::sync::{Mutex, OnceLock};
@@ -40,6 +41,10 @@ use crate::signal::noise_sigma;
 /// against 1e4, the leak fitted at half its truth, its interval missing it; with `Rf` held,
 /// the leak came out at 1.98e-9 for 2e-9).
 pub const CALIBRATED_UNITS: [&str; 1] = ["W/(m^2 K)"];
+
+/// What a kinematic verdict adds when the file's flywheel has no friction parameter to
+/// check (`kinematic_flywheel.rs`): a `no_significant_gap` is then the gas's alone.
+pub const FLYWHEEL_UNTESTED: &str = "; the flywheel's friction and load are not tested (the file gives its flywheel no friction parameter to check): the verdict is the gas's, driven by the measured angle";
 
 /// Diagnose the kinematic engine `model` from `p0` (its effects at their nulls) on a record
 /// with the pressure `p` and the flywheel's angle.
@@ -122,6 +127,17 @@ pub(super) fn diagnose(
         (gap, nominal.err.len()),
         held,
     );
+    // the flywheel's friction, which the driven gas cannot see (`kinematic_flywheel.rs`)
+    match super::kinematic_flywheel::check(model, p0, data, &fit_opts, level) {
+        Ok(Some(f)) => {
+            d.verdict.reason.push_str(&f.sentence());
+            d.flywheel = Some(f);
+        }
+        Ok(None) => d.verdict.reason.push_str(FLYWHEEL_UNTESTED),
+        Err(e) => d.verdict.reason.push_str(&format!(
+            "; the flywheel's friction could not be checked against the file's ({e})"
+        )),
+    }
     if let (Some(name), Some(h)) = (&named, held) {
         let row = ranking.iter().find(|r| &r.effect == name).expect("named");
         d.steps = vec![step(row, h, data, &ranking)];

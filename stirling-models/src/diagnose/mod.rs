@@ -41,6 +41,8 @@ pub mod joint;
 mod joint_fit;
 /// The diagnosis of a kinematic engine: the driven stage of the measured angle.
 pub mod kinematic;
+/// A kinematic engine's flywheel friction against the file's.
+pub mod kinematic_flywheel;
 /// The model effects of a kinematic engine, fitted by the kinematic fit.
 mod kinematic_refit;
 mod kinematic_verdict;

@@ -103,6 +103,7 @@ pub(super) fn diagnose_once(
         steps: ex.steps,
         remainder: ex.last,
         verdict,
+        flywheel: None,
         fits: ctx.fits.load(std::sync::atomic::Ordering::Relaxed),
         seconds: 0.0,
         before: Some(nominal),

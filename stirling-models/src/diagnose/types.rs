@@ -226,6 +226,9 @@ pub struct Diagnosis {
     /// After the last step, the round that named nothing more, ranked (empty without steps).
     pub remainder: Vec<RankEntry>,
     pub verdict: Verdict,
+    /// A kinematic engine's flywheel friction against the file's (`kinematic_flywheel.rs`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub flywheel: Option<super::kinematic_flywheel::FlywheelFriction>,
     /// Fits run (the nominal calibration and every joint fit).
     pub fits: usize,
     pub seconds: f64,
