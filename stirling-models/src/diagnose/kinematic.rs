@@ -194,19 +194,32 @@ fn step(row: &RankEntry, held: &HeldOut, data: &Measured, ranking: &[RankEntry])
     }
 }
 
-/// The parameters the calibration frees by default: the gas parameters whose unit is one of
-/// [`CALIBRATED_UNITS`] and whose value is not an effect's null (0).
-pub fn default_free(model: &dyn Model, p0: &[f64]) -> Result<Vec<String>, DiagnoseError> {
-    let free: Vec<String> = model
+/// The parameters of `model` whose unit is one of `units`, nonzero at `p0` (not an effect's
+/// null), that act on the gas alone (`mechanics` false) or on the mechanics alone (true).
+pub(super) fn acting_params(
+    model: &dyn Model,
+    p0: &[f64],
+    units: &[&str],
+    mechanics: bool,
+) -> Vec<String> {
+    model
         .params()
         .iter()
         .zip(p0)
-        .filter(|(i, &v)| CALIBRATED_UNITS.contains(&i.unit) && v > 0.0)
+        .filter(|(i, &v)| units.contains(&i.unit) && v > 0.0)
         .map(|(i, _)| i.name.to_string())
-        .filter(|n| {
-            matches!(classify(model, p0, std::slice::from_ref(n)), Ok((m, g)) if m.is_empty() && !g.is_empty())
+        .filter(|n| match classify(model, p0, std::slice::from_ref(n)) {
+            Ok((m, g)) if mechanics => !m.is_empty() && g.is_empty(),
+            Ok((m, g)) => m.is_empty() && !g.is_empty(),
+            Err(_) => false,
         })
-        .collect();
+        .collect()
+}
+
+/// The parameters the calibration frees by default: the gas parameters whose unit is one of
+/// [`CALIBRATED_UNITS`] and whose value is not an effect's null (0).
+pub fn default_free(model: &dyn Model, p0: &[f64]) -> Result<Vec<String>, DiagnoseError> {
+    let free = acting_params(model, p0, &CALIBRATED_UNITS, false);
     if free.is_empty() {
         return Err(DiagnoseError::KinematicFree {
             model: model.name().into(),

@@ -15,7 +15,6 @@ use stirling_dsl::Model;
 
 use super::DiagnoseError;
 use crate::data::Measured;
-use crate::fit::classify::classify;
 use crate::fit::kinematic::flywheel::TORQUE;
 use crate::fit::{identify_stages, FitOptions};
 use crate::signal::chi2_sf;
@@ -59,16 +58,7 @@ impl FlywheelFriction {
 /// The file's friction parameters of the flywheel: of a unit of [`FRICTION_UNITS`], nonzero
 /// at `p0`, and acting on the mechanics only.
 pub fn friction_params(model: &dyn Model, p0: &[f64]) -> Vec<String> {
-    model
-        .params()
-        .iter()
-        .zip(p0)
-        .filter(|(i, &v)| FRICTION_UNITS.contains(&i.unit) && v > 0.0)
-        .map(|(i, _)| i.name.to_string())
-        .filter(|n| {
-            matches!(classify(model, p0, std::slice::from_ref(n)), Ok((m, g)) if !m.is_empty() && g.is_empty())
-        })
-        .collect()
+    super::kinematic::acting_params(model, p0, &FRICTION_UNITS, true)
 }
 
 /// The check on the record `data` with the calibration's options `fit_opts` (its free gas
