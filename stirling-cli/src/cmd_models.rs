@@ -1,9 +1,9 @@
-//! `stirling models`: the family and its aliases, registered engines, and the bases an
-//! engine file may extend by name.
+//! `stirling models`: the family and its aliases, registered engines, the bases an engine
+//! file may extend by name, and the engine files that come with stirling.
 
 use std::io::Write;
 
-use stirling_models::model::files::BASES;
+use stirling_models::model::files::{BASES, SHIPPED};
 use stirling_models::{user_models, FAMILY};
 
 use crate::common;
@@ -17,6 +17,7 @@ pub fn run(json: bool) -> anyhow::Result<()> {
             .map(|e| serde_json::json!({ "name": e.name, "aliases": e.aliases, "summary": e.summary }))
             .chain(user.iter().map(|u| serde_json::json!({ "name": u.name, "aliases": [], "summary": u.summary, "registered": true })))
             .chain(BASES.iter().map(|b| serde_json::json!({ "name": b.name, "aliases": [], "summary": base_summary(b.text), "base": true })))
+            .chain(SHIPPED.iter().map(|f| serde_json::json!({ "name": f.path, "aliases": [], "summary": base_summary(f.text), "file": true })))
             .collect();
         return common::print_json(&list);
     }
@@ -33,6 +34,13 @@ pub fn run(json: bool) -> anyhow::Result<()> {
     )?;
     for b in BASES {
         writeln!(o, "  {:<17} {}", b.name, base_summary(b.text))?;
+    }
+    writeln!(
+        o,
+        "\nengine files in the source tree (run one by its path, e.g. `stirling info examples/engines/gamma_ltd.stirling`):"
+    )?;
+    for f in SHIPPED {
+        writeln!(o, "  {:<42} {}", f.path, base_summary(f.text))?;
     }
     Ok(())
 }

@@ -73,8 +73,9 @@ fn simulate_runs_from_a_push_and_refuses_the_limit_cycle() {
     assert!(!err.contains("panicked"), "{err}");
 }
 
-/// The kinematic base is built in: `stirling models` lists it among the bases, and a copy of
-/// the gamma engine's file in a folder of its own (no `bases/` beside it) loads and runs.
+/// The kinematic base is built in: `stirling models` lists it among the bases and the
+/// kinematic engines' files with their summaries, and a copy of the gamma engine's file in a
+/// folder of its own (no `bases/` beside it) loads and runs.
 #[test]
 fn the_kinematic_base_is_built_in() {
     let models = ok(&["models"]);
@@ -82,6 +83,16 @@ fn the_kinematic_base_is_built_in() {
         models.contains("kinematic_engine") && models.contains("nsection_engine"),
         "{models}"
     );
+    for (file, summary) in [
+        ("gamma_ltd.stirling", "Gamma-type LTD engine"),
+        ("beta.stirling", "Beta-type engine"),
+        ("alpha.stirling", "Alpha-type engine"),
+    ] {
+        assert!(
+            models.contains(&format!("examples/engines/{file}")) && models.contains(summary),
+            "{file}: {models}"
+        );
+    }
     let dir = support::scratch("kinematic_copy");
     let copy = dir.join("my_ltd.stirling");
     std::fs::copy(engine("gamma_ltd.stirling"), &copy).unwrap();

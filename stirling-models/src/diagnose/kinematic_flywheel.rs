@@ -76,7 +76,11 @@ pub fn check(
     }
     let mut o = fit_opts.clone();
     let mut free = o.free.clone().unwrap_or_default();
-    free.extend(friction.iter().cloned());
+    for f in &friction {
+        if !free.contains(f) {
+            free.push(f.clone());
+        }
+    }
     o.free = Some(free);
     let (id, _) = identify_stages(model, p0, data, &o)?;
     let name = if friction.len() > 1 {

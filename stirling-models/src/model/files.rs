@@ -42,6 +42,34 @@ pub const BASES: &[BuiltinBase] = &[
     },
 ];
 
+/// An engine file that comes with stirling: its path in the source tree and its text (for
+/// `stirling models`, which lists them with the first sentence of their doc comment).
+pub struct Shipped {
+    pub path: &'static str,
+    pub text: &'static str,
+}
+
+/// The engine files of `examples/engines/` beyond the family's own: the kinematic engines
+/// (docs/physics.md section 12) and the gamma engine with a hot plate of finite heat capacity.
+pub const SHIPPED: &[Shipped] = &[
+    Shipped {
+        path: "examples/engines/gamma_ltd.stirling",
+        text: include_str!("../../../examples/engines/gamma_ltd.stirling"),
+    },
+    Shipped {
+        path: "examples/engines/gamma_ltd_plate.stirling",
+        text: include_str!("../../../examples/engines/gamma_ltd_plate.stirling"),
+    },
+    Shipped {
+        path: "examples/engines/beta.stirling",
+        text: include_str!("../../../examples/engines/beta.stirling"),
+    },
+    Shipped {
+        path: "examples/engines/alpha.stirling",
+        text: include_str!("../../../examples/engines/alpha.stirling"),
+    },
+];
+
 /// Why a file's model cannot be had.
 #[derive(Debug, thiserror::Error)]
 pub enum FileError {
