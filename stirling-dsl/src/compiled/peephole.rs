@@ -9,6 +9,9 @@
 //! - `a / k` becomes `a * (1 / k)` (a multiplication for a division; the reciprocal's
 //!   rounding).
 //!
+//! A reassociated or reciprocal number is made only when it is a normal number (neither
+//! zero, subnormal nor infinite): `(y * 1e-200) * 1e-200` must not become `y * 0`.
+//!
 //! Only on the folded right-hand side and Jacobian, with the multiply-adds
 //! ([`super::Tape::fold_fused`]): the simulation's work, whose results already differ from
 //! the macro's by ulps. A new number goes just before the instruction that reads it (inside
@@ -60,6 +63,12 @@ impl Rewriter {
             Op::K(c) => Some(c),
             _ => None,
         }
+    }
+
+    /// A new number `c`, placed before instruction `k`, when it is normal (see the module
+    /// doc; the exact rules' negated numbers always are when their source is).
+    fn normal(&mut self, c: f64, k: usize) -> Option<u32> {
+        c.is_normal().then(|| self.konst(c, k))
     }
 
     /// A new number `c`, placed before instruction `k`.
@@ -168,12 +177,14 @@ impl Rewriter {
                 }
             }
             Op::Div(a, b) => {
-                if let Some(c) = self.number(b) {
-                    let kr = self.konst(1.0 / c, k);
-                    self.replace(k, Op::Mul(a, kr));
+                if let Some(c) = self.number(b).filter(|c| c.is_normal()) {
+                    if let Some(kr) = self.normal(1.0 / c, k) {
+                        self.replace(k, Op::Mul(a, kr));
+                    }
                 } else if let (Some(c1), Some((y, _, c2))) = (self.number(a), self.scaled(b)) {
-                    let kr = self.konst(c1 / c2, k);
-                    self.replace(k, Op::Div(kr, y));
+                    if let Some(kr) = self.normal(c1 / c2, k) {
+                        self.replace(k, Op::Div(kr, y));
+                    }
                 }
             }
             _ => {}
@@ -188,8 +199,9 @@ impl Rewriter {
             _ => return,
         };
         if let Some((y, _, c1)) = self.scaled(x) {
-            let kr = self.konst(c1 * c, k);
-            self.replace(k, Op::Mul(y, kr));
+            if let Some(kr) = self.normal(c1 * c, k) {
+                self.replace(k, Op::Mul(y, kr));
+            }
         } else if let Some(y) = self.negated(x) {
             let kr = self.konst(-c, k);
             self.replace(k, Op::Mul(y, kr));
@@ -265,5 +277,26 @@ mod tests {
         }
         // `x * 5` and `y * 5` still read one shared 5
         assert_eq!(o.iter().filter(|op| **op == K(5.0)).count(), 1, "{o:?}");
+    }
+
+    /// A reassociated number that would underflow, or the reciprocal of a subnormal, is not
+    /// made: the tape keeps its two roundings.
+    #[test]
+    fn numbers_out_of_the_normal_range_are_not_made() {
+        use Op::*;
+        let ops = vec![
+            X(0),
+            K(1e-200),
+            Mul(0, 1),
+            K(1e-200),
+            Mul(2, 3), // (x * 1e-200) * 1e-200: 1e-400 underflows
+            K(1e-310),
+            Div(0, 5), // x / 1e-310: 1 / 1e-310 overflows
+        ];
+        let outputs = vec![4, 6];
+        let (o, _) = simplified(&ops, &outputs);
+        assert_eq!(o, ops, "{o:?}");
+        let (got, _) = run(o, outputs, &[1e300]);
+        assert_eq!(got, [1e300 * 1e-200 * 1e-200, 1e300 / 1e-310]);
     }
 }
