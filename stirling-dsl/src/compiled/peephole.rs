@@ -106,8 +106,8 @@ impl Rewriter {
     }
 
     /// `y * k` at `r` (either order) with `k` a number, if nothing but one instruction
-    /// reads `r`: `(y, k's register, k)`.
-    fn scaled(&self, r: u32) -> Option<(u32, u32, f64)> {
+    /// reads `r`: `(y, k)`.
+    fn scaled(&self, r: u32) -> Option<(u32, f64)> {
         if self.uses[r as usize] != 1 {
             return None;
         }
@@ -115,8 +115,8 @@ impl Rewriter {
             return None;
         };
         self.number(b)
-            .map(|c| (a, b, c))
-            .or_else(|| self.number(a).map(|c| (b, a, c)))
+            .map(|c| (a, c))
+            .or_else(|| self.number(a).map(|c| (b, c)))
     }
 
     /// `-y` at `r`, if nothing but one instruction reads `r`.
@@ -159,7 +159,7 @@ impl Rewriter {
         match self.ops[k] {
             Op::Mul(a, b) => self.product(k, a, b),
             Op::Neg(a) => {
-                if let Some((y, _, c)) = self.scaled(a) {
+                if let Some((y, c)) = self.scaled(a) {
                     let kr = self.konst(-c, k);
                     self.replace(k, Op::Mul(y, kr));
                 }
@@ -181,7 +181,7 @@ impl Rewriter {
                     if let Some(kr) = self.normal(1.0 / c, k) {
                         self.replace(k, Op::Mul(a, kr));
                     }
-                } else if let (Some(c1), Some((y, _, c2))) = (self.number(a), self.scaled(b)) {
+                } else if let (Some(c1), Some((y, c2))) = (self.number(a), self.scaled(b)) {
                     if let Some(kr) = self.normal(c1 / c2, k) {
                         self.replace(k, Op::Div(kr, y));
                     }
@@ -198,7 +198,7 @@ impl Rewriter {
             (None, Some(c)) => (b, c),
             _ => return,
         };
-        if let Some((y, _, c1)) = self.scaled(x) {
+        if let Some((y, c1)) = self.scaled(x) {
             if let Some(kr) = self.normal(c1 * c, k) {
                 self.replace(k, Op::Mul(y, kr));
             }
