@@ -86,6 +86,10 @@ pub struct Context<'a> {
     /// [`super::restarted`]): each body's stops are screened on their own and fitted from
     /// the reset start too.
     pub restarted: bool,
+    /// End-stop travels seen in the measured acceleration ([`super::stops_equation`]), in
+    /// the model's coordinates: on the restarted pass the stops are screened and fitted at
+    /// these travels, held (empty: none seen, or the first pass).
+    pub held_travels: Vec<(&'static str, f64)>,
 }
 
 impl Context<'_> {

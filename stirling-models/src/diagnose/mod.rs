@@ -68,6 +68,8 @@ pub mod selfcheck;
 pub mod sim_gap;
 /// The explanation step by step.
 pub mod steps;
+/// End stops seen in the measured acceleration (equation error).
+pub mod stops_equation;
 /// What a diagnosis reports.
 pub mod types;
 /// The verdict a user reads.

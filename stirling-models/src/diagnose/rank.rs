@@ -159,7 +159,7 @@ pub fn fit_set(
     (opts, mode): (&LmOptions, Mode),
     entry: &mut RankEntry,
 ) -> Result<(Eval, SetFit), DiagnoseError> {
-    let free_shapes = cands.iter().any(|c| !c.shapes.is_empty());
+    let free_shapes = cands.iter().any(|c| !c.shapes.is_empty()) && !on.basis.held_shapes;
     let mut joint = Joint::new(ctx.model, on.nominal, on.s2, on.basis, cands, free_shapes)?;
     let best = best_fit(ctx, &joint, cands, !mode.significant, score, opts)?;
     let (res, fixed) = if mode.significant {

@@ -32,6 +32,13 @@ use crate::data::Measured;
 /// [0.92, 0.95] with quarter cycles.
 pub const RESTART_CYCLES: f64 = 0.25;
 
+/// Whether the measured acceleration shows end stops over the training block
+/// ([`super::stops_equation`]).
+fn stops_seen(data: &Measured, opts: &DiagnoseOptions) -> bool {
+    super::blocks::blocks(data, opts)
+        .is_ok_and(|b| !super::stops_equation::seen(data, b.train_idx.0, b.train_idx.1).is_empty())
+}
+
 /// The second pass, when the first pass (`first`) calls for it and it names an effect; `None`
 /// otherwise (the first pass stands).
 pub fn second_pass(
@@ -41,9 +48,9 @@ pub fn second_pass(
     opts: &DiagnoseOptions,
     first: &Diagnosis,
 ) -> Option<Box<Diagnosis>> {
+    let seen = stops_seen(data, opts);
     let called = opts.fit.restart_cycles.is_none()
-        && first.verdict.verdict == "unexplained"
-        && absorbed(&first.gap_before);
+        && (seen || first.verdict.verdict == "unexplained" && absorbed(&first.gap_before));
     if !called {
         return None;
     }

@@ -54,7 +54,10 @@ pub(super) fn diagnose_once(
     let (id, stages) = fit::identify_stages(model, p0, data, &calibration_options(opts, &b))?;
     let calibrated = clock.elapsed().as_secs_f64();
     let p_nom = nominal_params(model, p0, &id);
-    let ctx = context(model, data, &b, &stages, p_nom.clone(), opts)?;
+    let mut ctx = context(model, data, &b, &stages, p_nom.clone(), opts)?;
+    if ctx.restarted {
+        ctx.held_travels = held_travels(data, &b, &id.offsets);
+    }
     let all: Vec<Prediction> = ctx.nominal_preds.iter().flatten().cloned().collect();
     let nominal = ctx.eval(&all, vec![], p_nom.clone())?;
     let s2 = variance_factors(&stages)?;
@@ -209,8 +212,21 @@ fn context<'a>(
         input_noise,
         fits: std::sync::atomic::AtomicUsize::new(1),
         restarted: opts.fit.restart_cycles.is_some(),
+        held_travels: Vec::new(),
         progress: opts.progress,
     })
+}
+
+/// The end-stop travels seen in the measured acceleration over the training block, in the
+/// model's coordinates (the travel less the calibrated position offset, as a distance).
+fn held_travels(data: &Measured, b: &Blocks, offsets: &SensorOffsets) -> Vec<(&'static str, f64)> {
+    super::stops_equation::seen(data, b.train_idx.0, b.train_idx.1)
+        .into_iter()
+        .map(|s| match s.channel.as_str() {
+            "x" => ("xmax", (s.travel - offsets.x).abs()),
+            _ => ("ymax", (s.travel - offsets.y).abs()),
+        })
+        .collect()
 }
 
 /// A calibrated parameter further than this many prior standard deviations from its start

@@ -26,6 +26,9 @@ fn shape_grid(ctx: &Context, e: &EffectInfo) -> Vec<Vec<(&'static str, f64)>> {
     if travel.is_empty() {
         return vec![vec![]];
     }
+    if ctx.restarted && !ctx.held_travels.is_empty() {
+        return vec![held_setting(ctx, &travel)];
+    }
     if ctx.restarted {
         return body_grid(&travel);
     }
@@ -71,6 +74,18 @@ fn body_grid(travel: &[(&'static str, f64)]) -> Vec<Vec<(&'static str, f64)>> {
             .any(|((_, v), (_, a))| *v < INERT_TRAVEL * a)
     });
     grid
+}
+
+/// The restarted pass's one setting when travels were seen in the measured acceleration:
+/// those travels, every other body's stops out of its reach ([`INERT_TRAVEL`]).
+fn held_setting(ctx: &Context, travel: &[(&'static str, f64)]) -> Vec<(&'static str, f64)> {
+    travel
+        .iter()
+        .map(|&(q, a)| {
+            let held = ctx.held_travels.iter().find(|(h, _)| *h == q);
+            (q, held.map_or(INERT_TRAVEL * a, |h| h.1))
+        })
+        .collect()
 }
 
 /// Whether an effect has end-stop travels (shape parameters screened on a grid).

@@ -162,6 +162,7 @@ pub fn explain(
 ) -> Explained {
     let level = opts.alpha / cands.len().max(1) as f64;
     let mut basis = Basis::nominal(nominal);
+    basis.held_shapes = ctx.restarted && !ctx.held_travels.is_empty();
     let mut base_eval = nominal_eval.clone();
     let mut left: Vec<&'static EffectInfo> = cands.to_vec();
     let mut out = Explained {

@@ -22,13 +22,13 @@ pub(super) struct EffectVars {
 }
 
 impl EffectVars {
-    /// The variables of the effects accepted so far (`base`, their shapes free) and of the
+    /// The variables of the effects accepted so far (`base`, their shapes free unless `held`) and of the
     /// candidates (their strengths and, with `free_shapes`, their shapes), and where they
     /// enter.
     pub fn of(
         model: &dyn Model,
         (nominal, memo): (&[FittedStage], &Memo),
-        base: &[EffectAt],
+        (base, held): (&[EffectAt], bool),
         cands: &[EffectAt],
         free_shapes: bool,
     ) -> Result<Self, DiagnoseError> {
@@ -43,7 +43,7 @@ impl EffectVars {
                 (nominal, memo),
                 a.effect,
                 &a.shapes,
-                (!a.shapes.is_empty(), true),
+                (!a.shapes.is_empty() && !held, true),
             )?;
         }
         for c in cands {

@@ -81,6 +81,9 @@ pub struct Basis {
     pub x: Vec<f64>,
     /// The runs every joint problem on this calibration shares (`joint/memo.rs`).
     pub memo: memo::Memo,
+    /// The accepted effects' shapes stay where they were set (end-stop travels seen in the
+    /// measured acceleration, [`crate::diagnose::stops_equation`]) instead of being refitted.
+    pub held_shapes: bool,
 }
 
 impl Basis {
@@ -90,6 +93,7 @@ impl Basis {
             effects: Vec::new(),
             x: nominal.iter().flat_map(|s| s.u.iter().copied()).collect(),
             memo: memo::Memo::default(),
+            held_shapes: false,
         }
     }
 }
@@ -144,7 +148,7 @@ impl<'a> Joint<'a> {
         let vars = EffectVars::of(
             model,
             (nominal, &basis.memo),
-            &basis.effects,
+            (&basis.effects, basis.held_shapes),
             cands,
             free_shapes,
         )?;
