@@ -351,3 +351,28 @@ fn a_lag_beside_an_outside_cause_is_named_with_the_remainder() {
     let p = last.channels.iter().find(|c| c.channel == "p").unwrap();
     assert!(p.ratio > 2.0, "{p:?}");
 }
+
+#[test]
+fn end_stops_beside_a_partner_are_named_with_the_partner_left_as_a_remainder() {
+    // the self-check's evaluation records of the stops beside Coulomb friction and beside a
+    // quadratic regenerator loss: one run explains nothing; the stops, seen in the measured
+    // acceleration, call the restarted pass at their travel, which names them; the partner
+    // is not named there (restarts hide what builds up over cycles), and the verdict says a
+    // gap remains rather than claiming the stops explain it all
+    let opts = VerdictOptions::default();
+    for label in ["coulomb+end_stops", "end_stops+regen_quadratic"] {
+        let d = diagnosed_case(&opts, label, 0x5709);
+        assert_eq!(d.verdict.verdict, "effect", "{label}: {}", d.verdict.reason);
+        assert!(
+            d.verdict.effects.contains(&"end_stops".to_string()),
+            "{label}: {}",
+            d.verdict.reason
+        );
+        assert!(
+            d.verdict.unexplained_remainder,
+            "{label}: {}",
+            d.verdict.reason
+        );
+        check_steps(&d);
+    }
+}
