@@ -20,6 +20,7 @@ use stirling_dsl::Model;
 use super::candidates::candidates;
 use super::run::{absorbed, diagnose_once};
 use super::screen::has_travel;
+use super::stops_equation::StopSide;
 use super::types::Diagnosis;
 use super::DiagnoseOptions;
 use crate::data::Measured;
@@ -32,11 +33,31 @@ use crate::data::Measured;
 /// [0.92, 0.95] with quarter cycles.
 pub const RESTART_CYCLES: f64 = 0.25;
 
-/// Whether the measured acceleration shows end stops over the training block
+/// The end stops the measured acceleration shows over the training block
 /// ([`super::stops_equation`]).
-fn stops_seen(data: &Measured, opts: &DiagnoseOptions) -> bool {
+fn stops_seen(data: &Measured, opts: &DiagnoseOptions) -> Vec<StopSide> {
     super::blocks::blocks(data, opts)
-        .is_ok_and(|b| !super::stops_equation::seen(data, b.train_idx.0, b.train_idx.1).is_empty())
+        .map(|b| super::stops_equation::seen(data, b.train_idx.0, b.train_idx.1))
+        .unwrap_or_default()
+}
+
+/// How the seen stops read in a verdict's reason.
+fn seen_text(seen: &[StopSide]) -> String {
+    let sides: Vec<String> = seen
+        .iter()
+        .map(|s| {
+            format!(
+                "`{}` beyond {:.3e} m ({:.0} % of its acceleration's misfit)",
+                s.channel,
+                s.travel,
+                100.0 * s.share
+            )
+        })
+        .collect();
+    format!(
+        "end stops seen in the measured acceleration ({}), held at that travel",
+        sides.join(", ")
+    )
 }
 
 /// The second pass, when the first pass (`first`) calls for it and it names an effect; `None`
@@ -50,7 +71,8 @@ pub fn second_pass(
 ) -> Option<Box<Diagnosis>> {
     let seen = stops_seen(data, opts);
     let called = opts.fit.restart_cycles.is_none()
-        && (seen || first.verdict.verdict == "unexplained" && absorbed(&first.gap_before));
+        && (!seen.is_empty()
+            || first.verdict.verdict == "unexplained" && absorbed(&first.gap_before));
     if !called {
         return None;
     }
@@ -79,9 +101,13 @@ pub fn second_pass(
     }
     second.fits += first.fits;
     flag_untested(&mut second, first, opts.alpha);
+    if !seen.is_empty() {
+        second.verdict.reason = format!("{}; {}", second.verdict.reason, seen_text(&seen));
+    }
+    second.stops_seen = seen;
     second.verdict.reason = format!(
-        "{}; named on a second pass with stage 1 restarted from the measured body states every {RESTART_CYCLES} cycle: on one run the library explained nothing ({}), and a body between end stops cannot be followed by one driven run",
-        second.verdict.reason, first.verdict.reason
+        "{}; named on a second pass with stage 1 restarted from the measured body states every {RESTART_CYCLES} cycle (a body between end stops cannot be followed by one driven run); one run gave `{}` ({})",
+        second.verdict.reason, first.verdict.verdict, first.verdict.reason
     );
     Some(Box::new(second))
 }
@@ -100,16 +126,13 @@ fn first_pass_only(first: &Diagnosis, second: &Diagnosis, alpha: f64) -> Vec<Str
         .collect()
 }
 
-/// A second pass that names no remainder although the first pass found another effect
-/// significant: the remainder is flagged. Stage 1 restarted every quarter cycle cannot show
+/// A second pass whose named effects leave out one the first pass found significant: the
+/// remainder is flagged (and those candidates named in the reason). Stage 1 restarted every quarter cycle cannot show
 /// what accumulates over cycles (a friction's or a loss's lost stroke), so a clean held-out
 /// block after the stops is no evidence that nothing else acts; on the self-check a quadratic
 /// regenerator loss beside the stops was significant on the first pass (p 8e-11) and went
 /// unnamed on the second, which then claimed the stops explained the whole gap.
 fn flag_untested(second: &mut Diagnosis, first: &Diagnosis, alpha: f64) {
-    if second.verdict.unexplained_remainder {
-        return;
-    }
     let only = first_pass_only(first, second, alpha);
     if only.is_empty() {
         return;

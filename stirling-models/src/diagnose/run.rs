@@ -107,6 +107,7 @@ pub(super) fn diagnose_once(
         remainder: ex.last,
         verdict,
         flywheel: None,
+        stops_seen: Vec::new(),
         fits: ctx.fits.load(std::sync::atomic::Ordering::Relaxed),
         seconds: 0.0,
         before: Some(nominal),

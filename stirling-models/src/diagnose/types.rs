@@ -229,6 +229,10 @@ pub struct Diagnosis {
     /// A kinematic engine's flywheel friction against the file's (`kinematic_flywheel.rs`).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub flywheel: Option<super::kinematic_flywheel::FlywheelFriction>,
+    /// End stops seen in the measured acceleration over the training block
+    /// ([`super::stops_equation`]), each body's strongest side (empty: none seen).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub stops_seen: Vec<super::stops_equation::StopSide>,
     /// Fits run (the nominal calibration and every joint fit).
     pub fits: usize,
     pub seconds: f64,
