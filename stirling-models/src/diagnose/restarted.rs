@@ -100,7 +100,7 @@ pub fn second_pass(
         return None;
     }
     second.fits += first.fits;
-    flag_untested(&mut second, first, opts.alpha);
+    flag_untested(&mut second, first, (opts.alpha, &stops));
     if !seen.is_empty() {
         second.verdict.reason = format!("{}; {}", second.verdict.reason, seen_text(&seen));
     }
@@ -113,27 +113,32 @@ pub fn second_pass(
 }
 
 /// What the first pass found significant and the second pass did not name, other than the
-/// stops: the candidates whose score on one run (level `alpha` over the candidates) says
-/// they act on the record.
-fn first_pass_only(first: &Diagnosis, second: &Diagnosis, alpha: f64) -> Vec<String> {
+/// effects with travels (`stops`): the candidates whose score on one run (level `alpha` over
+/// the candidates) says they act on the record.
+fn first_pass_only(
+    first: &Diagnosis,
+    second: &Diagnosis,
+    (alpha, stops): (f64, &[String]),
+) -> Vec<String> {
     let level = alpha / first.ranking.len().max(1) as f64;
     first
         .ranking
         .iter()
-        .filter(|e| e.p_value < level && e.effect != "end_stops")
+        .filter(|e| e.p_value < level && !stops.contains(&e.effect))
         .filter(|e| !second.verdict.effects.contains(&e.effect))
         .map(|e| format!("`{}` (p {:.1e})", e.effect, e.p_value))
         .collect()
 }
 
 /// A second pass whose named effects leave out one the first pass found significant: the
-/// remainder is flagged (and those candidates named in the reason). Stage 1 restarted every quarter cycle cannot show
-/// what accumulates over cycles (a friction's or a loss's lost stroke), so a clean held-out
-/// block after the stops is no evidence that nothing else acts; on the self-check a quadratic
-/// regenerator loss beside the stops was significant on the first pass (p 8e-11) and went
-/// unnamed on the second, which then claimed the stops explained the whole gap.
-fn flag_untested(second: &mut Diagnosis, first: &Diagnosis, alpha: f64) {
-    let only = first_pass_only(first, second, alpha);
+/// remainder is flagged (and those candidates named in the reason). Stage 1 restarted every
+/// quarter cycle cannot show what accumulates over cycles (a friction's or a loss's lost
+/// stroke), so a clean held-out block after the stops is no evidence that nothing else acts;
+/// on the self-check a quadratic regenerator loss beside the stops was significant on the
+/// first pass (p 8e-11) and went unnamed on the second, which then claimed the stops
+/// explained the whole gap.
+fn flag_untested(second: &mut Diagnosis, first: &Diagnosis, level: (f64, &[String])) {
+    let only = first_pass_only(first, second, level);
     if only.is_empty() {
         return;
     }
