@@ -70,7 +70,7 @@ pub(super) fn diagnose(
     let mut o = opts.clone();
     o.fit.free = Some(free.clone());
     o.effects = Some(sensor.iter().map(|e| e.name.to_string()).collect());
-    let mut d = super::run::diagnose_once(model, p0, data, &o)?;
+    let mut d = super::run::diagnose_once(model, p0, data, &o, &[])?;
     // the model effects, each by the kinematic fit with its strength freed
     let fit_opts = FitOptions {
         train: Some(d.train),

@@ -95,7 +95,7 @@ pub fn second_pass(
     // every candidate, at the first pass's family-wise level: the first step tries only the
     // stops (`steps::round_candidates`), the steps after them every other effect
     o.fit.restart_cycles = Some(RESTART_CYCLES);
-    let mut second = diagnose_once(model, p0, data, &o).ok()?;
+    let mut second = diagnose_once(model, p0, data, &o, &seen).ok()?;
     if second.verdict.verdict != "effect" {
         return None;
     }

@@ -8,6 +8,7 @@ use super::blocks::{blocks, Blocks};
 use super::candidates::candidates;
 use super::context::{predict, Context, Prediction};
 use super::gap::gap_before;
+use super::stops_equation::StopSide;
 use super::types::{Diagnosis, EffectEstimate};
 use super::{
     free_run_check, joint, localize, score, sim_gap, steps, verdict, DiagnoseError, DiagnoseOptions,
@@ -34,19 +35,21 @@ pub fn diagnose(
     let mut opts = opts.clone();
     (opts.fit.sim.rtol, opts.fit.sim.atol) = (opts.rtol, opts.rtol);
     let opts = &opts;
-    let first = diagnose_once(model, p0, data, opts)?;
+    let first = diagnose_once(model, p0, data, opts, &[])?;
     let mut d = super::restarted::second_pass(model, p0, data, opts, &first)
         .map_or(first, |second| *second);
     d.seconds = clock.elapsed().as_secs_f64();
     Ok(d)
 }
 
-/// One pass of the diagnosis with `opts` as given.
+/// One pass of the diagnosis with `opts` as given; on the restarted pass the end stops
+/// `seen` in the measured acceleration hold their travels ([`super::restarted`]).
 pub(super) fn diagnose_once(
     model: &dyn Model,
     p0: &[f64],
     data: &Measured,
     opts: &DiagnoseOptions,
+    seen: &[StopSide],
 ) -> Result<Diagnosis, DiagnoseError> {
     let clock = Instant::now();
     let b = blocks(data, opts)?;
@@ -56,7 +59,7 @@ pub(super) fn diagnose_once(
     let p_nom = nominal_params(model, p0, &id);
     let mut ctx = context(model, data, &b, &stages, p_nom.clone(), opts)?;
     if ctx.restarted {
-        ctx.held_travels = held_travels(data, &b, &id.offsets);
+        ctx.held_travels = held_travels(seen, &id.offsets);
     }
     let all: Vec<Prediction> = ctx.nominal_preds.iter().flatten().cloned().collect();
     let nominal = ctx.eval(&all, vec![], p_nom.clone())?;
@@ -218,11 +221,10 @@ fn context<'a>(
     })
 }
 
-/// The end-stop travels seen in the measured acceleration over the training block, in the
-/// model's coordinates (the travel less the calibrated position offset, as a distance).
-fn held_travels(data: &Measured, b: &Blocks, offsets: &SensorOffsets) -> Vec<(&'static str, f64)> {
-    super::stops_equation::seen(data, b.train_idx.0, b.train_idx.1)
-        .into_iter()
+/// The end-stop travels `seen` in the measured acceleration, in the model's coordinates (the
+/// travel less the calibrated position offset, as a distance).
+fn held_travels(seen: &[StopSide], offsets: &SensorOffsets) -> Vec<(&'static str, f64)> {
+    seen.iter()
         .map(|s| match s.channel.as_str() {
             "x" => ("xmax", (s.travel - offsets.x).abs()),
             _ => ("ymax", (s.travel - offsets.y).abs()),

@@ -68,7 +68,8 @@ fn smoothed(data: &Measured) -> Option<Smoothed> {
     let dt = data.dt();
     let h = ((SMOOTH_S / dt).round() as usize).max(3);
     let (p, x, y) = (data.channel("p")?, data.channel("x")?, data.channel("y")?);
-    let (ps, _, _) = smooth2(p, dt, h);
+    // the pressure needs no derivative: smoothed twice like the positions' values
+    let (ps, _) = savitzky_golay(&savitzky_golay(p, dt, h, 4).0, dt, h, 4);
     let (xs, vx, ax) = smooth2(x, dt, h);
     let (ys, vy, ay) = smooth2(y, dt, h);
     let mean = ps.iter().sum::<f64>() / ps.len() as f64;
