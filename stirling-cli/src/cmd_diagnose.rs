@@ -125,7 +125,8 @@ pub struct DiagnoseArgs {
     pub mixed_strength: f64,
     /// Self-check: only the cases of these truths, by the labels of the confusion matrix
     /// (e.g. `end_stops+leak,sensor_gain,clean`); each keeps the seeds and start it has in the
-    /// whole self-check
+    /// whole self-check of the same other options (a start's seed follows the case's place in
+    /// the whole plan, so with another `--seeds` or `--clean` the same label draws new records)
     #[arg(long, value_delimiter = ',')]
     pub cases: Option<Vec<String>>,
     /// Self-check: keep every case's record and start in OUT/records (`case<k>.csv`,
