@@ -121,7 +121,8 @@ pub struct RefactorLu {
     /// Diagonal pivots in AMD's order (`diagonal`), when the pattern has them: tried before
     /// every fresh partial pivoting; `None` also when [`RefactorLu::partial_pivoting_only`].
     diagonal: Option<Arc<LuPattern>>,
-    /// Factorizations with fresh pivoting, and those that reused the pivots.
+    /// Factorizations with fresh partial pivoting, and those on a pattern given beforehand
+    /// (the pivots kept from the last factorization, or the diagonal pattern).
     pub full: usize,
     pub refactored: usize,
 }
