@@ -13,27 +13,27 @@
 
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::perm::PermRef;
-use faer::sparse::linalg::amd;
 use faer::sparse::linalg::lu::simplicial::{
     factorize_simplicial_numeric_lu, factorize_simplicial_numeric_lu_scratch, SimplicialLu,
 };
 use faer::sparse::{SparseColMat, SparseColMatRef, SymbolicSparseColMatRef, Triplet};
 
+use super::order::{column_order, ColumnOrder};
 use super::LuPattern;
 
 /// The diagonal in the symbolic factorization: large enough that
 /// partial pivoting never leaves it (every other entry is 1).
 const DOMINANT: f64 = 1e150;
 
-/// The pattern of diagonal pivots of `a` in AMD's order on `A + A^T`; `None` when a diagonal
-/// entry is missing from the pattern or an ordering step fails.
+/// The pattern of diagonal pivots of `a` in AMD's order on `A + A^T` (the matrix's own order if
+/// AMD fails); `None` when a diagonal entry is missing from the pattern.
 pub(super) fn diagonal_pattern(a: SymbolicSparseColMatRef<'_, usize>) -> Option<LuPattern> {
     let n = a.ncols();
     let (cp, ri) = (a.col_ptr(), a.row_idx());
     if (0..n).any(|k| !ri[cp[k]..cp[k + 1]].contains(&k)) {
         return None;
     }
-    let (fwd, inv) = amd_order(a)?;
+    let (fwd, inv) = column_order(a, ColumnOrder::Amd);
     // C = P A P^T with the diagonal dominant, factored in its own (identity) order
     let mut trip = Vec::with_capacity(ri.len());
     for k in 0..n {
@@ -46,17 +46,6 @@ pub(super) fn diagonal_pattern(a: SymbolicSparseColMatRef<'_, usize>) -> Option<
     let mut p = symbolic_factor(c.as_ref())?;
     (p.row_perm, p.row_inv, p.col_perm) = (fwd.clone(), inv, fwd);
     Some(p)
-}
-
-/// AMD's order on the pattern of `A + A^T`.
-fn amd_order(a: SymbolicSparseColMatRef<'_, usize>) -> Option<(Vec<usize>, Vec<usize>)> {
-    let n = a.ncols();
-    let (mut fwd, mut inv) = (vec![0usize; n], vec![0usize; n]);
-    let scratch = amd::order_maybe_unsorted_scratch::<usize>(n, a.compute_nnz());
-    let mut mem = MemBuffer::new(scratch);
-    let stack = MemStack::new(&mut mem);
-    amd::order_maybe_unsorted(&mut fwd, &mut inv, a, Default::default(), stack).ok()?;
-    Some((fwd, inv))
 }
 
 /// The patterns of `L` and `U` of `c` factored in its own order with diagonal pivots (`c`'s
@@ -73,14 +62,8 @@ fn symbolic_factor(c: SparseColMatRef<'_, usize, f64>) -> Option<LuPattern> {
     if rp != id {
         return None;
     }
-    let (l, u) = (lu.l_factor_unsorted(), lu.u_factor_unsorted());
-    let p = LuPattern {
-        l_ptr: l.symbolic().col_ptr().to_vec(),
-        l_idx: l.symbolic().row_idx().to_vec(),
-        u_ptr: u.symbolic().col_ptr().to_vec(),
-        u_idx: u.symbolic().row_idx().to_vec(),
-        ..Default::default()
-    };
+    let mut p = LuPattern::default();
+    p.copy_factors(&lu);
     let diag_last = (0..n).all(|j| p.u_idx[p.u_ptr[j + 1] - 1] == j);
     let diag_first = (0..n).all(|j| p.l_idx[p.l_ptr[j]] == j);
     (diag_last && diag_first).then_some(p)

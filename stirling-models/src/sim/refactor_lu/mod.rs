@@ -74,6 +74,17 @@ struct LuPattern {
     col_perm: Vec<usize>,
 }
 
+impl LuPattern {
+    /// The patterns of `L` and `U` copied out of faer's factors (the permutations untouched).
+    fn copy_factors(&mut self, lu: &SimplicialLu<usize, f64>) {
+        let (l, u) = (lu.l_factor_unsorted(), lu.u_factor_unsorted());
+        self.l_ptr = l.symbolic().col_ptr().to_vec();
+        self.l_idx = l.symbolic().row_idx().to_vec();
+        self.u_ptr = u.symbolic().col_ptr().to_vec();
+        self.u_idx = u.symbolic().row_idx().to_vec();
+    }
+}
+
 /// The values of one factorization on its [`LuPattern`].
 #[derive(Clone, Debug, Default)]
 struct LuValues {
@@ -291,11 +302,8 @@ fn full_factor(
         MemStack::new(stack),
     )
     .ok()?;
+    p.copy_factors(&lu);
     let (l, u) = (lu.l_factor_unsorted(), lu.u_factor_unsorted());
-    p.l_ptr = l.symbolic().col_ptr().to_vec();
-    p.l_idx = l.symbolic().row_idx().to_vec();
-    p.u_ptr = u.symbolic().col_ptr().to_vec();
-    p.u_idx = u.symbolic().row_idx().to_vec();
     let diag = |j: usize| p.u_ptr[j + 1] - 1;
     let regular = (0..n).all(|j| {
         let d = u.val()[diag(j)];
