@@ -107,3 +107,43 @@ fn budget_along_a_trajectory(model: &dyn Model) {
         );
     }
 }
+
+/// With every CV's mass a state (`full` closure) each gas temperature is `P V / (m R)`
+/// (docs/physics.md), so it is positive once the pressure, volume and mass are: the
+/// nonphysical-state check (`sim::PhysicalCheck`) relies on it and checks the temperatures
+/// only when some CV's mass is not a state.
+#[test]
+fn full_closure_temperatures_are_the_gas_law_of_the_checked_states() {
+    let model = NSection::new(3, Closure::Full).unwrap();
+    let p = model.default_params();
+    let r = p[model.params().iter().position(|q| q.name == "R").unwrap()];
+    let states = model.states();
+    let x = perturbed(&model, &p);
+    let tr = sim::simulate(
+        &model,
+        &p,
+        &x,
+        0.05,
+        &sim::uniform_samples(0.05, 20),
+        &SimOptions::default(),
+    )
+    .unwrap();
+    let nv = model.vessel_names().len();
+    for x in &tr.x {
+        let (mut pr, mut vol) = (vec![0.0; nv], vec![0.0; nv]);
+        model.pv(&p, x, &mut pr, &mut vol);
+        let mut temp = vec![0.0; nv];
+        model.temperatures(&p, x, &mut temp);
+        for (k, s) in states.iter().enumerate() {
+            if let stirling::dsl::StateKind::Mass(cv) = s.kind {
+                let law = pr[cv] * vol[cv] / (x[k] * r);
+                assert!(
+                    ((temp[cv] - law) / law).abs() < 1e-12,
+                    "{}: T {} against P V / (m R) {law}",
+                    s.name,
+                    temp[cv]
+                );
+            }
+        }
+    }
+}
