@@ -190,6 +190,7 @@ fn step(row: &RankEntry, held: &HeldOut, data: &Measured, ranking: &[RankEntry])
         seconds: row.seconds,
         after_stops: false,
         from_reset: false,
+        one_run: false,
         eval: None,
     }
 }

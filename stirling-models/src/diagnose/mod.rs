@@ -50,6 +50,8 @@ mod kinematic_verdict;
 pub mod localize;
 /// Pairs of significant candidates tried together.
 mod pairs;
+/// A partner beside seen end stops, named from the one-run pass.
+pub mod partner;
 /// Which: fit and rank the screened candidates.
 pub mod rank;
 /// The Markdown report and its figures.

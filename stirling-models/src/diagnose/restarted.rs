@@ -18,12 +18,14 @@
 use stirling_dsl::Model;
 
 use super::candidates::candidates;
+use super::partner;
 use super::run::{absorbed, diagnose_once};
 use super::screen::has_travel;
 use super::stops_equation::StopSide;
 use super::types::Diagnosis;
 use super::DiagnoseOptions;
 use crate::data::Measured;
+use crate::effects::EffectInfo;
 
 /// Stage 1 restarts every this many cycles on the second pass. Shorter segments follow the
 /// record more closely from their measured start: at the rig's own parameters stage 1 fitted
@@ -76,9 +78,9 @@ pub fn second_pass(
     if !called {
         return None;
     }
-    let stops: Vec<String> = candidates(model, &opts.effects)
-        .ok()?
-        .into_iter()
+    let infos = candidates(model, &opts.effects).ok()?;
+    let stops: Vec<String> = infos
+        .iter()
         .filter(|e| has_travel(e))
         .map(|e| e.name.to_string())
         .collect();
@@ -100,16 +102,40 @@ pub fn second_pass(
         return None;
     }
     second.fits += first.fits;
+    if !seen.is_empty() {
+        name_partners(&mut second, first, &infos);
+    }
     flag_untested(&mut second, first, (opts.alpha, &stops));
     if !seen.is_empty() {
         second.verdict.reason = format!("{}; {}", second.verdict.reason, seen_text(&seen));
     }
     second.stops_seen = seen;
+    second.one_run = first.ranking.clone();
     second.verdict.reason = format!(
         "{}; named on a second pass with stage 1 restarted from the measured body states every {RESTART_CYCLES} cycle (a body between end stops cannot be followed by one driven run); one run gave `{}` ({})",
         second.verdict.reason, first.verdict.verdict, first.verdict.reason
     );
     Some(Box::new(second))
+}
+
+/// Name the partners of the seen stops that the one-run pass (`first`) shows
+/// ([`partner`]), each with its one-run evidence in the verdict's reason.
+fn name_partners(second: &mut Diagnosis, first: &Diagnosis, infos: &[&'static EffectInfo]) {
+    let named = partner::name(second, first, infos);
+    for e in first.ranking.iter().filter(|e| named.contains(&e.effect)) {
+        second.verdict.reason = format!(
+            "{}; beside the stops, `{}` named from the one-run pass: score p {:.1e} (the stops alone give no candidate less than {:.1e} there, over ten: {:.1e}), held-out BIC change {:.0}, closure {:.3} [{:.3}, {:.3}] of the one-run gap (which the stops dominate); the restarted pass hides what builds up over cycles",
+            second.verdict.reason,
+            e.effect,
+            e.p_value,
+            10.0 * partner::PARTNER_P,
+            partner::PARTNER_P,
+            e.delta_bic.unwrap_or(f64::NAN),
+            e.closure_fraction.unwrap_or(f64::NAN),
+            e.ci_low.unwrap_or(f64::NAN),
+            e.ci_high.unwrap_or(f64::NAN),
+        );
+    }
 }
 
 /// What the first pass found significant and the second pass did not name, other than the

@@ -111,6 +111,7 @@ pub(super) fn diagnose_once(
         verdict,
         flywheel: None,
         stops_seen: Vec::new(),
+        one_run: Vec::new(),
         fits: ctx.fits.load(std::sync::atomic::Ordering::Relaxed),
         seconds: 0.0,
         before: Some(nominal),

@@ -314,6 +314,7 @@ fn make_step(
         seconds: clock.elapsed().as_secs_f64(),
         after_stops: false,
         from_reset: e.from_reset,
+        one_run: false,
         eval: Some(named.eval.clone()),
     }
 }

@@ -155,6 +155,9 @@ pub struct Step {
     /// Named from the reset start on a calibration that absorbed something, under that
     /// rule ([`super::steps::StepRule::passes`]).
     pub from_reset: bool,
+    /// Named on the one-run pass beside end stops seen on the second pass
+    /// ([`super::partner`]): its estimates, score and closure are the one-run pass's.
+    pub one_run: bool,
     /// Residual series after this step, for the report.
     #[serde(skip)]
     pub eval: Option<Eval>,
@@ -233,6 +236,11 @@ pub struct Diagnosis {
     /// ([`super::stops_equation`]), each body's strongest side (empty: none seen).
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub stops_seen: Vec<super::stops_equation::StopSide>,
+    /// When the verdict is a second pass's (stage 1 restarted, [`super::restarted`]): the
+    /// one-run pass's first round, ranked (empty otherwise). What the restarts cannot show -
+    /// an effect that builds up over cycles - shows here.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub one_run: Vec<RankEntry>,
     /// Fits run (the nominal calibration and every joint fit).
     pub fits: usize,
     pub seconds: f64,

@@ -9,6 +9,7 @@ use stirling_dsl::Model;
 
 use super::plan::{named_label, Planned, Split, Truth, VerdictOptions};
 use super::record::{record, seeded_start, signature, Signature};
+use crate::diagnose::partner;
 use crate::diagnose::run::diagnose;
 use crate::diagnose::steps::StepRule;
 use crate::diagnose::types::{Diagnosis, RankEntry};
@@ -50,6 +51,9 @@ pub struct Outcome {
     pub ranking: Vec<RankEntry>,
     /// The steps of the explanation (what the thresholds re-decide).
     pub steps: Vec<StepBrief>,
+    /// A second pass's verdict: the one-run pass's candidates and their score p-values.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub one_run: Vec<(String, f64)>,
     /// The nominal model's held-out error (noise variances).
     pub gap: f64,
     pub signature: Signature,
@@ -72,6 +76,8 @@ pub struct StepBrief {
     pub after_stops: bool,
     /// Named from the reset start ([`StepRule::passes`]).
     pub from_reset: bool,
+    /// Named on the one-run pass beside the stops ([`crate::diagnose::partner`]).
+    pub one_run: bool,
     /// Held-out error after the step (noise variances) and each channel's rms against its
     /// noise: what a test of the remainder reads.
     pub holdout_error: f64,
@@ -116,7 +122,12 @@ impl Outcome {
             let rule = StepRule::at(th.strong_bic, s.after_stops);
             let moved = true;
             let at = (level, s.from_reset);
-            if !rule.passes(moved, s.p_value, Some(s.delta_bic), Some(s.ci_low), at) {
+            let passes = if s.one_run {
+                partner::passes(s.p_value, Some(s.delta_bic), th.strong_bic)
+            } else {
+                rule.passes(moved, s.p_value, Some(s.delta_bic), Some(s.ci_low), at)
+            };
+            if !passes {
                 break;
             }
             named.extend(s.effects.iter().cloned());
@@ -151,6 +162,7 @@ impl Outcome {
             ci_high: None,
             truth_rank: None,
             ranking: Vec::new(),
+            one_run: Vec::new(),
             steps: Vec::new(),
             gap: 0.0,
             signature: Signature::default(),
@@ -182,6 +194,7 @@ impl Outcome {
                 cumulative_low: s.cumulative.ci_low,
                 after_stops: s.after_stops,
                 from_reset: s.from_reset,
+                one_run: s.one_run,
                 holdout_error: s.holdout_error,
                 channels: s
                     .channels
@@ -202,6 +215,11 @@ impl Outcome {
         self.ci_low = entry.and_then(|r| r.ci_low);
         self.ci_high = entry.and_then(|r| r.ci_high);
         self.candidates = d.ranking.len();
+        self.one_run = d
+            .one_run
+            .iter()
+            .map(|r| (r.effect.clone(), r.p_value))
+            .collect();
         self.ranking = d.ranking;
         self
     }
