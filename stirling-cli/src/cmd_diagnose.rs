@@ -431,7 +431,7 @@ fn print_steps(o: &mut impl Write, d: &Diagnosis) -> io::Result<()> {
             o,
             "  {}. {:<24} closes {:.2} [{:.2}, {:.2}] of what remained; {:.2} [{:.2}, {:.2}] in all; held-out error {:.3}; rms/noise {}",
             s.step,
-            s.effects.join(" + "),
+            s.label(),
             s.closure.value,
             s.closure.ci_low,
             s.closure.ci_high,

@@ -114,4 +114,26 @@ mod tests {
         // held-out evidence without the score
         assert!(!passes(1.6e-4, Some(-108.0), STRONG_BIC));
     }
+
+    #[test]
+    fn a_partner_step_keeps_the_last_cumulative_closure_and_says_where_it_was_named() {
+        let mut e = RankEntry::named("regen_quadratic");
+        e.p_value = 8.4e-11;
+        e.delta_bic = Some(-25.0);
+        e.closure_fraction = Some(0.007);
+        let stops = Interval {
+            value: 0.87,
+            ci_low: 0.78,
+            ci_high: 0.91,
+        };
+        let mut last = step_of(&RankEntry::named("end_stops"), None, 1);
+        (last.one_run, last.cumulative, last.holdout_error) = (false, stops, 2.09);
+        let s = step_of(&e, Some(&last), 2);
+        assert_eq!((s.step, s.p_value, s.delta_bic), (2, 8.4e-11, -25.0));
+        assert_eq!(s.closure.value, 0.007);
+        assert_eq!(s.cumulative.value, stops.value);
+        assert_eq!(s.holdout_error, 2.09);
+        assert_eq!(s.label(), "regen_quadratic (one-run pass)");
+        assert_eq!(last.label(), "end_stops");
+    }
 }

@@ -92,7 +92,7 @@ fn waterfall_figure(d: &Diagnosis, dir: &Path) -> Result<Option<String>, DrawErr
         return Ok(None);
     }
     let start = d.gap_before.holdout_error - 1.0;
-    let labels: Vec<String> = d.steps.iter().map(|s| s.effects.join(" + ")).collect();
+    let labels: Vec<String> = d.steps.iter().map(|s| s.label()).collect();
     let drops: Vec<plot::waterfall::Drop> = d
         .steps
         .iter()
@@ -255,7 +255,7 @@ fn steps_section(s: &mut String, d: &Diagnosis) {
             s,
             "| {} | {} | {} | {} | {:.3} | {} | {} |",
             st.step,
-            st.effects.join(" + "),
+            st.label(),
             iv(&st.closure),
             iv(&st.cumulative),
             st.holdout_error,

@@ -124,11 +124,10 @@ fn name_partners(second: &mut Diagnosis, first: &Diagnosis, infos: &[&'static Ef
     let named = partner::name(second, first, infos);
     for e in first.ranking.iter().filter(|e| named.contains(&e.effect)) {
         second.verdict.reason = format!(
-            "{}; beside the stops, `{}` named from the one-run pass: score p {:.1e} (the stops alone give no candidate less than {:.1e} there, over ten: {:.1e}), held-out BIC change {:.0}, closure {:.3} [{:.3}, {:.3}] of the one-run gap (which the stops dominate); the restarted pass hides what builds up over cycles",
+            "{}; beside the stops, `{}` named from the one-run pass, where stage 1 runs through the whole block: score p {:.1e} (below {:.1e}, a tenth of the least the stops alone gave any candidate on the self-check's tuning records), held-out BIC change {:.0}, closure {:.3} [{:.3}, {:.3}] of the one-run gap (which the stops dominate); the restarted pass hides what builds up over cycles",
             second.verdict.reason,
             e.effect,
             e.p_value,
-            10.0 * partner::PARTNER_P,
             partner::PARTNER_P,
             e.delta_bic.unwrap_or(f64::NAN),
             e.closure_fraction.unwrap_or(f64::NAN),

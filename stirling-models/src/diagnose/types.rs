@@ -163,6 +163,19 @@ pub struct Step {
     pub eval: Option<Eval>,
 }
 
+impl Step {
+    /// The step's effects as a reader sees them: a partner named from the one-run pass
+    /// says so (its closure is of the one-run gap, not of what the last step left).
+    pub fn label(&self) -> String {
+        let names = self.effects.join(" + ");
+        if self.one_run {
+            format!("{names} (one-run pass)")
+        } else {
+            names
+        }
+    }
+}
+
 /// The verdict.
 #[derive(Clone, Debug, Serialize)]
 pub struct Verdict {
