@@ -157,7 +157,8 @@ pub(crate) fn function(
     } else {
         crate::schedule::order(&tape.ops, range.clone())
     };
-    for k in order {
+    let last = last_reads(&tape.ops, &order, range.start);
+    for (at, k) in order.into_iter().enumerate() {
         let mut stores = layout.stores.partition_point(|&(r, _)| (r as usize) < k);
         // a leaf is loaded again at every use (a memory operand of its user): never kept in a
         // register across the function, never spilled (the parameters are used everywhere)
@@ -190,7 +191,15 @@ pub(crate) fn function(
             }
             Op::MulAdd(..) | Op::MulSub(..) | Op::NegMulAdd(..) => {
                 let (args, _) = operands(&op);
-                let (x, y, z) = (r(args[0]), r(args[1]), r(args[2]));
+                // x86's `vfmadd213`/`132` (what Cranelift emits) write the first factor's
+                // register: a factor read later would be copied first, so the factor read for
+                // the last time goes first (the product commutes: the same bits)
+                let (p, q) = (args[0] as usize, args[1] as usize);
+                let ends = |q: usize| {
+                    leaf(&tape.ops[q]) || (q >= range.start && last[q - range.start] == at)
+                };
+                let (p, q) = if !ends(p) && ends(q) { (q, p) } else { (p, q) };
+                let (x, y, z) = (r(p as u32), r(q as u32), r(args[2]));
                 fused(&mut b, op, x, y, z)
             }
             _ => {
@@ -228,6 +237,21 @@ pub(crate) fn function(
     b.ins().return_(&[]);
     b.finalize(config);
     Ok(())
+}
+
+/// For instructions `start..` emitted in `order`: where in it each is read for the last time
+/// (`usize::MAX`: never read there).
+fn last_reads(ops: &[Op], order: &[usize], start: usize) -> Vec<usize> {
+    let mut last = vec![usize::MAX; order.len()];
+    for (at, &k) in order.iter().enumerate() {
+        let (args, count) = operands(&ops[k]);
+        for &q in &args[..count] {
+            if q as usize >= start {
+                last[q as usize - start] = at;
+            }
+        }
+    }
+    last
 }
 
 /// The value of the operation `op` (not a leaf) on `a` and `c` (its second operand, if it
