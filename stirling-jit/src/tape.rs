@@ -233,15 +233,16 @@ impl JitTape {
         debug_assert!(s.len() >= self.scratch);
         for &f in &self.code {
             // SAFETY: `f` is the finalized address of a function `compile_chunked` declared
-            // with exactly `Code`'s signature (six pointers, no result, the platform's C
+            // with exactly `Code`'s signature (seven pointers, no result, the platform's C
             // convention), and its module (a field of `self`) keeps the code alive. The code
             // reads `x[i]`, `p[k]`, `v[i]` only at indices the tape names and writes the
             // output buffers only at its outputs' indices; `run_split` checked every slice is
             // at least that long (`needs`); it reads the numbers of `self.consts` at the
-            // slots the tape gave them (`Layout`, `looped::Numbers`), all within it. The scratch array is read and written only at
-            // slots below `self.scratch` (`Layout`, `looped::before`), its length whenever
-            // that is not 0 (with 0, the code never touches it). Every buffer is borrowed mutably, so no
-            // one else sees the writes.
+            // slots the tape gave them (`Layout`, `looped::Numbers`), all within it (an empty
+            // table is never read). The scratch array is read and written only at slots below
+            // `self.scratch` (`Layout`, `looped::before`), its length whenever that is not 0
+            // (with 0, the code never touches it). Every buffer is borrowed mutably, so no one
+            // else sees the writes.
             let code = unsafe { std::mem::transmute::<*const u8, Code>(f) };
             code(
                 x.as_ptr(),
