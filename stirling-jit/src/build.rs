@@ -42,10 +42,9 @@ pub(crate) struct Layout {
     /// `(register, output)` pairs, sorted by register: each output stored as its register
     /// is computed (no value kept alive to the end of the function for it).
     stores: Vec<(u32, u32)>,
-    /// The tape's numbers (`slot[r]` of an `Op::K` is its index here), read by the code
-    /// at `consts_addr` (the table's address, set once it no longer moves).
+    /// The tape's numbers (`slot[r]` of an `Op::K` is its index here), their address the
+    /// code's last argument.
     pub consts: Box<[f64]>,
-    pub consts_addr: usize,
 }
 
 impl Layout {
@@ -76,7 +75,6 @@ impl Layout {
             }
         }
         let consts: Box<[f64]> = consts.into_boxed_slice();
-        let consts_addr = consts.as_ptr() as usize;
         let mut stores: Vec<(u32, u32)> = (0..tape.outputs.len() as u32)
             .map(|k| (tape.outputs[k as usize], k))
             .collect();
@@ -87,7 +85,6 @@ impl Layout {
             slots: slots as usize,
             stores,
             consts,
-            consts_addr,
         }
     }
 }
@@ -143,17 +140,26 @@ pub(crate) fn function(
     };
     let head = tape.head();
     let flags = MemFlagsData::trusted();
-    let ptr = module.target_config().pointer_type();
     // the registers this function has: its own (none for a leaf), and those of earlier
     // functions it read
     let mut regs: HashMap<u32, Value> = HashMap::new();
-    let mut own: Vec<Option<Value>> = Vec::with_capacity(range.len());
+    let mut own: Vec<Option<Value>> = vec![None; range.len()];
     let mut minus_zero: Option<Value> = None;
-    let consts = b.ins().iconst(ptr, layout.consts_addr as i64);
-    let mut stores = layout
-        .stores
-        .partition_point(|&(r, _)| (r as usize) < range.start);
-    for k in range.clone() {
+    // the numbers' address: an argument, so one register (as an `iconst`, Cranelift
+    // materialised the 64-bit address again before every load, 51 `movabs` at n = 2)
+    let consts = a[6];
+    // in the order that keeps fewer values live (`schedule`) where the tape reads no
+    // parameter (folded: `nsection` at n = 10, 134 to 123 ns), in the tape's order where it
+    // does (scheduled, its RHS + Jacobian at n = 10 measured 167 to 177-182 ns); each output
+    // stored as its register is computed
+    let order: Vec<usize> = if tape.ops.iter().any(|op| matches!(op, Op::P(_))) {
+        range.clone().collect()
+    } else {
+        crate::schedule::order(&tape.ops, range.clone())
+    };
+    let last = last_reads(&tape.ops, &order, range.start);
+    for (at, k) in order.into_iter().enumerate() {
+        let mut stores = layout.stores.partition_point(|&(r, _)| (r as usize) < k);
         // a leaf is loaded again at every use (a memory operand of its user): never kept in a
         // register across the function, never spilled (the parameters are used everywhere)
         let mut r = |q: u32| -> Value {
@@ -179,14 +185,21 @@ pub(crate) fn function(
                     .get(stores)
                     .is_some_and(|&(g, _)| g as usize == k);
                 if !has_output {
-                    own.push(None);
                     continue;
                 }
                 r(k as u32)
             }
             Op::MulAdd(..) | Op::MulSub(..) | Op::NegMulAdd(..) => {
                 let (args, _) = operands(&op);
-                let (x, y, z) = (r(args[0]), r(args[1]), r(args[2]));
+                // x86's `vfmadd213`/`132` (what Cranelift emits) write the first factor's
+                // register: a factor read later would be copied first, so the factor read for
+                // the last time goes first (the product commutes: the same bits)
+                let (p, q) = (args[0] as usize, args[1] as usize);
+                let ends = |q: usize| {
+                    leaf(&tape.ops[q]) || (q >= range.start && last[q - range.start] == at)
+                };
+                let (p, q) = if !ends(p) && ends(q) { (q, p) } else { (p, q) };
+                let (x, y, z) = (r(p as u32), r(q as u32), r(args[2]));
                 fused(&mut b, op, x, y, z)
             }
             _ => {
@@ -202,7 +215,7 @@ pub(crate) fn function(
                 arith(&mut b, &imports, &mut minus_zero, op, a, c)?
             }
         };
-        own.push(Some(val));
+        own[k - range.start] = Some(val);
         if !leaf(&op) && layout.slot[k] != u32::MAX {
             b.ins()
                 .store(flags, val, args.scratch, offset(layout.slot[k]));
@@ -224,6 +237,21 @@ pub(crate) fn function(
     b.ins().return_(&[]);
     b.finalize(config);
     Ok(())
+}
+
+/// For instructions `start..` emitted in `order`: where in it each is read for the last time
+/// (`usize::MAX`: never read there).
+fn last_reads(ops: &[Op], order: &[usize], start: usize) -> Vec<usize> {
+    let mut last = vec![usize::MAX; order.len()];
+    for (at, &k) in order.iter().enumerate() {
+        let (args, count) = operands(&ops[k]);
+        for &q in &args[..count] {
+            if q as usize >= start {
+                last[q as usize - start] = at;
+            }
+        }
+    }
+    last
 }
 
 /// The value of the operation `op` (not a leaf) on `a` and `c` (its second operand, if it

@@ -15,6 +15,7 @@
 
 mod build;
 mod looped;
+mod schedule;
 mod shims;
 mod tape;
 

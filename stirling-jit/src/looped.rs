@@ -239,8 +239,8 @@ fn loop_leaf(e: &mut Emit, m: &mut Moved, l: LoopLeaf) -> Value {
     e.load(ptr, at)
 }
 
-/// Fill `func` (its signature set: `x`, `p`, `v`, the two output buffers, an unused
-/// scratch array) with the looped code of `tape`.
+/// Fill `func` (its signature set: `x`, `p`, `v`, the two output buffers, the scratch
+/// array, the numbers' table) with the looped code of `tape`.
 pub(crate) fn function(
     module: &mut JITModule,
     func: &mut cranelift_codegen::ir::Function,
@@ -256,14 +256,14 @@ pub(crate) fn function(
     };
     declare_imports(module, func, &tape.ops, &mut imports)?;
     let config = module.target_config();
-    let ptr = config.pointer_type();
     let mut b = FunctionBuilder::new(func, &mut fctx);
     let entry = b.create_block();
     b.append_block_params_for_function_params(entry);
     b.switch_to_block(entry);
     b.seal_block(entry);
     let a = b.block_params(entry).to_vec();
-    let consts = b.ins().iconst(ptr, numbers.values.as_ptr() as i64);
+    // the numbers' address: the last argument (`build::function`)
+    let consts = a[6];
     let mut stores: Vec<(u32, u32)> = (0..tape.outputs.len() as u32)
         .map(|k| (tape.outputs[k as usize], k))
         .collect();

@@ -29,8 +29,12 @@ impl From<ModuleError> for JitError {
 }
 
 /// The signature of the compiled code: `x`, `p`, `v`, the two output buffers, the scratch
-/// array.
-type Code = extern "C" fn(*const f64, *const f64, *const f64, *mut f64, *mut f64, *mut f64);
+/// array, the tape's numbers.
+type Code =
+    extern "C" fn(*const f64, *const f64, *const f64, *mut f64, *mut f64, *mut f64, *const f64);
+
+/// The number of arguments of [`Code`].
+const ARGS: usize = 7;
 
 /// A tape compiled to native code: `run` writes output `k` of the tape to `out[k]`.
 pub struct JitTape {
@@ -43,9 +47,8 @@ pub struct JitTape {
     needs: [usize; 5],
     /// The length of the scratch array the functions pass registers through.
     scratch: usize,
-    /// The tape's numbers, which the code reads at their address (a boxed slice: its
-    /// elements never move, and live as long as the code).
-    _consts: Box<[f64]>,
+    /// The tape's numbers, whose address the code takes as its last argument.
+    consts: Box<[f64]>,
     /// Whether the code loops over the tape's repeating sections ([`Repeat`]).
     looped: bool,
     /// The machine code's size in bytes, every function together.
@@ -105,7 +108,7 @@ impl JitTape {
             build::define_tanh_keep(&mut module)?;
         }
         let mut ctx = module.make_context();
-        for _ in 0..6 {
+        for _ in 0..ARGS {
             ctx.func.signature.params.push(AbiParam::new(ptr));
         }
         looped::function(&mut module, &mut ctx.func, tape, rep, &numbers)?;
@@ -124,7 +127,7 @@ impl JitTape {
             code,
             needs: needs(tape),
             scratch: looped::scratch_len(tape, rep),
-            _consts: numbers.values,
+            consts: numbers.values,
             looped: true,
             bytes,
         })
@@ -139,7 +142,7 @@ impl JitTape {
         let mut ctx = module.make_context();
         let mut bytes = 0;
         for c in 0..layout.chunks.len() {
-            for _ in 0..6 {
+            for _ in 0..ARGS {
                 ctx.func.signature.params.push(AbiParam::new(ptr));
             }
             build::function(&mut module, &mut ctx.func, tape, &layout, c)?;
@@ -164,7 +167,7 @@ impl JitTape {
             code,
             needs: needs(tape),
             scratch: layout.slots,
-            _consts: std::mem::take(&mut layout.consts),
+            consts: std::mem::take(&mut layout.consts),
             looped: false,
             bytes,
         })
@@ -230,16 +233,16 @@ impl JitTape {
         debug_assert!(s.len() >= self.scratch);
         for &f in &self.code {
             // SAFETY: `f` is the finalized address of a function `compile_chunked` declared
-            // with exactly `Code`'s signature (six pointers, no result, the platform's C
+            // with exactly `Code`'s signature (seven pointers, no result, the platform's C
             // convention), and its module (a field of `self`) keeps the code alive. The code
             // reads `x[i]`, `p[k]`, `v[i]` only at indices the tape names and writes the
             // output buffers only at its outputs' indices; `run_split` checked every slice is
-            // at least that long (`needs`); it reads the numbers of `self._consts` at the
-            // address they were compiled with (their heap block, never moved or freed
-            // before `self`). The scratch array is read and written only at
-            // slots below `self.scratch` (`Layout`, `looped::before`), its length whenever
-            // that is not 0 (with 0, the code never touches it). Every buffer is borrowed mutably, so no
-            // one else sees the writes.
+            // at least that long (`needs`); it reads the numbers of `self.consts` at the
+            // slots the tape gave them (`Layout`, `looped::Numbers`), all within it (an empty
+            // table is never read). The scratch array is read and written only at slots below
+            // `self.scratch` (`Layout`, `looped::before`), its length whenever that is not 0
+            // (with 0, the code never touches it). Every buffer is borrowed mutably, so no one
+            // else sees the writes.
             let code = unsafe { std::mem::transmute::<*const u8, Code>(f) };
             code(
                 x.as_ptr(),
@@ -248,6 +251,7 @@ impl JitTape {
                 h.as_mut_ptr(),
                 t.as_mut_ptr(),
                 s.as_mut_ptr(),
+                self.consts.as_ptr(),
             );
         }
     }

@@ -92,6 +92,47 @@ fn every_op_gives_the_interpreters_bits() {
     }
 }
 
+/// A tape that reads no parameter (as a folded one): compiled in the order of
+/// `schedule.rs`, not the tape's, with multiply-adds whose first factor is read again later
+/// (its factors then swapped); every register an output.
+fn tape_without_parameters() -> Tape {
+    let mut ops = vec![Op::X(0), Op::X(1), Op::X(2), Op::K(0.375), Op::K(-1.5)];
+    let mut seed = 7u32;
+    let mut pick = |below: usize| {
+        seed = seed.wrapping_mul(1_103_515_245).wrapping_add(12_345);
+        (seed >> 8) as usize % below
+    };
+    for k in 0..60 {
+        let n = ops.len();
+        let (a, b, c) = (pick(n) as u32, pick(n) as u32, pick(n) as u32);
+        ops.push(match k % 6 {
+            0 => Op::MulAdd(a, b, c),
+            1 => Op::NegMulAdd(a, b, c),
+            2 => Op::MulSub(a, b, c),
+            3 => Op::Mul(a, b),
+            4 => Op::Sub(a, b),
+            _ => Op::MulAdd(n as u32 - 1, b, c),
+        });
+    }
+    let outputs = (0..ops.len() as u32).collect();
+    Tape {
+        ops,
+        outputs,
+        split: None,
+        sections: Vec::new(),
+    }
+}
+
+#[test]
+fn a_tape_without_parameters_gives_the_interpreters_bits() {
+    let t = tape_without_parameters();
+    for x in [[0.7, -2.3, 1.1], [1e-3, 3.5e2, -0.25], [0.0, -0.0, 1.0]] {
+        for chunk in [usize::MAX, 7] {
+            same_chunked(&t, chunk, &x, &[], &[]);
+        }
+    }
+}
+
 #[test]
 fn short_slices_are_refused_before_the_call() {
     let t = tape();
