@@ -10,9 +10,10 @@
 //! alone); the stops alone give no candidate a p-value below 1.6e-4 there
 //! and no model effect a BIC change beyond -7 (the self-check's single stops records).
 //! Both tests together name it: a score beyond what the stops' clipping produces
-//! ([`PARTNER_P`]) and a fit that is strongly better on the held-out block
-//! ([`STRONG_BIC`]). Its closure is of the one-run gap, which the stops dominate (a few
-//! thousandths); the step says so, and adds nothing to the cumulative closure.
+//! ([`PARTNER_P`](crate::diagnose::partner::PARTNER_P)) and a fit that is strongly better on
+//! the held-out block ([`STRONG_BIC`](crate::diagnose::verdict::STRONG_BIC)). Its closure is
+//! of the one-run gap, which the stops dominate (a few thousandths); the step says so, and
+//! adds nothing to the cumulative closure.
 //!
 //! Only effects on the model's dynamics without travels qualify: a sensor effect is tested
 //! by the restarted pass itself (a pressure lag is named there beside the stops), and a
