@@ -38,12 +38,7 @@ fn tape() -> Tape {
         }
     }
     let outputs = (0..ops.len() as u32).collect();
-    Tape {
-        ops,
-        outputs,
-        split: None,
-        sections: Vec::new(),
-    }
+    straight(ops, outputs)
 }
 
 fn same(x: &[f64], p: &[f64], v: &[f64]) {
@@ -115,6 +110,11 @@ fn tape_without_parameters() -> Tape {
         });
     }
     let outputs = (0..ops.len() as u32).collect();
+    straight(ops, outputs)
+}
+
+/// A tape of one straight stretch (no loop over sections) of `ops` with `outputs`.
+fn straight(ops: Vec<Op>, outputs: Vec<u32>) -> Tape {
     Tape {
         ops,
         outputs,
@@ -165,12 +165,7 @@ fn long_tape(len: usize) -> Tape {
         k += 1;
     }
     let outputs = (0..len as u32).rev().step_by(3).collect();
-    Tape {
-        ops,
-        outputs,
-        split: None,
-        sections: Vec::new(),
-    }
+    straight(ops, outputs)
 }
 
 #[test]
