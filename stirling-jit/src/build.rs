@@ -147,7 +147,7 @@ pub(crate) fn function(
     let mut minus_zero: Option<Value> = None;
     // the numbers' address: an argument, so one register (as an `iconst`, Cranelift
     // materialised the 64-bit address again before every load, 51 `movabs` at n = 2)
-    let consts = a[6];
+    let consts = a[crate::tape::ARGS - 1];
     // in the order that keeps fewer values live (`schedule`) where the tape reads no
     // parameter (folded: `nsection` at n = 10, 134 to 123 ns), in the tape's order where it
     // does (scheduled, its RHS + Jacobian at n = 10 measured 167 to 177-182 ns); each output

@@ -263,7 +263,7 @@ pub(crate) fn function(
     b.seal_block(entry);
     let a = b.block_params(entry).to_vec();
     // the numbers' address: the last argument (`build::function`)
-    let consts = a[6];
+    let consts = a[crate::tape::ARGS - 1];
     let mut stores: Vec<(u32, u32)> = (0..tape.outputs.len() as u32)
         .map(|k| (tape.outputs[k as usize], k))
         .collect();

@@ -33,8 +33,8 @@ impl From<ModuleError> for JitError {
 type Code =
     extern "C" fn(*const f64, *const f64, *const f64, *mut f64, *mut f64, *mut f64, *const f64);
 
-/// The number of arguments of [`Code`].
-const ARGS: usize = 7;
+/// The number of arguments of [`Code`]; the last is the numbers' table.
+pub(crate) const ARGS: usize = 7;
 
 /// A tape compiled to native code: `run` writes output `k` of the tape to `out[k]`.
 pub struct JitTape {

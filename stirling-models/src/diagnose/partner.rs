@@ -46,8 +46,13 @@ pub fn passes(p: f64, delta_bic: Option<f64>, strong_bic: f64) -> bool {
 }
 
 /// Add the partners of `first` (the one-run pass) to `second` (a second pass that named the
-/// stops), each as a step of its own; `infos`: the candidates. Returns the names added.
-pub fn name(second: &mut Diagnosis, first: &Diagnosis, infos: &[&EffectInfo]) -> Vec<String> {
+/// stops), each as a step of its own; `infos`: the candidates. Returns the one-run entries
+/// named.
+pub fn name<'f>(
+    second: &mut Diagnosis,
+    first: &'f Diagnosis,
+    infos: &[&EffectInfo],
+) -> Vec<&'f RankEntry> {
     let info = |name: &str| infos.iter().copied().find(|i| i.name == name);
     let found: Vec<&RankEntry> = first
         .ranking
@@ -60,7 +65,7 @@ pub fn name(second: &mut Diagnosis, first: &Diagnosis, infos: &[&EffectInfo]) ->
         second.steps.push(step);
         second.verdict.effects.push(e.effect.clone());
     }
-    found.iter().map(|e| e.effect.clone()).collect()
+    found
 }
 
 /// The step of a partner: its one-run estimates, score, BIC change and closure of the

@@ -121,8 +121,7 @@ pub fn second_pass(
 /// Name the partners of the seen stops that the one-run pass (`first`) shows
 /// ([`partner`]), each with its one-run evidence in the verdict's reason.
 fn name_partners(second: &mut Diagnosis, first: &Diagnosis, infos: &[&'static EffectInfo]) {
-    let named = partner::name(second, first, infos);
-    for e in first.ranking.iter().filter(|e| named.contains(&e.effect)) {
+    for e in partner::name(second, first, infos) {
         second.verdict.reason = format!(
             "{}; beside the stops, `{}` named from the one-run pass, where stage 1 runs through the whole block: score p {:.1e} (below {:.1e}, a tenth of the least the stops alone gave any candidate on the self-check's tuning records), held-out BIC change {:.0}, closure {:.3} [{:.3}, {:.3}] of the one-run gap (which the stops dominate); the restarted pass hides what builds up over cycles",
             second.verdict.reason,
