@@ -401,3 +401,45 @@ fn end_stops_beside_a_partner_name_the_quadratic_loss_and_leave_coulomb_as_a_rem
         );
     }
 }
+
+#[test]
+fn end_stops_beside_a_position_gain_name_the_gain_and_do_not_keep_what_it_superseded() {
+    // the self-check's evaluation record of the stops beside a +5 % gain on both positions:
+    // the stops are held at the travel seen in the measured acceleration, which the gain
+    // scales (`joint::rebase` divides it by `1 + gain`); a quadratic regenerator loss stands
+    // in for part of the gain before it is named, and is not kept once the gain is fitted
+    // with it (`diagnose::superseded`). The plan of docs/selfcheck-runs' runs (`--seeds 1:2
+    // --clean 4:20`): its first evaluation record of the pair (seed 1005)
+    let opts = VerdictOptions {
+        seeds: (1, 2),
+        clean: (4, 20),
+        ..VerdictOptions::default()
+    };
+    let d = diagnosed_case(&opts, "end_stops+sensor_gain", 0x5710);
+    assert_eq!(d.verdict.verdict, "effect", "{}", d.verdict.reason);
+    assert_eq!(
+        named(&d),
+        ["end_stops", "sensor_gain"],
+        "{}",
+        d.verdict.reason
+    );
+    check_steps(&d);
+    let last = d.steps.last().unwrap();
+    assert!(last.superseded.is_none() && last.effects == ["sensor_gain"]);
+    let gain_y = last.params.iter().find(|q| q.name == "gain_y").unwrap();
+    assert!(
+        gain_y.ci_low < 0.05 && 0.05 < gain_y.ci_high,
+        "gain_y {:.4} [{:.4}, {:.4}] misses 0.05",
+        gain_y.value,
+        gain_y.ci_low,
+        gain_y.ci_high
+    );
+    for s in d.steps.iter().filter(|s| s.superseded.is_some()) {
+        assert!(
+            d.verdict.reason.contains("not kept"),
+            "{}",
+            d.verdict.reason
+        );
+        assert!(!d.verdict.effects.contains(&s.effects[0]));
+    }
+}

@@ -72,6 +72,8 @@ pub mod sim_gap;
 pub mod steps;
 /// End stops seen in the measured acceleration (equation error).
 pub mod stops_equation;
+/// The backward check: an earlier step's effect the last step's fit does not need.
+pub mod superseded;
 /// What a diagnosis reports.
 pub mod types;
 /// The verdict a user reads.

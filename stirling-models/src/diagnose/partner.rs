@@ -100,6 +100,7 @@ fn step_of(e: &RankEntry, last: Option<&Step>, index: usize) -> Step {
         after_stops: true,
         from_reset: false,
         one_run: true,
+        superseded: None,
         eval: None,
     }
 }

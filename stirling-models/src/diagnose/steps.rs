@@ -216,6 +216,7 @@ pub fn explain(
             break;
         }
     }
+    super::superseded::mark(&mut out.steps, cands);
     out
 }
 
@@ -315,6 +316,7 @@ fn make_step(
         after_stops: false,
         from_reset: e.from_reset,
         one_run: false,
+        superseded: None,
         eval: Some(named.eval.clone()),
     }
 }

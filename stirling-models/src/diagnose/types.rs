@@ -158,9 +158,21 @@ pub struct Step {
     /// Named on the one-run pass beside end stops seen on the second pass
     /// ([`super::partner`]): its estimates, score and closure are the one-run pass's.
     pub one_run: bool,
+    /// Not kept: the last step's joint fit does not need this step's effect
+    /// ([`super::superseded`]).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub superseded: Option<Superseded>,
     /// Residual series after this step, for the report.
     #[serde(skip)]
     pub eval: Option<Eval>,
+}
+
+/// Why a step's effect is not kept in the verdict.
+#[derive(Clone, Debug, Serialize)]
+pub struct Superseded {
+    /// The step whose joint fit does not need it (1 for the first).
+    pub by_step: usize,
+    pub reason: String,
 }
 
 impl Step {
@@ -170,8 +182,40 @@ impl Step {
         let names = self.effects.join(" + ");
         if self.one_run {
             format!("{names} (one-run pass)")
+        } else if self.superseded.is_some() {
+            format!("{names} (not kept)")
         } else {
             names
+        }
+    }
+
+    /// A step naming the entry `e` alone, everything else empty (NaN closures): tests.
+    #[cfg(test)]
+    pub fn of_entry(e: &RankEntry) -> Step {
+        let nan = Interval {
+            value: f64::NAN,
+            ci_low: f64::NAN,
+            ci_high: f64::NAN,
+        };
+        Step {
+            step: 1,
+            effects: vec![e.effect.clone()],
+            p_value: e.p_value,
+            delta_bic: e.delta_bic.unwrap_or(f64::NAN),
+            params: e.params.clone(),
+            closure: nan,
+            cumulative: nan,
+            holdout_error: f64::NAN,
+            channels: Vec::new(),
+            simulation_gap: None,
+            simulation_gap_note: None,
+            ranking: Vec::new(),
+            seconds: 0.0,
+            after_stops: false,
+            from_reset: false,
+            one_run: false,
+            superseded: None,
+            eval: None,
         }
     }
 }

@@ -200,13 +200,17 @@ pub fn decide_steps(
         return decide(ranking, nominal, alpha, candidates, shifts);
     };
     let level = alpha / candidates.max(1) as f64;
-    let named: Vec<String> = steps.iter().flat_map(|s| s.effects.clone()).collect();
+    let named: Vec<String> = steps
+        .iter()
+        .filter(|s| s.superseded.is_none())
+        .flat_map(|s| s.effects.clone())
+        .collect();
     let cum = end.cumulative;
     let chain = steps
         .iter()
         .map(|s| {
             format!(
-                "`{}` closes {:.2} [{:.2}, {:.2}] of what remained (p {:.1e}, BIC {:.0}{})",
+                "`{}` closes {:.2} [{:.2}, {:.2}] of what remained (p {:.1e}, BIC {:.0}{}{})",
                 s.effects.join("` + `"),
                 s.closure.value,
                 s.closure.ci_low,
@@ -217,7 +221,10 @@ pub fn decide_steps(
                     ", fitted from the nominal parameters' estimates: the calibration had absorbed it"
                 } else {
                     ""
-                }
+                },
+                s.superseded
+                    .as_ref()
+                    .map_or(String::new(), |x| format!("; {}", x.reason))
             )
         })
         .collect::<Vec<_>>()

@@ -114,6 +114,10 @@ pub struct Joint<'a> {
     dp_link: Option<rebase::DpLink>,
     /// The basis's optimum: the start of the candidate's variables at their null.
     base_x: Vec<f64>,
+    /// Held end-stop travels (`Basis::held_shapes`) as seen in the record: the position
+    /// gain's name that scales each, the model parameter and the travel ([`Joint::rebase`]
+    /// divides it by the gain).
+    held_travels: Vec<(&'static str, usize, f64)>,
 }
 
 /// Whether a stage is the mechanics stage (positions out, pressures in).
@@ -169,6 +173,11 @@ impl<'a> Joint<'a> {
             stages.push((si, ext));
         }
         let dp_link = rebase::DpLink::of(&stages, &map);
+        let held_travels = if basis.held_shapes {
+            rebase::held_travels(model, &all_shapes)
+        } else {
+            Vec::new()
+        };
         let mut joint = Joint {
             stages,
             map,
@@ -177,6 +186,7 @@ impl<'a> Joint<'a> {
             effect: vars.effect,
             dp_link,
             base_x: basis.x.clone(),
+            held_travels,
         };
         if !basis.effects.is_empty() {
             let key = memo::basis_key(&basis.x, &basis.effects);

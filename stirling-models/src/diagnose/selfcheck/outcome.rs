@@ -78,6 +78,10 @@ pub struct StepBrief {
     pub from_reset: bool,
     /// Named on the one-run pass beside the stops ([`crate::diagnose::partner`]).
     pub one_run: bool,
+    /// Not kept: the joint fit of this step (1 for the first) does not need it
+    /// ([`crate::diagnose::superseded`]).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub superseded_by: Option<usize>,
     /// Held-out error after the step (noise variances) and each channel's rms against its
     /// noise: what a test of the remainder reads.
     pub holdout_error: f64,
@@ -116,8 +120,9 @@ impl Outcome {
             return label_of(pick(&self.ranking, self.candidates, self.gap, th));
         }
         let level = th.alpha / self.candidates.max(1) as f64;
-        let mut named = Vec::new();
+        let mut named: Vec<(Option<usize>, &String)> = Vec::new();
         let mut cumulative = f64::NEG_INFINITY;
+        let mut kept = 0;
         for s in &self.steps {
             let rule = StepRule::at(th.strong_bic, s.after_stops);
             let moved = true;
@@ -130,9 +135,16 @@ impl Outcome {
             if !passes {
                 break;
             }
-            named.extend(s.effects.iter().cloned());
+            named.extend(s.effects.iter().map(|e| (s.superseded_by, e)));
             cumulative = s.cumulative_low;
+            kept += 1;
         }
+        // a step superseded by one the thresholds keep is not named
+        let named: Vec<String> = named
+            .into_iter()
+            .filter(|(by, _)| by.is_none_or(|b| b > kept))
+            .map(|(_, e)| e.clone())
+            .collect();
         if !named.is_empty() && cumulative > th.min_closure {
             named_label(&named, self.remainder)
         } else if self.ranking.iter().any(|r| r.p_value < level) || self.gap > GROSS_GAP {
@@ -195,6 +207,7 @@ impl Outcome {
                 after_stops: s.after_stops,
                 from_reset: s.from_reset,
                 one_run: s.one_run,
+                superseded_by: s.superseded.as_ref().map(|x| x.by_step),
                 holdout_error: s.holdout_error,
                 channels: s
                     .channels
