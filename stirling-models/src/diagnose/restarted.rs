@@ -122,6 +122,18 @@ pub fn second_pass(
 /// ([`partner`]), each with its one-run evidence in the verdict's reason.
 fn name_partners(second: &mut Diagnosis, first: &Diagnosis, infos: &[&'static EffectInfo]) {
     for e in partner::name(second, first, infos) {
+        if partner::on_score_alone(e.p_value, e.delta_bic) {
+            second.verdict.reason = format!(
+                "{}; beside the stops, `{}` named from the one-run pass on its score alone: p {:.1e}, below {:.1e}, far beyond what any absent effect gave there on the self-check's tuning records; its one-run fit, which lacks the stops, does not lower the held-out error (BIC change {:.0}), so its one-run estimate in the step is no measure of its strength and its part of the gap stays in the remainder",
+                second.verdict.reason,
+                e.effect,
+                e.p_value,
+                partner::PARTNER_SCORE_P,
+                e.delta_bic.unwrap_or(f64::NAN),
+            );
+            second.verdict.unexplained_remainder = true;
+            continue;
+        }
         second.verdict.reason = format!(
             "{}; beside the stops, `{}` named from the one-run pass, where stage 1 runs through the whole block: score p {:.1e} (below {:.1e}, a tenth of the least the stops alone gave any candidate on the self-check's tuning records), held-out BIC change {:.0}, closure {:.3} [{:.3}, {:.3}] of the one-run gap (which the stops dominate); the restarted pass hides what builds up over cycles",
             second.verdict.reason,
