@@ -51,6 +51,9 @@ pub struct Outcome {
     pub ranking: Vec<RankEntry>,
     /// The steps of the explanation (what the thresholds re-decide).
     pub steps: Vec<StepBrief>,
+    /// The round after the last step, which named nothing (what a step rule is tried on).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub last_round: Vec<RankEntry>,
     /// A second pass's verdict: the one-run pass's candidates and their score p-values.
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub one_run: Vec<(String, f64)>,
@@ -176,6 +179,7 @@ impl Outcome {
             ranking: Vec::new(),
             one_run: Vec::new(),
             steps: Vec::new(),
+            last_round: Vec::new(),
             gap: 0.0,
             signature: Signature::default(),
             seconds: 0.0,
@@ -216,6 +220,7 @@ impl Outcome {
                     .collect(),
             })
             .collect();
+        self.last_round = d.remainder.clone();
         self.tuned_verdict = self.verdict.clone();
         self.top = d.ranking.first().map(|r| r.effect.clone());
         // the closure of the truth when it was fitted, else of the leading candidate
