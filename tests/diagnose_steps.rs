@@ -95,6 +95,18 @@ fn named(d: &Diagnosis) -> Vec<String> {
     v
 }
 
+/// The step's estimate of `name` has an interval covering `truth`.
+fn assert_covers(step: &stirling::models::diagnose::types::Step, name: &str, truth: f64) {
+    let q = step.params.iter().find(|q| q.name == name).unwrap();
+    assert!(
+        q.ci_low < truth && truth < q.ci_high,
+        "{name} {:.4e} [{:.4e}, {:.4e}] misses {truth:e}",
+        q.value,
+        q.ci_low,
+        q.ci_high
+    );
+}
+
 /// The steps' record is whole: numbered from 1, each with its closure inside its interval,
 /// the cumulative closure growing, every named effect's parameters estimated.
 fn check_steps(d: &Diagnosis) {
@@ -396,14 +408,7 @@ fn end_stops_beside_a_partner_name_the_quadratic_loss_and_leave_coulomb_as_a_rem
             continue;
         }
         // the self-check's unit: `Rq` 1e8 (0.1 of its typical value)
-        let rq = step.params.iter().find(|q| q.name == "Rq").unwrap();
-        assert!(
-            rq.ci_low < 1e8 && 1e8 < rq.ci_high,
-            "Rq {:.3e} [{:.3e}, {:.3e}] misses 1e8",
-            rq.value,
-            rq.ci_low,
-            rq.ci_high
-        );
+        assert_covers(step, "Rq", 1e8);
         assert!(
             d.verdict.reason.contains("one-run pass"),
             "{}",
@@ -436,14 +441,7 @@ fn end_stops_beside_a_position_gain_name_the_gain_and_do_not_keep_what_it_supers
     check_steps(&d);
     let last = d.steps.last().unwrap();
     assert!(last.superseded.is_none() && last.effects == ["sensor_gain"]);
-    let gain_y = last.params.iter().find(|q| q.name == "gain_y").unwrap();
-    assert!(
-        gain_y.ci_low < 0.05 && 0.05 < gain_y.ci_high,
-        "gain_y {:.4} [{:.4}, {:.4}] misses 0.05",
-        gain_y.value,
-        gain_y.ci_low,
-        gain_y.ci_high
-    );
+    assert_covers(last, "gain_y", 0.05);
     for s in d.steps.iter().filter(|s| s.superseded.is_some()) {
         assert!(
             d.verdict.reason.contains("not kept"),
