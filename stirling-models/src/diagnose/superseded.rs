@@ -1,6 +1,6 @@
 //! The backward check of the explanation: an effect named at an earlier step that the last
-//! step's joint fit no longer needs is not kept (docs/diagnosis.md, "An earlier step
-//! superseded").
+//! step's joint fit no longer needs is not kept (docs/diagnosis.md, Method step 8, "An
+//! earlier step not kept").
 //!
 //! Why: the steps are forward selection; each names what closes most of what is left at that
 //! point, and an effect can stand in for one that is named later. The last step refits every
