@@ -90,36 +90,22 @@ pub fn name<'f>(
 /// one-run gap; the cumulative closure and held-out errors stay the last step's (`last`),
 /// which the partner's one-run fit does not change.
 fn step_of(e: &RankEntry, last: Option<&Step>, index: usize) -> Step {
-    let nan = Interval {
-        value: f64::NAN,
-        ci_low: f64::NAN,
-        ci_high: f64::NAN,
-    };
     Step {
         step: index,
-        effects: vec![e.effect.clone()],
-        p_value: e.p_value,
-        delta_bic: e.delta_bic.unwrap_or(f64::NAN),
-        params: e.params.clone(),
         closure: Interval {
             value: e.closure_fraction.unwrap_or(f64::NAN),
             ci_low: e.ci_low.unwrap_or(f64::NAN),
             ci_high: e.ci_high.unwrap_or(f64::NAN),
         },
-        cumulative: last.map_or(nan, |s| s.cumulative),
+        cumulative: last.map_or(Interval::NAN, |s| s.cumulative),
         holdout_error: last.map_or(f64::NAN, |s| s.holdout_error),
         channels: last.map(|s| s.channels.clone()).unwrap_or_default(),
-        simulation_gap: None,
         simulation_gap_note: Some(
             "named on the one-run pass beside the end stops: no simulated gap of its own".into(),
         ),
-        ranking: Vec::new(),
-        seconds: 0.0,
         after_stops: true,
-        from_reset: false,
         one_run: true,
-        superseded: None,
-        eval: None,
+        ..Step::of_entry(e)
     }
 }
 

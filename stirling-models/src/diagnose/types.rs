@@ -119,6 +119,15 @@ pub struct Interval {
     pub ci_high: f64,
 }
 
+impl Interval {
+    /// No value (not computed).
+    pub const NAN: Interval = Interval {
+        value: f64::NAN,
+        ci_low: f64::NAN,
+        ci_high: f64::NAN,
+    };
+}
+
 /// One step of the explanation: the effect named (or a pair tried together), fitted jointly
 /// with the nominal parameters and every effect named before it.
 #[derive(Clone, Debug, Serialize)]
@@ -189,22 +198,17 @@ impl Step {
         }
     }
 
-    /// A step naming the entry `e` alone, everything else empty (NaN closures): tests.
-    #[cfg(test)]
+    /// A step naming the entry `e` alone with its score, BIC change and estimates; no
+    /// closure (NaN), no held-out errors, no ranking.
     pub fn of_entry(e: &RankEntry) -> Step {
-        let nan = Interval {
-            value: f64::NAN,
-            ci_low: f64::NAN,
-            ci_high: f64::NAN,
-        };
         Step {
             step: 1,
             effects: vec![e.effect.clone()],
             p_value: e.p_value,
             delta_bic: e.delta_bic.unwrap_or(f64::NAN),
             params: e.params.clone(),
-            closure: nan,
-            cumulative: nan,
+            closure: Interval::NAN,
+            cumulative: Interval::NAN,
             holdout_error: f64::NAN,
             channels: Vec::new(),
             simulation_gap: None,
