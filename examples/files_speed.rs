@@ -6,7 +6,12 @@
 //! parameters folded in, at the benchmarks' fairness state (`examples/support/fairness.rs`,
 //! as `examples/bench_native.rs` and CasADi's side of `bench/`).
 //!
-//! The kernels are timed in alternating rounds (macro, JIT, folded, three times; each keeps
+//! With the parameters folded in, three ways: the folded tapes compiled by Cranelift, by the
+//! system's C compiler where it pays (`files::folded_native`, `stirling_jit::cc_jit`), both
+//! called through the `Model` trait (which checks the parameters at each call), and that
+//! model's kernel (`CompiledModel::kernel`: the state alone, like CasADi's literal C).
+//!
+//! The kernels are timed in alternating rounds (each of them in turn, three times; each keeps
 //! its fastest round's median), so that a busy machine slows them alike.
 //!
 //! Run: `cargo run --release --example files_speed [-- --ns 2,10,100,1000] [--json]`
@@ -22,7 +27,7 @@ use std::time::{Duration, Instant};
 
 use fairness::{fairness_state, time_per_call};
 use serde_json::{json, Value};
-use stirling::dsl::compiled::{CompiledModel, Definition};
+use stirling::dsl::compiled::{CompiledModel, Definition, Kernel, KernelError};
 use stirling::dsl::{Closure, Model};
 use stirling::models::family::NSection;
 use stirling::models::files;
@@ -41,6 +46,18 @@ fn time(m: &dyn Model, p: &[f64], x: &[f64]) -> f64 {
         )
     };
     time_per_call(once, 2e-3, 21, 0.6).0
+}
+
+/// Seconds per call of the folded model's kernel (`CompiledModel::kernel`: the state alone,
+/// no parameters to check) at `x`.
+fn time_kernel(k: &Kernel, x: &[f64]) -> Result<f64, KernelError> {
+    let mut f = vec![0.0; k.n_states()];
+    let mut v = vec![0.0; k.nnz()];
+    k.rhs_and_jacobian_values(x, &mut f, &mut v)?;
+    let once = || {
+        let _ = k.rhs_and_jacobian_values(std::hint::black_box(x), &mut f, &mut v);
+    };
+    Ok(time_per_call(once, 2e-3, 21, 0.6).0)
 }
 
 /// The first RHS + Jacobian call (the JIT compiles the tape then).
@@ -105,13 +122,22 @@ fn row(def: &Arc<Definition>, n: usize) -> Result<Value, Box<dyn std::error::Err
     let jit_compile = first_call(&jit, &p, &x);
     let folded = jit.folded(&p);
     let folded_compile = first_call(&folded, &p, &x);
-    let mut best = [f64::INFINITY; 3];
+    let folded_c = files::folded_native(&jit, &p);
+    let folded_c_compile = first_call(&folded_c, &p, &x);
+    let kernel = folded_c
+        .kernel()
+        .ok_or("the folded model has no native kernel")?;
+    let (mut best, mut k) = ([f64::INFINITY; 4], f64::INFINITY);
     for _ in 0..3 {
-        for (b, m) in best.iter_mut().zip([&mac as &dyn Model, &jit, &folded]) {
+        k = k.min(time_kernel(&kernel, &x)?);
+        for (b, m) in best
+            .iter_mut()
+            .zip([&mac as &dyn Model, &jit, &folded, &folded_c])
+        {
             *b = b.min(time(m, &p, &x));
         }
     }
-    let [a, c, d] = best;
+    let [a, c, d, e] = best;
     let b = time(&tape, &p, &x);
     let names: Vec<&str> = mac.params().iter().map(|q| q.name).collect();
     let params: serde_json::Map<String, Value> = names
@@ -123,12 +149,16 @@ fn row(def: &Arc<Definition>, n: usize) -> Result<Value, Box<dyn std::error::Err
     Ok(json!({
         "n": n, "tape_build_ms": ms(build), "jit_compile_ms": ms(jit_compile),
         "jit_folded_compile_ms": ms(folded_compile),
+        "cc_folded_compile_ms": ms(folded_c_compile),
         "tape_ops": {"rhs": rhs_ops, "jac": jac_ops,
                      "rhs_jac": tape.rhs_jacobian_tape(&p).ops.len(),
                      "rhs_jac_folded": folded.rhs_jacobian_tape(&p).ops.len()},
         "macro_ns": a * 1e9, "tape_ns": b * 1e9, "jit_ns": c * 1e9, "jit_folded_ns": d * 1e9,
+        "cc_folded_ns": e * 1e9, "cc_folded_over_macro": e / a,
+        "kernel_ns": k * 1e9, "kernel_over_macro": k / a,
         "tape_over_macro": b / a, "jit_over_macro": c / a, "jit_folded_over_macro": d / a,
         "params": params, "folded_at_x": values(&folded, &p, &x),
+        "cc_folded_at_x": values(&folded_c, &p, &x),
     }))
 }
 
@@ -160,22 +190,27 @@ fn print_table(load: &Value, rows: &[Value]) {
     );
     println!("RHS + Jacobian values per call (ns):");
     println!(
-        "     n    macro     tape      jit  jit fold  tape/mac  jit/mac  fold/mac  \
-         tapes (ms)  jit compile (ms)"
+        "     n    macro     tape      jit  jit fold   cc fold   kernel  tape/mac  jit/mac  \
+         fold/mac  cc/mac  kernel/mac  tapes (ms)  jit compile (ms)  cc compile (ms)"
     );
     for r in rows {
         println!(
-            "{:>6} {:>8.0} {:>8.0} {:>8.0} {:>9.0} {:>9.2} {:>8.2} {:>9.2} {:>11.1} {:>17.1}",
+            "{:>6} {:>8.0} {:>8.0} {:>8.0} {:>9.0} {:>9.0} {:>8.0} {:>9.2} {:>8.2} {:>9.2} {:>7.2} {:>11.2} {:>11.1} {:>17.1} {:>16.1}",
             r["n"],
             f(r, "macro_ns"),
             f(r, "tape_ns"),
             f(r, "jit_ns"),
             f(r, "jit_folded_ns"),
+            f(r, "cc_folded_ns"),
+            f(r, "kernel_ns"),
             f(r, "tape_over_macro"),
             f(r, "jit_over_macro"),
             f(r, "jit_folded_over_macro"),
+            f(r, "cc_folded_over_macro"),
+            f(r, "kernel_over_macro"),
             f(r, "tape_build_ms"),
-            f(r, "jit_compile_ms")
+            f(r, "jit_compile_ms"),
+            f(r, "cc_folded_compile_ms")
         );
     }
 }

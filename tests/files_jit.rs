@@ -125,6 +125,9 @@ fn jit_is_the_interpreter_on_every_family_file() {
                     let (jf, inf) = (jit.folded(&p), interp.folded(&p));
                     check(name, n, &jf, &inf, &p, &x);
                     assert!(jf.native_tapes() > 0, "{name} n = {n}: folded ran natively");
+                    if n <= 2 && k == 0 && matches!(closure, Closure::Full) {
+                        the_c_compilers_code_and_kernel(name, n, &jit, &inf, (&p, &x));
+                    }
                 }
                 assert_eq!(interp.native_tapes(), 0);
                 assert!(
@@ -135,6 +138,38 @@ fn jit_is_the_interpreter_on_every_family_file() {
             }
         }
     }
+}
+
+/// The folded model of the C compiler's code (`files::folded_native`) gives the interpreter's
+/// folded bits, and its kernel gives that model's RHS + Jacobian bits.
+fn the_c_compilers_code_and_kernel(
+    name: &str,
+    n: usize,
+    jit: &CompiledModel,
+    interp_folded: &CompiledModel,
+    (p, x): (&[f64], &[f64]),
+) {
+    let cf = files::folded_native(jit, p);
+    check(name, n, &cf, interp_folded, p, x);
+    let kernel = cf
+        .kernel()
+        .expect("a folded model's RHS + Jacobian runs natively");
+    let (mut f, mut v) = (vec![0.0; cf.n_states()], vec![0.0; kernel.nnz()]);
+    kernel.rhs_and_jacobian_values(x, &mut f, &mut v).unwrap();
+    let (mut g, mut w) = (f.clone(), v.clone());
+    cf.rhs_and_jacobian_values(p, x, 0.0, &mut g, &mut w);
+    let bits = |a: &[f64]| a.iter().map(|z| z.to_bits()).collect::<Vec<_>>();
+    assert_eq!(
+        (bits(&f), bits(&v)),
+        (bits(&g), bits(&w)),
+        "{name} n = {n}: kernel"
+    );
+    // wrong lengths are an error that says them, nothing written
+    let e = kernel
+        .rhs_and_jacobian_values(&x[1..], &mut f, &mut v)
+        .unwrap_err();
+    assert_eq!((e.x, e.n_states), (x.len() - 1, x.len()));
+    assert!(e.to_string().contains("called with x of"));
 }
 
 #[test]

@@ -12,11 +12,20 @@
 //! `sign` and the saturated `tanh` (inline) and `powf` call the interpreter's own Rust
 //! functions (`shims`); `powi` multiplies as the interpreter's `f64::powi` does (`build`). [`jit`] is a [`Jit`](stirling_dsl::compiled::Jit) to install
 //! on a model ([`CompiledModel::with_jit`](stirling_dsl::compiled::CompiledModel::with_jit)).
+//!
+//! [`cc_jit`] is a second [`Jit`](stirling_dsl::compiled::Jit), for short tapes with the
+//! parameters folded in ([`CompiledModel::folded_by`](stirling_dsl::compiled::CompiledModel::folded_by)):
+//! the tape as C ([`CcTape`]), compiled by the system's C compiler with IEEE arithmetic kept
+//! (the interpreter's bits again) and loaded as a shared library; Cranelift's code where no C
+//! compiler works or the tape is longer than [`CC_MAX_OPS`].
 
 mod build;
+mod cc;
+mod csource;
 mod looped;
 mod schedule;
 mod shims;
 mod tape;
 
+pub use cc::{cc_jit, CcTape, CC_MAX_OPS};
 pub use tape::{jit, JitError, JitTape, CHUNK_OPS, LOOP_MIN};

@@ -31,6 +31,18 @@ extern "C" fn powf(a: f64, b: f64) -> f64 {
     a.powf(b)
 }
 
+/// Every unary function with its shim.
+const UNARY: [(Func, extern "C" fn(f64) -> f64); 8] = [
+    (Func::Sqrt, sqrt),
+    (Func::Ln, ln),
+    (Func::Exp, exp),
+    (Func::Tanh, tanh),
+    (Func::Abs, abs),
+    (Func::Sign, sign),
+    (Func::Sin, sin),
+    (Func::Cos, cos),
+];
+
 /// The symbol name a function is imported under.
 pub(crate) fn name(f: Func) -> &'static str {
     match f {
@@ -50,20 +62,21 @@ pub(crate) const POWF: &str = "stirling_powf";
 
 /// Every symbol with its address, for `JITBuilder::symbol`.
 pub(crate) fn symbols() -> Vec<(&'static str, *const u8)> {
-    let unary: [(Func, extern "C" fn(f64) -> f64); 8] = [
-        (Func::Sqrt, sqrt),
-        (Func::Ln, ln),
-        (Func::Exp, exp),
-        (Func::Tanh, tanh),
-        (Func::Abs, abs),
-        (Func::Sign, sign),
-        (Func::Sin, sin),
-        (Func::Cos, cos),
-    ];
-    let mut v: Vec<(&'static str, *const u8)> = unary
+    let mut v: Vec<(&'static str, *const u8)> = UNARY
         .iter()
         .map(|&(f, g)| (name(f), g as *const u8))
         .collect();
     v.push((POWF, powf as extern "C" fn(f64, f64) -> f64 as *const u8));
     v
+}
+
+/// The functions' addresses in the order of `csource::slot`, `powf` last: the table the C
+/// compiler's code calls through (`cc.rs`).
+pub(crate) fn table() -> [*const u8; 9] {
+    let mut t = [std::ptr::null::<u8>(); 9];
+    for (f, g) in UNARY {
+        t[crate::csource::slot(f)] = g as *const u8;
+    }
+    t[crate::csource::POWF_SLOT] = powf as extern "C" fn(f64, f64) -> f64 as *const u8;
+    t
 }

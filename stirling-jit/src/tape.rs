@@ -317,7 +317,7 @@ fn module() -> Result<JITModule, JitError> {
 }
 
 /// The lengths of `x`, `p`, `v` and both output buffers the tape needs.
-fn needs(tape: &Tape) -> [usize; 5] {
+pub(crate) fn needs(tape: &Tape) -> [usize; 5] {
     let head = tape.head();
     let mut n = [0, 0, 0, head, tape.outputs.len() - head];
     for op in &tape.ops {

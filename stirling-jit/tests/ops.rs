@@ -1,8 +1,9 @@
 //! Every instruction of a tape, compiled, against the interpreter: the same bits.
 
+use stirling_dsl::compiled::Runner;
 use stirling_dsl::compiled::{Op, Tape};
 use stirling_dsl::expr::Func;
-use stirling_jit::JitTape;
+use stirling_jit::{CcTape, JitTape};
 
 const FUNCS: [Func; 8] = [
     Func::Sqrt,
@@ -46,17 +47,32 @@ fn same(x: &[f64], p: &[f64], v: &[f64]) {
     for chunk in [usize::MAX, 7] {
         same_chunked(&t, chunk, x, p, v);
     }
+    same_cc(&cc(&t), &t, x, p, v);
 }
 
-/// The tape compiled as functions of at most `chunk` instructions gives the interpreter's
-/// bits.
-fn same_chunked(t: &Tape, chunk: usize, x: &[f64], p: &[f64], v: &[f64]) {
-    let jit = JitTape::compile_chunked(t, chunk).expect("the host has a JIT");
+/// `t` compiled by the C compiler (the machines the tests run on have one: Rust links with it).
+fn cc(t: &Tape) -> CcTape {
+    CcTape::compile(t).expect("the C compiler compiles the tape")
+}
+
+/// The C compiler's code of `t` gives the interpreter's bits.
+fn same_cc(code: &CcTape, t: &Tape, x: &[f64], p: &[f64], v: &[f64]) {
+    let mut out = vec![0.0; t.outputs.len()];
+    assert!(code.run(x, p, v, &mut out, &mut []));
+    agree(t, &out, x, p, v);
+}
+
+/// `out` holds the interpreter's bits of every output of `t` (NaN for NaN).
+fn agree(t: &Tape, out: &[f64], x: &[f64], p: &[f64], v: &[f64]) {
     let mut regs = Vec::new();
     t.run(p, x, v, &mut regs);
-    let mut out = vec![0.0; t.outputs.len()];
-    assert!(jit.run(x, p, v, &mut out));
-    for (k, (a, b)) in regs.iter().zip(&out).enumerate() {
+    for (k, (a, b)) in t
+        .outputs
+        .iter()
+        .map(|&r| regs[r as usize])
+        .zip(out)
+        .enumerate()
+    {
         let equal = a.to_bits() == b.to_bits() || (a.is_nan() && b.is_nan());
         assert!(
             equal,
@@ -64,6 +80,15 @@ fn same_chunked(t: &Tape, chunk: usize, x: &[f64], p: &[f64], v: &[f64]) {
             t.ops[k]
         );
     }
+}
+
+/// The tape compiled as functions of at most `chunk` instructions gives the interpreter's
+/// bits.
+fn same_chunked(t: &Tape, chunk: usize, x: &[f64], p: &[f64], v: &[f64]) {
+    let jit = JitTape::compile_chunked(t, chunk).expect("the host has a JIT");
+    let mut out = vec![0.0; t.outputs.len()];
+    assert!(jit.run(x, p, v, &mut out));
+    agree(t, &out, x, p, v);
 }
 
 #[test]
@@ -126,10 +151,12 @@ fn straight(ops: Vec<Op>, outputs: Vec<u32>) -> Tape {
 #[test]
 fn a_tape_without_parameters_gives_the_interpreters_bits() {
     let t = tape_without_parameters();
+    let code = cc(&t);
     for x in [[0.7, -2.3, 1.1], [1e-3, 3.5e2, -0.25], [0.0, -0.0, 1.0]] {
         for chunk in [usize::MAX, 7] {
             same_chunked(&t, chunk, &x, &[], &[]);
         }
+        same_cc(&code, &t, &x, &[], &[]);
     }
 }
 

@@ -271,7 +271,13 @@ impl CompiledModel {
     /// other vector (even `-0.0` for `0.0`) it computes with the parameters as inputs, so a
     /// changed parameter is never silently ignored.
     pub fn folded(&self, p: &[f64]) -> CompiledModel {
-        let jit = self.jit;
+        self.folded_by(p, self.jit)
+    }
+
+    /// [`Self::folded`], the folded tapes compiled by `jit` (e.g. `stirling_jit::cc_jit`, an
+    /// optimising C compiler's code, worth its compile time only where the model runs many
+    /// times at `p`); the parameter-input tapes keep this model's JIT.
+    pub fn folded_by(&self, p: &[f64], jit: Option<Jit>) -> CompiledModel {
         let mut folded = self
             .f
             .map(|f| Function::new(f.tape.fold(p), f.places.clone()).with_jit(jit));
@@ -288,7 +294,7 @@ impl CompiledModel {
             n_states: self.n_states,
             f: self.f.clone(),
             folded: Some((p.to_vec(), folded)),
-            jit,
+            jit: self.jit,
         }
     }
 
@@ -333,6 +339,21 @@ impl CompiledModel {
     /// The parameter vector folded in, if any ([`CompiledModel::folded`]).
     pub fn folded_params(&self) -> Option<&[f64]> {
         self.folded.as_ref().map(|(q, _)| q.as_slice())
+    }
+
+    /// The right-hand side with the Jacobian's values at the folded parameters as a function
+    /// of the state alone ([`Kernel`](super::Kernel): no parameters, so no check of them at
+    /// each call); `None` unless this model is folded ([`Self::folded`]) and that tape runs
+    /// as native code.
+    pub fn kernel(&self) -> Option<super::Kernel> {
+        let (_, f) = self.folded.as_ref()?;
+        f.rhs_jac.tape.split?;
+        let code = f.rhs_jac.code()?;
+        Some(super::Kernel::new(
+            Arc::clone(code),
+            self.n_states,
+            self.f.jac.places.len(),
+        ))
     }
 
     /// The functions to run at `p`: the folded ones at the folded vector.
