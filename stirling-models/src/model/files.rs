@@ -170,7 +170,7 @@ pub fn jit(model: CompiledModel) -> CompiledModel {
 
 /// `model` with the parameters `p` folded in ([`CompiledModel::folded`]), the folded tapes
 /// compiled by the system's C compiler where it works (`stirling_jit::cc_jit`: some 0.1 s at
-/// n = 2, the code about 1.2x faster than Cranelift's there, docs/performance.md), else by the
+/// n = 2, the code some 12 % faster than Cranelift's there, docs/performance.md), else by the
 /// JIT; run by the interpreter without the `jit` feature.
 pub fn folded_native(model: &CompiledModel, p: &[f64]) -> CompiledModel {
     #[cfg(feature = "jit")]
