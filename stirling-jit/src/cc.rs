@@ -4,7 +4,7 @@
 //! worth its compile time (some 0.1 s at n = 2). What CasADi does for its generated C; here
 //! the tape is the one the Cranelift code runs, compiled without contraction
 //! (`-ffp-contract=off`, no `-ffast-math`), so the bits are the interpreter's
-//! (`tests/cc.rs`). [`cc_jit`] falls back to Cranelift ([`jit`]) where no C compiler works.
+//! (`tests/ops.rs`). [`cc_jit`] falls back to Cranelift ([`jit`]) where no C compiler works.
 
 use std::path::Path;
 use std::process::Command;
@@ -15,7 +15,7 @@ use stirling_dsl::compiled::{Runner, Tape};
 
 use crate::csource::{self, ENTRY};
 use crate::shims;
-use crate::tape::{jit, needs, JitError};
+use crate::tape::{fits, jit, needs, JitError};
 
 /// The compiled function: `x`, `p`, `v`, the two output buffers, the table of functions.
 type Code =
@@ -128,8 +128,10 @@ fn load(path: &Path) -> Result<(Library, Code), JitError> {
 impl Runner for CcTape {
     #[allow(unsafe_code)]
     fn run(&self, x: &[f64], p: &[f64], v: &[f64], head: &mut [f64], tail: &mut [f64]) -> bool {
-        let [nx, np, nv, nh, nt] = self.needs;
-        if x.len() < nx || p.len() < np || v.len() < nv || head.len() < nh || tail.len() < nt {
+        if !fits(
+            self.needs,
+            [x.len(), p.len(), v.len(), head.len(), tail.len()],
+        ) {
             return false;
         }
         // SAFETY: the code reads `x[i]`, `p[k]`, `v[i]` only at indices the tape names and

@@ -209,8 +209,10 @@ impl JitTape {
         head: &mut [f64],
         tail: &mut [f64],
     ) -> bool {
-        let [nx, np, nv, nh, nt] = self.needs;
-        if x.len() < nx || p.len() < np || v.len() < nv || head.len() < nh || tail.len() < nt {
+        if !fits(
+            self.needs,
+            [x.len(), p.len(), v.len(), head.len(), tail.len()],
+        ) {
             return false;
         }
         if self.scratch == 0 {
@@ -314,6 +316,12 @@ fn module() -> Result<JITModule, JitError> {
         jb.symbol(name, addr);
     }
     Ok(JITModule::new(jb))
+}
+
+/// Whether slices of the lengths `have` (`x`, `p`, `v`, both output buffers) are long enough
+/// for a tape that `needs` them.
+pub(crate) fn fits(needs: [usize; 5], have: [usize; 5]) -> bool {
+    needs.iter().zip(have).all(|(&n, h)| h >= n)
 }
 
 /// The lengths of `x`, `p`, `v` and both output buffers the tape needs.

@@ -3,7 +3,8 @@
 //!
 //! A folded [`CompiledModel`](super::CompiledModel) called through the [`Model`](crate::Model)
 //! trait checks at every call that the parameters it is given are the folded ones (a changed
-//! parameter is never silently ignored): some 5 ns of 50 at n = 2 (docs/performance.md). A
+//! parameter is never silently ignored); that check and the dispatch cost some 6-7 ns of 49
+//! at n = 2 (docs/performance.md). A
 //! kernel takes no parameters, so it has nothing to check: the loop of a simulation or a
 //! sweep point at one parameter vector can call it directly.
 
