@@ -422,34 +422,44 @@ fn print_steps(o: &mut impl Write, d: &Diagnosis) -> io::Result<()> {
         "\nsteps (each refits the nominal parameters and every effect named so far):"
     )?;
     for s in &d.steps {
-        let left: Vec<String> = s
-            .channels
-            .iter()
-            .map(|c| format!("{} {:.2}", c.channel, c.ratio))
-            .collect();
-        writeln!(
-            o,
-            "  {}. {:<24} closes {:.2} [{:.2}, {:.2}] of what remained; {:.2} [{:.2}, {:.2}] in all; held-out error {:.3}; rms/noise {}",
-            s.step,
-            s.label(),
-            s.closure.value,
-            s.closure.ci_low,
-            s.closure.ci_high,
-            s.cumulative.value,
-            s.cumulative.ci_low,
-            s.cumulative.ci_high,
-            s.holdout_error,
-            left.join(", ")
-        )?;
+        writeln!(o, "  {}. {:<24} {}", s.step, s.label(), step_summary(s))?;
         for q in &s.params {
-            writeln!(
-                o,
-                "       {} = {:.4e} [{:.4e}, {:.4e}] {}",
-                q.name, q.value, q.ci_low, q.ci_high, q.unit
-            )?;
+            let iv = if q.ci_low.is_finite() {
+                format!("[{:.4e}, {:.4e}]", q.ci_low, q.ci_high)
+            } else {
+                "(no interval)".into()
+            };
+            writeln!(o, "       {} = {:.4e} {iv} {}", q.name, q.value, q.unit)?;
         }
     }
     Ok(())
+}
+
+/// What a step closed and left; for a step without a simulated closure (end stops named
+/// from the measured acceleration alone), why.
+fn step_summary(s: &stirling_models::diagnose::types::Step) -> String {
+    if !s.cumulative.value.is_finite() {
+        return s
+            .simulation_gap_note
+            .clone()
+            .unwrap_or_else(|| "no simulated closure".into());
+    }
+    let left: Vec<String> = s
+        .channels
+        .iter()
+        .map(|c| format!("{} {:.2}", c.channel, c.ratio))
+        .collect();
+    format!(
+        "closes {:.2} [{:.2}, {:.2}] of what remained; {:.2} [{:.2}, {:.2}] in all; held-out error {:.3}; rms/noise {}",
+        s.closure.value,
+        s.closure.ci_low,
+        s.closure.ci_high,
+        s.cumulative.value,
+        s.cumulative.ci_low,
+        s.cumulative.ci_high,
+        s.holdout_error,
+        left.join(", ")
+    )
 }
 
 /// The driven subsystems' held-out gap per channel and the calibrated parameters.

@@ -58,7 +58,13 @@ pub fn assess_all(
             && s.effect.target == EffectTarget::Model
             && !screen::has_travel(s.effect)
     };
-    let fit = |s: &screen::Screened| opts.fit_all || s.significant(level) || from_reset(s);
+    // beside seen end stops every candidate without travels is judged on the channels the
+    // stops do not touch (`untouched`), whatever its score, on the nominal calibration
+    let untouched = on.basis.effects.is_empty() && super::untouched::has_gap(ctx, on.base_eval);
+    let beside_stops = |s: &screen::Screened| untouched && !screen::has_travel(s.effect);
+    let fit = |s: &screen::Screened| {
+        opts.fit_all || s.significant(level) || from_reset(s) || beside_stops(s)
+    };
     report(opts, || {
         let sig = screened.iter().filter(|s| s.significant(level)).count();
         let fitted = screened.iter().filter(|s| fit(s)).count();
@@ -76,7 +82,7 @@ pub fn assess_all(
         }
     });
     rank::sort(&mut assessed, level);
-    attach_closures(ctx, on.base_eval, &mut assessed, opts);
+    attach_closures(ctx, on.base_eval, &mut assessed, (opts, untouched));
     assessed
 }
 
@@ -109,12 +115,13 @@ fn screen_line(
     )
 }
 
-/// The closure, with its interval, of the basis's held-out gap by every fitted candidate.
+/// The closure, with its interval, of the basis's held-out gap by every fitted candidate
+/// (and beside seen end stops, of the gap on the channels they do not touch).
 fn attach_closures(
     ctx: &Context,
     base: &Eval,
     assessed: &mut [rank::Assessed],
-    opts: &DiagnoseOptions,
+    (opts, untouched): (&DiagnoseOptions, bool),
 ) {
     for a in assessed.iter_mut() {
         if let Some(ev) = &a.eval {
@@ -130,6 +137,9 @@ fn attach_closures(
             a.entry.closure_fraction = Some(c.fraction);
             a.entry.ci_low = Some(c.ci_low);
             a.entry.ci_high = Some(c.ci_high);
+            if untouched {
+                a.entry.untouched = super::untouched::closure_on(ctx, base, ev, opts);
+            }
         }
     }
 }

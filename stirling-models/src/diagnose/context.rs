@@ -90,6 +90,11 @@ pub struct Context<'a> {
     /// the model's coordinates: on the restarted pass the stops are screened and fitted at
     /// these travels, held (empty: none seen, or the first pass).
     pub held_travels: Vec<(&'static str, f64)>,
+    /// On the one-run pass of a record whose end stops are seen in the measured acceleration:
+    /// the channels of the stages that predict no body whose stops are seen (the gas stage,
+    /// driven by the measured positions, so blind to the stops), on which every candidate
+    /// without travels is also judged ([`super::untouched`]). Empty otherwise.
+    pub untouched: Vec<String>,
 }
 
 impl Context<'_> {

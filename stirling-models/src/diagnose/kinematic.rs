@@ -191,6 +191,7 @@ fn step(row: &RankEntry, held: &HeldOut, data: &Measured, ranking: &[RankEntry])
         after_stops: false,
         from_reset: false,
         one_run: false,
+        evidence: super::types::Evidence::Steps,
         superseded: None,
         eval: None,
     }

@@ -76,6 +76,8 @@ pub mod stops_equation;
 pub mod superseded;
 /// What a diagnosis reports.
 pub mod types;
+/// An effect beside seen end stops, judged on the channels the stops do not touch.
+pub mod untouched;
 /// The verdict a user reads.
 pub mod verdict;
 

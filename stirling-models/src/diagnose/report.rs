@@ -92,9 +92,18 @@ fn waterfall_figure(d: &Diagnosis, dir: &Path) -> Result<Option<String>, DrawErr
         return Ok(None);
     }
     let start = d.gap_before.holdout_error - 1.0;
-    let labels: Vec<String> = d.steps.iter().map(|s| s.label()).collect();
-    let drops: Vec<plot::waterfall::Drop> = d
+    // a step without a simulated closure (end stops named from the measured acceleration
+    // alone, `diagnose::untouched`) has no level to draw
+    let steps: Vec<&super::types::Step> = d
         .steps
+        .iter()
+        .filter(|s| s.cumulative.value.is_finite())
+        .collect();
+    if steps.is_empty() {
+        return Ok(None);
+    }
+    let labels: Vec<String> = steps.iter().map(|s| s.label()).collect();
+    let drops: Vec<plot::waterfall::Drop> = steps
         .iter()
         .zip(&labels)
         .map(|(s, label)| plot::waterfall::Drop {

@@ -35,15 +35,18 @@ pub fn diagnose(
     let mut opts = opts.clone();
     (opts.fit.sim.rtol, opts.fit.sim.atol) = (opts.rtol, opts.rtol);
     let opts = &opts;
-    let first = diagnose_once(model, p0, data, opts, &[])?;
-    let mut d = super::restarted::second_pass(model, p0, data, opts, &first)
+    let seen = super::restarted::stops_seen(data, opts);
+    let first = diagnose_once(model, p0, data, opts, &seen)?;
+    let mut d = super::restarted::second_pass(model, p0, data, opts, (&first, &seen))
         .map_or(first, |second| *second);
     d.seconds = clock.elapsed().as_secs_f64();
     Ok(d)
 }
 
 /// One pass of the diagnosis with `opts` as given; on the restarted pass the end stops
-/// `seen` in the measured acceleration hold their travels ([`super::restarted`]).
+/// `seen` in the measured acceleration hold their travels ([`super::restarted`]), on the
+/// one-run pass the channels they do not touch judge the candidates too
+/// ([`super::untouched`]).
 pub(super) fn diagnose_once(
     model: &dyn Model,
     p0: &[f64],
@@ -60,6 +63,8 @@ pub(super) fn diagnose_once(
     let mut ctx = context(model, data, &b, &stages, p_nom.clone(), opts)?;
     if ctx.restarted {
         ctx.held_travels = held_travels(seen, &id.offsets);
+    } else {
+        ctx.untouched = super::untouched::channels(&ctx.nominal_preds, seen);
     }
     let all: Vec<Prediction> = ctx.nominal_preds.iter().flatten().cloned().collect();
     let nominal = ctx.eval(&all, vec![], p_nom.clone())?;
@@ -218,6 +223,7 @@ fn context<'a>(
         fits: std::sync::atomic::AtomicUsize::new(1),
         restarted: opts.fit.restart_cycles.is_some(),
         held_travels: Vec::new(),
+        untouched: Vec::new(),
         progress: opts.progress,
     })
 }

@@ -316,6 +316,7 @@ fn make_step(
         after_stops: false,
         from_reset: e.from_reset,
         one_run: false,
+        evidence: super::types::Evidence::Steps,
         superseded: None,
         eval: Some(named.eval.clone()),
     }

@@ -75,6 +75,23 @@ pub struct RankEntry {
     /// Fitted from the reset start although its score is not significant: a later round on
     /// a calibration that absorbed something ([`super::steps::RESET_P`]).
     pub from_reset: bool,
+    /// Beside end stops seen in the measured acceleration, on the one-run pass: its
+    /// closure of the held-out gap on the channels the stops do not touch
+    /// ([`super::untouched`]).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub untouched: Option<UntouchedClosure>,
+}
+
+/// A candidate's closure of the held-out gap on the channels the seen end stops do not
+/// touch ([`super::untouched`]).
+#[derive(Clone, Debug, Serialize)]
+pub struct UntouchedClosure {
+    pub channels: Vec<String>,
+    /// Held-out error on those channels, in noise variances, at the nominal calibration and
+    /// with the candidate fitted.
+    pub before: f64,
+    pub after: f64,
+    pub closure: Interval,
 }
 
 impl RankEntry {
@@ -96,6 +113,7 @@ impl RankEntry {
             seconds: 0.0,
             moved: false,
             from_reset: false,
+            untouched: None,
         }
     }
 }
@@ -167,6 +185,10 @@ pub struct Step {
     /// Named on the one-run pass beside end stops seen on the second pass
     /// ([`super::partner`]): its estimates, score and closure are the one-run pass's.
     pub one_run: bool,
+    /// What names the step when it is not the rule of the steps (or of a partner):
+    /// the channels the seen stops do not touch, or the measured acceleration alone
+    /// ([`super::untouched`]).
+    pub evidence: Evidence,
     /// Not kept: the last step's joint fit does not need this step's effect
     /// ([`super::superseded`]).
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -174,6 +196,22 @@ pub struct Step {
     /// Residual series after this step, for the report.
     #[serde(skip)]
     pub eval: Option<Eval>,
+}
+
+/// What names a step ([`Step::evidence`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Evidence {
+    /// The rule of the steps ([`super::steps::StepRule`]) or of a one-run partner
+    /// ([`super::partner`]).
+    #[default]
+    Steps,
+    /// Its closure of the gap on the channels the seen end stops do not touch
+    /// ([`super::untouched::clears`]).
+    Untouched,
+    /// End stops seen in the measured acceleration, named without a simulated fit
+    /// ([`super::untouched::seen_step`]).
+    Acceleration,
 }
 
 /// Why a step's effect is not kept in the verdict.
@@ -218,6 +256,7 @@ impl Step {
             after_stops: false,
             from_reset: false,
             one_run: false,
+            evidence: Evidence::Steps,
             superseded: None,
             eval: None,
         }

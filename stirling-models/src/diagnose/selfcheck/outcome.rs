@@ -12,7 +12,7 @@ use super::record::{record, seeded_start, signature, Signature};
 use crate::diagnose::partner;
 use crate::diagnose::run::diagnose;
 use crate::diagnose::steps::StepRule;
-use crate::diagnose::types::{Diagnosis, RankEntry};
+use crate::diagnose::types::{Diagnosis, Evidence, RankEntry};
 use crate::diagnose::verdict::{pick, Pick, Thresholds, GROSS_GAP};
 use crate::diagnose::DiagnoseError;
 
@@ -81,6 +81,9 @@ pub struct StepBrief {
     pub from_reset: bool,
     /// Named on the one-run pass beside the stops ([`crate::diagnose::partner`]).
     pub one_run: bool,
+    /// What named it when not a step's rule: the channels the stops do not touch or the
+    /// measured acceleration ([`crate::diagnose::untouched`]).
+    pub evidence: Evidence,
     /// Not kept: the joint fit of this step (1 for the first) does not need it
     /// ([`crate::diagnose::superseded`]).
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -130,25 +133,39 @@ impl Outcome {
             let rule = StepRule::at(th.strong_bic, s.after_stops);
             let moved = true;
             let at = (level, s.from_reset);
-            let passes = if s.one_run {
-                partner::passes(s.p_value, Some(s.delta_bic), th.strong_bic)
-            } else {
-                rule.passes(moved, s.p_value, Some(s.delta_bic), Some(s.ci_low), at)
+            let passes = match s.evidence {
+                // no threshold of the verdict's decides these: the hinge's share, and the
+                // untouched channels' closure bound (the tuned closure bound)
+                Evidence::Acceleration => true,
+                Evidence::Untouched => s.ci_low > th.min_closure,
+                Evidence::Steps if s.one_run => {
+                    partner::passes(s.p_value, Some(s.delta_bic), th.strong_bic)
+                }
+                Evidence::Steps => {
+                    rule.passes(moved, s.p_value, Some(s.delta_bic), Some(s.ci_low), at)
+                }
             };
             if !passes {
                 break;
             }
             named.extend(s.effects.iter().map(|e| (s.superseded_by, e)));
-            cumulative = s.cumulative_low;
+            if s.evidence == Evidence::Steps {
+                cumulative = s.cumulative_low;
+            }
             kept += 1;
         }
+        // end stops named from the acceleration stand without a simulated closure
+        let seen = self
+            .steps
+            .iter()
+            .any(|s| s.evidence == Evidence::Acceleration);
         // a step superseded by one the thresholds keep is not named
         let named: Vec<String> = named
             .into_iter()
             .filter(|(by, _)| by.is_none_or(|b| b > kept))
             .map(|(_, e)| e.clone())
             .collect();
-        if !named.is_empty() && cumulative > th.min_closure {
+        if !named.is_empty() && (seen || cumulative > th.min_closure) {
             named_label(&named, self.remainder)
         } else if self.ranking.iter().any(|r| r.p_value < level) || self.gap > GROSS_GAP {
             "unexplained".into()
@@ -211,6 +228,7 @@ impl Outcome {
                 after_stops: s.after_stops,
                 from_reset: s.from_reset,
                 one_run: s.one_run,
+                evidence: s.evidence,
                 superseded_by: s.superseded.as_ref().map(|x| x.by_step),
                 holdout_error: s.holdout_error,
                 channels: s
@@ -290,4 +308,65 @@ pub fn run_case(
     };
     out.seconds = clock.elapsed().as_secs_f64();
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn brief(effect: &str, evidence: Evidence, ci_low: f64, cumulative_low: f64) -> StepBrief {
+        StepBrief {
+            effects: vec![effect.into()],
+            p_value: f64::NAN,
+            delta_bic: f64::NAN,
+            ci_low,
+            cumulative_low,
+            after_stops: evidence == Evidence::Untouched,
+            from_reset: false,
+            one_run: evidence == Evidence::Untouched,
+            evidence,
+            superseded_by: None,
+            holdout_error: f64::NAN,
+            channels: Vec::new(),
+        }
+    }
+
+    fn outcome(steps: Vec<StepBrief>) -> Outcome {
+        let mut o = Outcome::blank(&Planned {
+            index: 47,
+            truth: Truth::Clean,
+            split: Split::Eval,
+            seed: 1005,
+            perturb_seed: 1,
+        });
+        o.error = None;
+        o.candidates = 6;
+        o.remainder = true;
+        o.steps = steps;
+        o
+    }
+
+    #[test]
+    fn stops_named_from_the_acceleration_and_a_gas_effect_beside_them_keep_their_verdict() {
+        // the stops beside a leak: no simulated closure, the leak's closure of the gas
+        // channel's gap 0.999 [0.99, 1.0]
+        let th = Thresholds::at(0.01);
+        let o = outcome(vec![
+            brief("end_stops", Evidence::Acceleration, f64::NAN, f64::NAN),
+            brief("leak", Evidence::Untouched, 0.99, f64::NAN),
+        ]);
+        assert_eq!(
+            o.relabel(&th),
+            named_label(&["end_stops".to_string(), "leak".to_string()], true)
+        );
+        // a tighter closure bound than the gas channel's closure drops the leak, not the stops
+        let tight = Thresholds {
+            min_closure: 0.995,
+            ..th
+        };
+        assert_eq!(
+            o.relabel(&tight),
+            named_label(&["end_stops".to_string()], true)
+        );
+    }
 }
