@@ -249,10 +249,23 @@ fn steps_section(s: &mut String, d: &Diagnosis) {
     }
     let _ = writeln!(
         s,
-        "## The explanation step by step\n\nEach step refits the nominal parameters and every effect named so far jointly; closures are of the held-out excess error (1 is the noise floor), with 95 % bootstrap intervals over cycles. Figure `gap_waterfall.svg`.\n\n| step | effect | closes of what remained | in all | held-out error | rms/noise by channel | parameters |\n|---|---|---|---|---|---|---|"
+        "## The explanation step by step\n\nEach step refits the nominal parameters and every effect named so far jointly; closures are of the held-out excess error (1 is the noise floor), with 95 % bootstrap intervals over cycles. Figure `gap_waterfall.svg` (the steps with a simulated closure).\n\n| step | effect | closes of what remained | in all | held-out error | rms/noise by channel | parameters |\n|---|---|---|---|---|---|---|"
     );
-    let iv =
-        |i: &super::types::Interval| format!("{:.2} [{:.2}, {:.2}]", i.value, i.ci_low, i.ci_high);
+    // a step without a simulated closure (end stops from the acceleration alone): a dash
+    let iv = |i: &super::types::Interval| {
+        if i.value.is_finite() {
+            format!("{:.2} [{:.2}, {:.2}]", i.value, i.ci_low, i.ci_high)
+        } else {
+            "-".into()
+        }
+    };
+    let err = |e: f64| {
+        if e.is_finite() {
+            format!("{e:.3}")
+        } else {
+            "-".into()
+        }
+    };
     for st in &d.steps {
         let ch: Vec<String> = st
             .channels
@@ -262,15 +275,25 @@ fn steps_section(s: &mut String, d: &Diagnosis) {
         let params = param_list(&st.params);
         let _ = writeln!(
             s,
-            "| {} | {} | {} | {} | {:.3} | {} | {} |",
+            "| {} | {} | {} | {} | {} | {} | {} |",
             st.step,
             st.label(),
             iv(&st.closure),
             iv(&st.cumulative),
-            st.holdout_error,
+            err(st.holdout_error),
             ch.join(", "),
             params
         );
+    }
+    for st in d.steps.iter().filter(|st| st.simulation_gap.is_none()) {
+        if let Some(note) = &st.simulation_gap_note {
+            let _ = writeln!(
+                s,
+                "\nStep {} (`{}`): {note}.",
+                st.step,
+                st.effects.join(" + ")
+            );
+        }
     }
     for st in &d.steps {
         if let Some(g) = &st.simulation_gap {
@@ -370,10 +393,14 @@ fn param_list(params: &[super::types::EffectEstimate]) -> String {
     params
         .iter()
         .map(|q| {
-            format!(
-                "{} = {:.3e} [{:.3e}, {:.3e}] {}",
-                q.name, q.value, q.ci_low, q.ci_high, q.unit
-            )
+            if q.ci_low.is_finite() {
+                format!(
+                    "{} = {:.3e} [{:.3e}, {:.3e}] {}",
+                    q.name, q.value, q.ci_low, q.ci_high, q.unit
+                )
+            } else {
+                format!("{} = {:.3e} (no interval) {}", q.name, q.value, q.unit)
+            }
         })
         .collect::<Vec<_>>()
         .join("; ")

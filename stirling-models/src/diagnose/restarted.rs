@@ -207,6 +207,12 @@ fn seen_only(
         d.verdict.effects.push(e.effect.clone());
         d.verdict.reason = format!("{}; {}", d.verdict.reason, untouched::reason(e));
     }
+    // the one-run pass's simulated gap is of its leading candidate, which is not named
+    d.simulation_gap = None;
+    d.simulation_gap_note = Some(
+        "the end stops are named from the measured acceleration, and the model with them does not follow the record on its own".into(),
+    );
+    d.after = None;
     d.stops_seen = seen.to_vec();
     d.one_run = first.ranking.clone();
     Some(d)
