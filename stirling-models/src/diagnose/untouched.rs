@@ -13,13 +13,14 @@
 //!
 //! So beside seen stops every candidate without travels is fitted on the one-run pass and
 //! its closure taken on the untouched channels alone. The one that closes the most is named
-//! when those channels carry a gap ([`UNTOUCHED_GAP`]) and the lower bound of its closure
-//! clears the verdict's [`MIN_CLOSURE`]. Measured on the 27 stop records of the two-seed
-//! self-check (docs/diagnosis.md): without a gas-side effect the gas channel sits at
-//! 1.00-1.04 noise sd (1.08 noise variances at most); beside a leak, a position gain or a
-//! pressure lag at 4.0 to 7.1 sd, each closed to 1.0-1.4 by the true effect and by no other
-//! as far; beside the speed-dependent heat transfer (outside the library) at 2.1 sd, which
-//! no candidate closes by more than a tenth.
+//! when those channels carry a gap
+//! ([`UNTOUCHED_GAP`](crate::diagnose::untouched::UNTOUCHED_GAP)) and the lower bound of
+//! its closure clears the verdict's [`MIN_CLOSURE`](crate::diagnose::verdict::MIN_CLOSURE).
+//! Measured on the 27 stop records of the two-seed self-check (docs/diagnosis.md): without
+//! a gas-side effect the gas channel sits at 1.00-1.04 noise sd (1.08 noise variances at
+//! most); beside a leak, a position gain or a pressure lag at 4.0 to 7.1 sd, each closed to
+//! 1.0-1.4 by the true effect and by no other as far; beside the speed-dependent heat
+//! transfer (outside the library) at 2.1 sd, which no candidate closes by a tenth.
 
 use super::closure;
 use super::context::{Context, Eval, Prediction};
