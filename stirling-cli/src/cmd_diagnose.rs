@@ -449,17 +449,7 @@ fn step_summary(s: &stirling_models::diagnose::types::Step) -> String {
         .iter()
         .map(|c| format!("{} {:.2}", c.channel, c.ratio))
         .collect();
-    format!(
-        "closes {:.2} [{:.2}, {:.2}] of what remained; {:.2} [{:.2}, {:.2}] in all; held-out error {:.3}; rms/noise {}",
-        s.closure.value,
-        s.closure.ci_low,
-        s.closure.ci_high,
-        s.cumulative.value,
-        s.cumulative.ci_low,
-        s.cumulative.ci_high,
-        s.holdout_error,
-        left.join(", ")
-    )
+    format!("{}; rms/noise {}", s.closure_text(), left.join(", "))
 }
 
 /// The driven subsystems' held-out gap per channel and the calibrated parameters.

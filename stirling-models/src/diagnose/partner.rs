@@ -90,23 +90,17 @@ pub fn name<'f>(
 /// one-run gap; the cumulative closure and held-out errors stay the last step's (`last`),
 /// which the partner's one-run fit does not change.
 fn step_of(e: &RankEntry, last: Option<&Step>, index: usize) -> Step {
-    Step {
-        step: index,
-        closure: Interval {
-            value: e.closure_fraction.unwrap_or(f64::NAN),
-            ci_low: e.ci_low.unwrap_or(f64::NAN),
-            ci_high: e.ci_high.unwrap_or(f64::NAN),
-        },
-        cumulative: last.map_or(Interval::NAN, |s| s.cumulative),
-        holdout_error: last.map_or(f64::NAN, |s| s.holdout_error),
-        channels: last.map(|s| s.channels.clone()).unwrap_or_default(),
-        simulation_gap_note: Some(
-            "named on the one-run pass beside the end stops: no simulated gap of its own".into(),
-        ),
-        after_stops: true,
-        one_run: true,
-        ..Step::of_entry(e)
-    }
+    let closure = Interval {
+        value: e.closure_fraction.unwrap_or(f64::NAN),
+        ci_low: e.ci_low.unwrap_or(f64::NAN),
+        ci_high: e.ci_high.unwrap_or(f64::NAN),
+    };
+    Step::one_run_of(
+        e,
+        (last, index),
+        closure,
+        "named on the one-run pass beside the end stops: no simulated gap of its own",
+    )
 }
 
 #[cfg(test)]

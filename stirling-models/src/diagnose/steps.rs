@@ -325,16 +325,14 @@ fn make_step(
 /// The progress line of a step.
 fn step_line(s: &Step, clock: Instant) -> String {
     format!(
-        "step: {}{} closes {:.2} [{:.2}, {:.2}] of what remained, {:.2} [{:.2}, {:.2}] in all; held-out error {:.3} ({:.1} s)",
+        "step: {}{} {} ({:.1} s)",
         s.effects.join(" + "),
-        if s.from_reset { " (from the reset start)" } else { "" },
-        s.closure.value,
-        s.closure.ci_low,
-        s.closure.ci_high,
-        s.cumulative.value,
-        s.cumulative.ci_low,
-        s.cumulative.ci_high,
-        s.holdout_error,
+        if s.from_reset {
+            " (from the reset start)"
+        } else {
+            ""
+        },
+        s.closure_text(),
         clock.elapsed().as_secs_f64()
     )
 }

@@ -238,6 +238,43 @@ impl Step {
 
     /// A step naming the entry `e` alone with its score, BIC change and estimates; no
     /// closure (NaN), no held-out errors, no ranking.
+    /// A step named on the one-run pass beside end stops (`index`, after `last`): the
+    /// entry's one-run estimates, score and BIC change, its `closure`; the cumulative
+    /// closure and held-out errors stay the last step's, which a one-run fit does not
+    /// change. `note`: why it has no simulated gap of its own.
+    pub fn one_run_of(
+        e: &RankEntry,
+        (last, index): (Option<&Step>, usize),
+        closure: Interval,
+        note: &str,
+    ) -> Step {
+        Step {
+            step: index,
+            closure,
+            cumulative: last.map_or(Interval::NAN, |s| s.cumulative),
+            holdout_error: last.map_or(f64::NAN, |s| s.holdout_error),
+            channels: last.map(|s| s.channels.clone()).unwrap_or_default(),
+            simulation_gap_note: Some(note.into()),
+            after_stops: true,
+            one_run: true,
+            ..Step::of_entry(e)
+        }
+    }
+
+    /// What the step closed, of what remained and in all, and the held-out error after it.
+    pub fn closure_text(&self) -> String {
+        format!(
+            "closes {:.2} [{:.2}, {:.2}] of what remained; {:.2} [{:.2}, {:.2}] in all; held-out error {:.3}",
+            self.closure.value,
+            self.closure.ci_low,
+            self.closure.ci_high,
+            self.cumulative.value,
+            self.cumulative.ci_low,
+            self.cumulative.ci_high,
+            self.holdout_error,
+        )
+    }
+
     pub fn of_entry(e: &RankEntry) -> Step {
         Step {
             step: 1,

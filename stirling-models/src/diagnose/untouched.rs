@@ -165,20 +165,15 @@ pub fn best<'f>(ranking: &'f [RankEntry], infos: &[&EffectInfo]) -> Option<&'f R
 /// and BIC change, its closure of those channels' gap; the cumulative closure and held-out
 /// errors stay the last step's (`last`).
 pub fn step_of(e: &RankEntry, last: Option<&Step>, index: usize) -> Step {
-    let u = e.untouched.as_ref();
+    let closure = e.untouched.as_ref().map_or(Interval::NAN, |u| u.closure);
     Step {
-        step: index,
-        closure: u.map_or(Interval::NAN, |u| u.closure),
-        cumulative: last.map_or(Interval::NAN, |s| s.cumulative),
-        holdout_error: last.map_or(f64::NAN, |s| s.holdout_error),
-        channels: last.map(|s| s.channels.clone()).unwrap_or_default(),
-        simulation_gap_note: Some(
-            "named on the one-run pass beside the end stops, on the channels they do not touch: its closure is of those channels' gap".into(),
-        ),
-        after_stops: true,
-        one_run: true,
         evidence: Evidence::Untouched,
-        ..Step::of_entry(e)
+        ..Step::one_run_of(
+            e,
+            (last, index),
+            closure,
+            "named on the one-run pass beside the end stops, on the channels they do not touch: its closure is of those channels' gap",
+        )
     }
 }
 
