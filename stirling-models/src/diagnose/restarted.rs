@@ -174,14 +174,14 @@ fn name_untouched(second: &mut Diagnosis, first: &Diagnosis, infos: &[&'static E
 /// piston's spring), while the acceleration's hinge needs no simulation and separates the
 /// records with stops from those without by a factor 5 or more (docs/diagnosis.md, "End
 /// stops seen in the acceleration"). `None` when the library has no stops, nothing is seen
-/// or the first pass named an effect (it stands).
+/// or the first pass is not `unexplained` (it stands).
 fn seen_only(
     first: &Diagnosis,
     seen: &[StopSide],
     infos: &[&'static EffectInfo],
 ) -> Option<Diagnosis> {
     let stops = infos.iter().find(|i| has_travel(i))?;
-    if seen.is_empty() || first.verdict.verdict == "effect" {
+    if seen.is_empty() || first.verdict.verdict != "unexplained" {
         return None;
     }
     let mut d = first.clone();
@@ -196,7 +196,7 @@ fn seen_only(
         d.verdict.ci_high,
     ) = (None, None, None);
     d.verdict.reason = format!(
-        "`{}` named from the measured acceleration alone: {}; the model with the stops, restarted every {RESTART_CYCLES} cycle, does not close the held-out gap (the calibration absorbed something: a gap remains); one run gave `{}` ({})",
+        "`{}` named from the measured acceleration alone: {}; the model with the stops, restarted every {RESTART_CYCLES} cycle, does not close the held-out gap: a gap remains that the named effects are not shown to explain; one run gave `{}` ({})",
         stops.name,
         seen_text(seen),
         first.verdict.verdict,
