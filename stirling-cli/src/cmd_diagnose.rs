@@ -438,7 +438,7 @@ fn print_steps(o: &mut impl Write, d: &Diagnosis) -> io::Result<()> {
 /// What a step closed and left; for a step without a simulated closure (end stops named
 /// from the measured acceleration alone), why.
 fn step_summary(s: &stirling_models::diagnose::types::Step) -> String {
-    if !s.cumulative.value.is_finite() {
+    if !s.has_closure() {
         return s
             .simulation_gap_note
             .clone()

@@ -94,11 +94,7 @@ fn waterfall_figure(d: &Diagnosis, dir: &Path) -> Result<Option<String>, DrawErr
     let start = d.gap_before.holdout_error - 1.0;
     // a step without a simulated closure (end stops named from the measured acceleration
     // alone, `diagnose::untouched`) has no level to draw
-    let steps: Vec<&super::types::Step> = d
-        .steps
-        .iter()
-        .filter(|s| s.cumulative.value.is_finite())
-        .collect();
+    let steps: Vec<&super::types::Step> = d.steps.iter().filter(|s| s.has_closure()).collect();
     if steps.is_empty() {
         return Ok(None);
     }

@@ -236,8 +236,6 @@ impl Step {
         }
     }
 
-    /// A step naming the entry `e` alone with its score, BIC change and estimates; no
-    /// closure (NaN), no held-out errors, no ranking.
     /// A step named on the one-run pass beside end stops (`index`, after `last`): the
     /// entry's one-run estimates, score and BIC change, its `closure`; the cumulative
     /// closure and held-out errors stay the last step's, which a one-run fit does not
@@ -261,6 +259,12 @@ impl Step {
         }
     }
 
+    /// Whether the step carries a simulated closure of the nominal gap (not so for end
+    /// stops named from the measured acceleration alone, nor for what is named beside them).
+    pub fn has_closure(&self) -> bool {
+        self.cumulative.value.is_finite()
+    }
+
     /// What the step closed, of what remained and in all, and the held-out error after it.
     pub fn closure_text(&self) -> String {
         format!(
@@ -275,6 +279,8 @@ impl Step {
         )
     }
 
+    /// A step naming the entry `e` alone with its score, BIC change and estimates; no
+    /// closure (NaN), no held-out errors, no ranking.
     pub fn of_entry(e: &RankEntry) -> Step {
         Step {
             step: 1,
